@@ -1,0 +1,72 @@
+// GPU scene layout: mirrors src/gpu.rs field for field (16-byte vectors only,
+// so std430 equals the Rust #[repr(C)] layout; src/gpu.rs asserts the sizes).
+// Include after defining SCENE_SET (the descriptor set index of the scene).
+#ifndef COMMON_SCENE_GLSL
+#define COMMON_SCENE_GLSL
+
+#include "bindings.glsl"
+
+#ifndef SCENE_SET
+#define SCENE_SET 0
+#endif
+
+struct Triangle {
+    vec4 p0; // w: material index (uint bits)
+    vec4 p1; // w: object index (uint bits)
+    vec4 p2;
+    vec4 n0; // w: reserved
+    vec4 n1;
+    vec4 n2;
+};
+
+struct BvhNode {
+    vec3 bounds_min;
+    uint left_or_first; // inner: left child (right = left + 1); leaf: first triangle
+    vec3 bounds_max;
+    uint count;         // 0: inner node; else triangles in the leaf
+};
+
+struct Material {
+    vec4 color;          // rgb albedo/reflectance; w: kind (uint bits)
+    vec4 absorption_ior; // rgb absorption 1/m; w: ior
+};
+
+struct Light {
+    vec4 position;  // w: kind (uint bits)
+    vec4 direction; // unit, the way light travels; w: cos(cone half-angle)
+    vec4 intensity; // rgb W/sr or W/m^2; w: cos(half-angle - falloff)
+    vec4 power;     // x: luminance power for light selection
+};
+
+struct Medium {
+    vec4 sigma_s;    // rgb 1/m; w: g
+    vec4 sigma_a;    // rgb 1/m; w: density kind (uint bits)
+    vec4 bounds_min; // w: density scale
+    vec4 bounds_max; // w: maximum density
+    vec4 noise;      // xyz offset; w: frequency
+    uvec4 dims;      // xyz grid dims; w: noise octaves
+};
+
+layout(set = SCENE_SET, binding = BINDING_FRAME, std140) uniform FrameBlock {
+    mat4 view;
+    mat4 proj;
+    mat4 view_proj;
+    mat4 inv_view_proj;
+    vec4 eye;          // w: tan(fov_y/2)
+    vec4 viewport;     // width, height, aspect, time
+    vec4 scene_sphere; // centre, radius
+    uvec4 counts;      // lights, triangles, materials, frame index
+} frame;
+
+layout(set = SCENE_SET, binding = BINDING_TRIANGLES, std430) readonly buffer TriangleBlock { Triangle triangles[]; };
+layout(set = SCENE_SET, binding = BINDING_BVH_NODES, std430) readonly buffer BvhBlock { BvhNode bvh_nodes[]; };
+layout(set = SCENE_SET, binding = BINDING_MATERIALS, std430) readonly buffer MaterialBlock { Material materials[]; };
+layout(set = SCENE_SET, binding = BINDING_LIGHTS, std430) readonly buffer LightBlock { Light lights[]; };
+layout(set = SCENE_SET, binding = BINDING_MEDIUM, std430) readonly buffer MediumBlock { Medium medium; };
+layout(set = SCENE_SET, binding = BINDING_DENSITY_GRID, std430) readonly buffer DensityBlock { float density_grid[]; };
+
+uint triangle_material(uint tri) { return floatBitsToUint(triangles[tri].p0.w); }
+uint material_kind(uint m) { return floatBitsToUint(materials[m].color.w); }
+uint light_kind(uint l) { return floatBitsToUint(lights[l].position.w); }
+
+#endif

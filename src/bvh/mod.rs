@@ -1,0 +1,1 @@
+//! Bounding volume hierarchy (placeholder until the builder lands).

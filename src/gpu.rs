@@ -1,0 +1,196 @@
+//! GPU-side layouts of the scene, shared with `glsl/common/scene.glsl`.
+//! Every struct is made of 16-byte vectors only, so std430 and `#[repr(C)]`
+//! agree without padding rules; the const assertions below pin sizes and
+//! offsets, and the GLSL side mirrors the same field order.
+
+use crate::shader_bindings as b;
+use crate::scene::{Density, LightKind, Material, MaterialKind, Medium, Light, Triangle};
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3, Vec4};
+use std::mem::{offset_of, size_of};
+
+/// One world-space triangle in BVH leaf order; rasterised by vertex pulling
+/// (gl_VertexIndex / 3) and traced by the BVH, so both see the same data.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuTriangle {
+    /// xyz position of vertex 0; w = material index (uint bits).
+    pub p0: [f32; 4],
+    /// w = object index (uint bits).
+    pub p1: [f32; 4],
+    pub p2: [f32; 4],
+    /// Vertex normals; w reserved for per-vertex technique data.
+    pub n0: [f32; 4],
+    pub n1: [f32; 4],
+    pub n2: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuBvhNode {
+    pub bounds_min: [f32; 3],
+    /// Inner node: index of the left child (right = left + 1). Leaf: first triangle.
+    pub left_or_first: u32,
+    pub bounds_max: [f32; 3],
+    /// 0 for an inner node, else the number of triangles in the leaf.
+    pub count: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuMaterial {
+    /// rgb albedo / reflectance; w = kind (uint bits).
+    pub color: [f32; 4],
+    /// rgb absorption (1/m); w = ior.
+    pub absorption_ior: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuLight {
+    /// xyz position; w = kind (uint bits).
+    pub position: [f32; 4],
+    /// xyz unit direction light travels; w = cos(cone half-angle).
+    pub direction: [f32; 4],
+    /// rgb W/sr (point, spot) or W/m^2 (directional); w = cos(half-angle - falloff).
+    pub intensity: [f32; 4],
+    /// x = emitted power used to pick lights (W, luminance-weighted sum over rgb), yzw reserved.
+    pub power: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuMedium {
+    /// rgb sigma_s (1/m); w = Henyey-Greenstein g.
+    pub sigma_s: [f32; 4],
+    /// rgb sigma_a (1/m); w = density kind (uint bits, DENSITY_NONE when no medium).
+    pub sigma_a: [f32; 4],
+    /// xyz bounds min; w = density scale (constant value, or noise scale).
+    pub bounds_min: [f32; 4],
+    /// xyz bounds max; w = maximum density (the majorant's multiplier).
+    pub bounds_max: [f32; 4],
+    /// xyz noise offset; w = noise frequency (1/m).
+    pub noise: [f32; 4],
+    /// xyz grid dimensions; w = noise octaves.
+    pub dims: [u32; 4],
+}
+
+/// Per-frame constants (uniform buffer, binding BINDING_FRAME).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuFrame {
+    pub view: [[f32; 4]; 4],
+    pub proj: [[f32; 4]; 4],
+    pub view_proj: [[f32; 4]; 4],
+    pub inv_view_proj: [[f32; 4]; 4],
+    /// xyz camera position; w = tan(fov_y / 2).
+    pub eye: [f32; 4],
+    /// x width, y height (pixels), z aspect, w animation time (s).
+    pub viewport: [f32; 4],
+    /// xyz centre, w radius of the scene's bounding sphere.
+    pub scene_sphere: [f32; 4],
+    /// x lights, y triangles, z materials, w frame index.
+    pub counts: [u32; 4],
+}
+
+const _: () = {
+    assert!(size_of::<GpuTriangle>() == 96);
+    assert!(size_of::<GpuBvhNode>() == 32);
+    assert!(offset_of!(GpuBvhNode, count) == 28);
+    assert!(size_of::<GpuMaterial>() == 32);
+    assert!(size_of::<GpuLight>() == 64);
+    assert!(size_of::<GpuMedium>() == 96);
+    assert!(offset_of!(GpuMedium, dims) == 80);
+    assert!(size_of::<GpuFrame>() == 320);
+    assert!(offset_of!(GpuFrame, eye) == 256);
+    assert!(offset_of!(GpuFrame, counts) == 304);
+};
+
+fn v4(v: Vec3, w: f32) -> [f32; 4] {
+    [v.x, v.y, v.z, w]
+}
+
+impl GpuTriangle {
+    pub fn new(t: &Triangle) -> Self {
+        let [p0, p1, p2] = t.positions;
+        let [n0, n1, n2] = t.normals;
+        Self {
+            p0: v4(p0, f32::from_bits(t.material)),
+            p1: v4(p1, f32::from_bits(t.object)),
+            p2: v4(p2, 0.0),
+            n0: v4(n0, 0.0),
+            n1: v4(n1, 0.0),
+            n2: v4(n2, 0.0),
+        }
+    }
+}
+
+impl GpuMaterial {
+    pub fn new(m: &Material) -> Self {
+        let kind = match m.kind {
+            MaterialKind::Diffuse => b::MATERIAL_DIFFUSE,
+            MaterialKind::Mirror => b::MATERIAL_MIRROR,
+            MaterialKind::Dielectric => b::MATERIAL_DIELECTRIC,
+        };
+        Self { color: v4(m.color, f32::from_bits(kind)), absorption_ior: v4(m.absorption, m.ior) }
+    }
+}
+
+/// Luminance weights used to turn rgb power into one number for light selection.
+pub const LUMINANCE: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);
+
+impl GpuLight {
+    /// `scene_radius` is the radius of the scene's bounding sphere: a directional
+    /// light's photons leave a disk of that radius, so its power is E * pi * R^2.
+    pub fn new(l: &Light, scene_radius: f32) -> Self {
+        let kind = match l.kind {
+            LightKind::Point => b::LIGHT_POINT,
+            LightKind::Spot => b::LIGHT_SPOT,
+            LightKind::Directional => b::LIGHT_DIRECTIONAL,
+        };
+        let outer = l.cone_angle_deg.to_radians();
+        let inner = (l.cone_angle_deg - l.cone_falloff_deg).max(0.0).to_radians();
+        let (cos_outer, cos_inner) = match l.kind {
+            LightKind::Spot => (outer.cos(), inner.cos()),
+            _ => (-1.0, -1.0),
+        };
+        Self {
+            position: v4(l.position, f32::from_bits(kind)),
+            direction: v4(l.direction.normalize_or_zero(), cos_outer),
+            intensity: v4(l.intensity, cos_inner),
+            power: [crate::radiometry::light_power(l, scene_radius).dot(LUMINANCE), 0.0, 0.0, 0.0],
+        }
+    }
+}
+
+impl GpuMedium {
+    pub fn none() -> Self {
+        let mut m = Self::zeroed();
+        m.sigma_a[3] = f32::from_bits(b::DENSITY_NONE);
+        m
+    }
+
+    pub fn new(m: &Medium) -> Self {
+        let (kind, scale, noise, dims) = match &m.density {
+            Density::Constant(d) => (b::DENSITY_CONSTANT, *d, Vec4::ZERO, [0; 4]),
+            Density::Noise { scale, frequency, octaves, offset } => {
+                (b::DENSITY_NOISE, *scale, offset.extend(*frequency), [0, 0, 0, *octaves])
+            }
+            Density::Grid { dims, .. } => (b::DENSITY_GRID, 1.0, Vec4::ZERO, [dims[0], dims[1], dims[2], 0]),
+        };
+        Self {
+            sigma_s: v4(m.sigma_s, m.g),
+            sigma_a: v4(m.sigma_a, f32::from_bits(kind)),
+            bounds_min: v4(m.bounds_min, scale),
+            bounds_max: v4(m.bounds_max, m.max_density()),
+            noise: noise.to_array(),
+            dims,
+        }
+    }
+}
+
+impl GpuFrame {
+    pub fn mat(m: Mat4) -> [[f32; 4]; 4] {
+        m.to_cols_array_2d()
+    }
+}

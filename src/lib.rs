@@ -1,0 +1,9 @@
+//! caustics: real-time caustics techniques on raw Vulkan, side by side against
+//! a GPU ground-truth light tracer. See docs/ARCHITECTURE.md for the map.
+
+pub mod bvh;
+pub mod gpu;
+pub mod radiometry;
+pub mod scene;
+pub mod shader_bindings;
+pub mod shaders;

@@ -1,0 +1,105 @@
+//! The shared radiometric conventions (GUIDE §2) as host-side functions.
+//! Shaders implement the same formulas in `glsl/common/`; tests check both.
+
+use crate::scene::{Light, LightKind};
+use glam::Vec3;
+use std::f32::consts::PI;
+
+/// Spot-light angular falloff: 1 inside `cos_inner`, 0 outside `cos_outer`,
+/// smoothstep in cos(theta) between (glsl/common/lights.glsl: spot_falloff).
+pub fn spot_falloff(cos_theta: f32, cos_outer: f32, cos_inner: f32) -> f32 {
+    if cos_inner <= cos_outer {
+        return if cos_theta >= cos_outer { 1.0 } else { 0.0 };
+    }
+    let t = ((cos_theta - cos_outer) / (cos_inner - cos_outer)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// Total emitted power (W per channel).
+/// Point: 4 pi I. Spot: I times the falloff integrated over the sphere,
+/// 2 pi [(1 - cos_inner) + (cos_inner - cos_outer) / 2] (a smoothstep integrates to
+/// half its interval). Directional: E times the area of the disk its photons
+/// leave, pi R^2, R the scene's bounding-sphere radius.
+pub fn light_power(light: &Light, scene_radius: f32) -> Vec3 {
+    match light.kind {
+        LightKind::Point => light.intensity * 4.0 * PI,
+        LightKind::Spot => {
+            let cos_outer = light.cone_angle_deg.to_radians().cos();
+            let cos_inner = (light.cone_angle_deg - light.cone_falloff_deg).max(0.0).to_radians().cos();
+            light.intensity * 2.0 * PI * ((1.0 - cos_inner) + 0.5 * (cos_inner - cos_outer))
+        }
+        LightKind::Directional => light.intensity * PI * scene_radius * scene_radius,
+    }
+}
+
+/// Unpolarised Fresnel reflectance of a dielectric interface (exact equations),
+/// `cos_i` the cosine of the incident angle, `eta` = n_incident / n_transmitted.
+/// Returns 1 under total internal reflection.
+pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
+    let cos_i = cos_i.abs().min(1.0);
+    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let r_s = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let r_p = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    0.5 * (r_s * r_s + r_p * r_p)
+}
+
+/// Henyey-Greenstein phase function, normalised over the sphere (1/(4 pi) at g = 0).
+/// `cos_theta` is the cosine between the propagation directions before and after scattering.
+pub fn henyey_greenstein(cos_theta: f32, g: f32) -> f32 {
+    let denom = 1.0 + g * g - 2.0 * g * cos_theta;
+    (1.0 - g * g) / (4.0 * PI * denom * denom.sqrt())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fresnel_normal_incidence_matches_closed_form() {
+        let n = 1.5f32;
+        let f0 = ((n - 1.0) / (n + 1.0)).powi(2);
+        assert!((fresnel_dielectric(1.0, 1.0 / n) - f0).abs() < 1e-6);
+        assert!((fresnel_dielectric(1.0, n) - f0).abs() < 1e-6);
+        assert_eq!(fresnel_dielectric(0.1, 1.5), 1.0, "total internal reflection");
+    }
+
+    #[test]
+    fn henyey_greenstein_integrates_to_one() {
+        for g in [-0.7f32, 0.0, 0.3, 0.7] {
+            let n = 20000;
+            let sum: f64 = (0..n)
+                .map(|i| {
+                    let c = -1.0 + 2.0 * (i as f32 + 0.5) / n as f32;
+                    henyey_greenstein(c, g) as f64 * 2.0 * std::f64::consts::PI * (2.0 / n as f64)
+                })
+                .sum();
+            assert!((sum - 1.0).abs() < 1e-3, "g = {g}: {sum}");
+        }
+    }
+
+    #[test]
+    fn spot_power_matches_numerical_integral() {
+        let light = Light {
+            kind: LightKind::Spot,
+            position: Vec3::ZERO,
+            direction: Vec3::NEG_Y,
+            intensity: Vec3::ONE,
+            cone_angle_deg: 30.0,
+            cone_falloff_deg: 10.0,
+        };
+        let (co, ci) = (30f32.to_radians().cos(), 20f32.to_radians().cos());
+        let n = 100000;
+        let numeric: f32 = (0..n)
+            .map(|i| {
+                let c = -1.0 + 2.0 * (i as f32 + 0.5) / n as f32;
+                spot_falloff(c, co, ci) * 2.0 * PI * 2.0 / n as f32
+            })
+            .sum();
+        let p = light_power(&light, 1.0).x;
+        assert!((p - numeric).abs() / numeric < 1e-3, "{p} vs {numeric}");
+    }
+}

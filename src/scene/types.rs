@@ -1,0 +1,141 @@
+//! The resolved scene model: what a parsed and validated scene file becomes.
+//! Everything here is in world units (metres) and the shared radiometry
+//! (docs/SCENES.md, GUIDE §2): point/spot intensity in W/sr, directional
+//! irradiance in W/m^2, media coefficients in 1/m.
+
+use glam::{Mat4, Vec3};
+use std::path::PathBuf;
+
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The file the scene was read from (relative paths inside it resolve against its folder).
+    pub source: PathBuf,
+    pub camera: Camera,
+    pub lights: Vec<Light>,
+    pub materials: Vec<Material>,
+    pub objects: Vec<Object>,
+    pub medium: Option<Medium>,
+    pub output: Output,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    /// Vertical field of view in degrees.
+    pub fov_y_deg: f32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightKind {
+    Point,
+    Spot,
+    Directional,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Light {
+    pub kind: LightKind,
+    /// Position (point, spot). Unused for directional lights.
+    pub position: Vec3,
+    /// Unit vector: the way light travels (spot axis, directional direction).
+    pub direction: Vec3,
+    /// W/sr per channel for point and spot lights; W/m^2 (irradiance on a
+    /// surface facing the light) for directional lights.
+    pub intensity: Vec3,
+    /// Spot only: half-angle of the cone in degrees (zero intensity outside).
+    pub cone_angle_deg: f32,
+    /// Spot only: width in degrees of the smooth edge inside the cone over
+    /// which intensity falls from full to zero.
+    pub cone_falloff_deg: f32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MaterialKind {
+    Diffuse,
+    Mirror,
+    Dielectric,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    pub kind: MaterialKind,
+    /// Diffuse: albedo. Mirror: reflectance per channel. Dielectric: unused (1).
+    pub color: Vec3,
+    /// Dielectric: index of refraction (>= 1). Others: 1.
+    pub ior: f32,
+    /// Dielectric: Beer-Lambert absorption coefficient inside, 1/m. Others: 0.
+    pub absorption: Vec3,
+}
+
+/// Triangle geometry in an object's local space.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub positions: Vec<Vec3>,
+    /// One normal per position (computed when the source has none).
+    pub normals: Vec<Vec3>,
+    pub indices: Vec<[u32; 3]>,
+    /// Scene material index per triangle.
+    pub materials: Vec<u32>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Animation {
+    /// Spin about `spin_axis` (through the object's origin after scale/rotate) in degrees per second.
+    pub spin_deg_per_s: f32,
+    pub spin_axis: Vec3,
+    /// Orbit about `orbit_center` around the world y axis: radius (m) and degrees per second.
+    pub orbit_center: Vec3,
+    pub orbit_radius: f32,
+    pub orbit_deg_per_s: f32,
+    /// Vertical bob: amplitude (m) and frequency (Hz).
+    pub bob_amplitude: f32,
+    pub bob_hz: f32,
+}
+
+#[derive(Clone, Debug)]
+pub struct Object {
+    pub name: String,
+    pub mesh: Mesh,
+    /// Static placement (translate/rotate/scale from the file), local -> world.
+    pub transform: Mat4,
+    pub animation: Option<Animation>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Density {
+    /// Uniform density multiplier.
+    Constant(f32),
+    /// Procedural fractal value noise in [0, 1] scaled by `scale`:
+    /// density(x) = scale * fbm(x * frequency + offset) (glsl/common/medium.glsl).
+    Noise { scale: f32, frequency: f32, octaves: u32, offset: Vec3 },
+    /// A grid of densities over the medium bounds, x fastest, trilinear.
+    Grid { dims: [u32; 3], values: Vec<f32> },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Medium {
+    pub sigma_s: Vec3,
+    pub sigma_a: Vec3,
+    pub g: f32,
+    pub bounds_min: Vec3,
+    pub bounds_max: Vec3,
+    pub density: Density,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Output {
+    /// Exposure multiplier applied to radiance before the tonemap of PNG output.
+    pub exposure: f32,
+}
+
+/// A world-space triangle as the renderer consumes it (raster and BVH).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    pub positions: [Vec3; 3],
+    pub normals: [Vec3; 3],
+    pub material: u32,
+    pub object: u32,
+}

@@ -1,0 +1,43 @@
+//! Descriptor binding numbers and shared constants: the one source of truth
+//! for both Rust and GLSL. `build.rs` includes this file and writes every
+//! `pub const NAME: u32` as `#define NAME value` into the generated header
+//! `bindings.glsl`, which shaders `#include`. Keep this file to plain
+//! `pub const X: u32 = N;` lines so the build script can read it.
+
+// Set 0: the scene, shared by every pass that reads geometry.
+pub const BINDING_FRAME: u32 = 0;
+pub const BINDING_TRIANGLES: u32 = 1;
+pub const BINDING_BVH_NODES: u32 = 2;
+pub const BINDING_MATERIALS: u32 = 3;
+pub const BINDING_LIGHTS: u32 = 4;
+pub const BINDING_MEDIUM: u32 = 5;
+pub const BINDING_DENSITY_GRID: u32 = 6;
+
+// Material kinds (GpuMaterial.color.w as uint bits).
+pub const MATERIAL_DIFFUSE: u32 = 0;
+pub const MATERIAL_MIRROR: u32 = 1;
+pub const MATERIAL_DIELECTRIC: u32 = 2;
+
+// Light kinds (GpuLight.position.w as uint bits).
+pub const LIGHT_POINT: u32 = 0;
+pub const LIGHT_SPOT: u32 = 1;
+pub const LIGHT_DIRECTIONAL: u32 = 2;
+
+// Medium density kinds (GpuMedium.sigma_a.w as uint bits).
+pub const DENSITY_NONE: u32 = 0;
+pub const DENSITY_CONSTANT: u32 = 1;
+pub const DENSITY_NOISE: u32 = 2;
+pub const DENSITY_GRID: u32 = 3;
+
+// Reference light tracer: path-type components of the accumulation buffer.
+pub const COMPONENT_DIRECT: u32 = 0;
+pub const COMPONENT_SURFACE_CAUSTICS: u32 = 1;
+pub const COMPONENT_AIRLIGHT: u32 = 2;
+pub const COMPONENT_VOLUME_CAUSTICS: u32 = 3;
+pub const COMPONENT_OTHER: u32 = 4;
+pub const COMPONENT_COUNT: u32 = 5;
+
+/// Most lights a scene may hold (one shadow map slot of 6 layers each).
+pub const MAX_LIGHTS: u32 = 8;
+/// BVH traversal stack depth in GLSL; the CPU builder guarantees the tree is no deeper.
+pub const BVH_STACK_SIZE: u32 = 48;
