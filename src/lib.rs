@@ -3,7 +3,12 @@
 
 pub mod bvh;
 pub mod gpu;
+pub mod output;
+pub mod passes;
 pub mod radiometry;
+pub mod renderer;
 pub mod scene;
 pub mod shader_bindings;
 pub mod shaders;
+pub mod techniques;
+pub mod vk;

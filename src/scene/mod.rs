@@ -15,3 +15,39 @@ impl Medium {
         }
     }
 }
+
+// TEMPORARY until the loader lands.
+impl Scene {
+    pub fn triangles(&self, _time: f32) -> Vec<Triangle> {
+        let mut out = Vec::new();
+        for (oi, o) in self.objects.iter().enumerate() {
+            let nm = o.transform.inverse().transpose();
+            for (ti, idx) in o.mesh.indices.iter().enumerate() {
+                out.push(Triangle {
+                    positions: idx
+                        .map(|i| o.transform.transform_point3(o.mesh.positions[i as usize])),
+                    normals: idx
+                        .map(|i| nm.transform_vector3(o.mesh.normals[i as usize]).normalize()),
+                    material: o.mesh.materials[ti],
+                    object: oi as u32,
+                });
+            }
+        }
+        out
+    }
+    pub fn is_animated(&self) -> bool {
+        false
+    }
+    pub fn bounding_sphere(&self, time: f32) -> (glam::Vec3, f32) {
+        let t = self.triangles(time);
+        let mut lo = glam::Vec3::splat(f32::MAX);
+        let mut hi = glam::Vec3::splat(f32::MIN);
+        for tri in &t {
+            for p in tri.positions {
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+        ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
+    }
+}

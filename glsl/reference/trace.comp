@@ -1,0 +1,237 @@
+#version 460
+// Ground truth: a progressive light (particle) tracer (GUIDE §3). Each
+// invocation emits one photon, follows it through specular chains (exact
+// Fresnel, Snell, total internal reflection, Beer-Lambert absorption inside
+// dielectrics) and through the medium (free-flight sampling against a
+// majorant with null collisions, Henyey-Greenstein scattering), and at every
+// diffuse hit and every medium collision connects it to the camera.
+//
+// Measurement (the pinhole camera's importance): a photon of flux Phi at x
+// adds to pixel j's mean radiance
+//     dL_j = Phi f cos(theta_x) T(x, eye) / (d^2 cos^3(theta_c) A_pix)
+// where f is the BRDF (albedo/pi) or sigma_s p(omega) per unit length for a
+// medium event, d = |x - eye|, theta_c the angle to the optical axis and
+// A_pix the pixel's area on the image plane at unit distance; that is the
+// change of variables from image-plane area to surface area (or volume).
+#extension GL_EXT_shader_atomic_float : require
+#include "common.glsl"
+
+layout(local_size_x = 64) in;
+
+// Adds `contribution` (already divided by nothing but the photon count, which
+// the resolve pass applies) to pixel `pixel` of image `component`.
+void splat(ivec2 pixel, uint component, vec3 value) {
+    uint w = image_width(), h = image_height();
+    uint base = ((component * h + uint(pixel.y)) * w + uint(pixel.x)) * 3u;
+    atomicAdd(photon_accum[base + 0u], value.r);
+    atomicAdd(photon_accum[base + 1u], value.g);
+    atomicAdd(photon_accum[base + 2u], value.b);
+}
+
+// Projects x into the image; returns false when it falls outside or behind.
+// `to_eye` is the unit direction from x to the eye, `dist` the distance, and
+// `measurement` the factor 1 / (d^2 cos^3 theta_c A_pix).
+bool camera_connection(vec3 x, out ivec2 pixel, out vec3 to_eye, out float dist, out float measurement) {
+    vec4 clip = frame.view_proj * vec4(x, 1.0);
+    if (clip.w <= 0.0) return false;
+    vec2 ndc = clip.xy / clip.w;
+    if (any(lessThan(ndc, vec2(-1.0))) || any(greaterThanEqual(ndc, vec2(1.0)))) return false;
+    vec2 p = (ndc * 0.5 + 0.5) * frame.viewport.xy;
+    pixel = ivec2(floor(p));
+    vec3 v = frame.eye.xyz - x;
+    dist = length(v);
+    to_eye = v / dist;
+    vec3 forward = -vec3(frame.view[0][2], frame.view[1][2], frame.view[2][2]);
+    float cos_c = dot(-to_eye, forward);
+    if (cos_c <= 0.0) return false;
+    float pixel_side = 2.0 * frame.eye.w / frame.viewport.y;
+    measurement = 1.0 / (dist * dist * cos_c * cos_c * cos_c * pixel_side * pixel_side);
+    return true;
+}
+
+// Path-type tags (Heckbert notation): what happened before this connection.
+uint tag_for(uint specular_bounces, bool scattered_or_bounced, bool at_medium) {
+    if (scattered_or_bounced) return COMPONENT_OTHER;
+    if (at_medium) return specular_bounces == 0u ? COMPONENT_AIRLIGHT : COMPONENT_VOLUME_CAUSTICS;
+    return specular_bounces == 0u ? COMPONENT_DIRECT : COMPONENT_SURFACE_CAUSTICS;
+}
+
+// Picks a light with probability proportional to its power.
+uint pick_light(float u, out float probability) {
+    uint count = frame.counts.x;
+    float total = 0.0;
+    for (uint l = 0u; l < count; ++l) total += lights[l].power.x;
+    float target = u * total;
+    float running = 0.0;
+    for (uint l = 0u; l < count; ++l) {
+        running += lights[l].power.x;
+        if (target < running || l + 1u == count) {
+            probability = lights[l].power.x / total;
+            return l;
+        }
+    }
+    probability = 1.0;
+    return 0u;
+}
+
+// Emits a photon from light l: origin, direction, and flux / pdf (W, per
+// channel, before dividing by the number of photons).
+void emit(uint l, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) {
+    Light light = lights[l];
+    uint kind = floatBitsToUint(light.position.w);
+    vec2 u = vec2(rng_next(rng), rng_next(rng));
+    if (kind == LIGHT_POINT) {
+        origin = light.position.xyz;
+        dir = uniform_sphere(u);
+        flux = light.intensity.rgb * (4.0 * PI);
+    } else if (kind == LIGHT_SPOT) {
+        origin = light.position.xyz;
+        float cos_outer = light.direction.w;
+        dir = uniform_cone(u, light.direction.xyz, cos_outer);
+        float falloff = spot_falloff(dot(dir, light.direction.xyz), cos_outer, light.intensity.w);
+        flux = light.intensity.rgb * falloff * (2.0 * PI * (1.0 - cos_outer));
+    } else {
+        // A disk of the scene's bounding radius, perpendicular to the light,
+        // just outside the scene: every ray that can reach the scene leaves it.
+        vec3 c = frame.scene_sphere.xyz;
+        float r = frame.scene_sphere.w;
+        dir = light.direction.xyz;
+        vec3 t, b;
+        basis(dir, t, b);
+        float rr = r * sqrt(u.x);
+        float phi = 2.0 * PI * u.y;
+        origin = c - dir * (r * 1.01) + t * (rr * cos(phi)) + b * (rr * sin(phi));
+        flux = light.intensity.rgb * (PI * r * r);
+    }
+}
+
+void connect_surface(vec3 x, vec3 n, vec3 weight, vec3 albedo, uint tag, inout uint rng) {
+    ivec2 pixel;
+    vec3 to_eye;
+    float dist, measurement;
+    if (!camera_connection(x, pixel, to_eye, dist, measurement)) return;
+    float cos_x = dot(n, to_eye);
+    if (cos_x <= 0.0) return;
+    vec3 o = offset_origin(x, n);
+    if (trace_any(o, to_eye, 0.0, dist * (1.0 - 1e-4))) return;
+    vec3 tr = medium_transmittance(o, to_eye, dist, rng);
+    splat(pixel, tag, weight * (albedo / PI) * cos_x * measurement * tr);
+}
+
+void connect_medium(vec3 x, vec3 d, vec3 weight_sigma_s, float g, uint tag, inout uint rng) {
+    ivec2 pixel;
+    vec3 to_eye;
+    float dist, measurement;
+    if (!camera_connection(x, pixel, to_eye, dist, measurement)) return;
+    if (trace_any(x, to_eye, 0.0, dist * (1.0 - 1e-4))) return;
+    vec3 tr = medium_transmittance(x, to_eye, dist, rng);
+    splat(pixel, tag, weight_sigma_s * hg_phase(dot(d, to_eye), g) * measurement * tr);
+}
+
+void main() {
+    uint rng = rng_seed(gl_GlobalInvocationID.x, pc.seed);
+    if (frame.counts.x == 0u) return;
+    float light_probability;
+    uint l = pick_light(rng_next(rng), light_probability);
+    vec3 o, d, weight;
+    emit(l, rng, o, d, weight);
+    weight /= light_probability;
+
+    uint specular = 0u;
+    bool scattered_or_bounced = false;
+    uint diffuse_left = pc.diffuse_bounces;
+    bool inside = false;          // inside a dielectric (no medium there)
+    vec3 inside_absorption = vec3(0.0);
+    bool has_medium = medium_present();
+    float g = medium.sigma_s.w;
+
+    for (uint depth = 0u; depth < pc.max_depth; ++depth) {
+        Hit hit;
+        bool found = trace_closest(o, d, 0.0, 1e30, hit);
+        float t_hit = found ? hit.t : 1e30;
+
+        if (has_medium && !inside) {
+            // Tentative collisions at rate `majorant` (delta tracking with
+            // null collisions; weighted so that rgb coefficients may differ).
+            float t0 = 0.0, t1 = t_hit;
+            float majorant = medium_majorant();
+            bool event = false;
+            if (majorant > 0.0 && clip_to_medium(o, d, t0, t1)) {
+                float t = t0;
+                for (int i = 0; i < 100000; ++i) {
+                    t -= log(1.0 - rng_next(rng)) / majorant;
+                    if (t >= t1) break;
+                    vec3 x = o + t * d;
+                    float density = medium_density(x);
+                    vec3 sigma_s = medium.sigma_s.rgb * density;
+                    vec3 sigma_n = vec3(majorant) - (medium.sigma_s.rgb + medium.sigma_a.rgb) * density;
+                    // Every tentative collision connects: E[sum] = integral of T sigma_s along the ray.
+                    connect_medium(x, d, weight * sigma_s / majorant, g, tag_for(specular, scattered_or_bounced, true), rng);
+                    float p_scatter = (sigma_s.r + sigma_s.g + sigma_s.b) / (3.0 * majorant);
+                    float p_null = max(sigma_n.r + sigma_n.g + sigma_n.b, 0.0) / (3.0 * majorant);
+                    float u = rng_next(rng);
+                    if (u < p_scatter) {
+                        weight *= sigma_s / (majorant * p_scatter);
+                        o = x;
+                        d = sample_hg(d, g, vec2(rng_next(rng), rng_next(rng)));
+                        scattered_or_bounced = true;
+                        event = true;
+                        break;
+                    } else if (u < p_scatter + p_null) {
+                        weight *= sigma_n / (majorant * p_null);
+                    } else {
+                        return; // absorbed
+                    }
+                }
+            }
+            if (event) continue;
+        }
+        if (!found) return;
+
+        vec3 x = o + hit.t * d;
+        vec3 ng = hit_geometric_normal(hit);
+        vec3 ns = hit_normal(hit);
+        bool front = dot(d, ng) < 0.0;
+        // Normals facing the side the photon arrives from.
+        vec3 ng_in = front ? ng : -ng;
+        vec3 ns_in = dot(ns, ng_in) > 0.0 ? ns : -ns;
+        if (inside) weight *= exp(-inside_absorption * hit.t);
+
+        Material m = materials[hit_material(hit)];
+        uint kind = floatBitsToUint(m.color.w);
+        if (kind == MATERIAL_DIFFUSE) {
+            connect_surface(x, ng_in, weight, m.color.rgb, tag_for(specular, scattered_or_bounced, false), rng);
+            if (diffuse_left == 0u) return;
+            diffuse_left -= 1u;
+            float survive = clamp(luminance(m.color.rgb), 0.05, 1.0);
+            if (rng_next(rng) >= survive) return;
+            weight *= m.color.rgb / survive;
+            d = cosine_hemisphere(vec2(rng_next(rng), rng_next(rng)), ng_in);
+            o = offset_origin(x, ng_in);
+            scattered_or_bounced = true;
+        } else if (kind == MATERIAL_MIRROR) {
+            weight *= m.color.rgb;
+            d = reflect(d, ns_in);
+            o = offset_origin(x, ng_in);
+            specular += 1u;
+        } else {
+            float ior = m.absorption_ior.w;
+            float eta = front ? 1.0 / ior : ior;
+            float cos_i = -dot(d, ns_in);
+            float f = fresnel_dielectric(cos_i, eta);
+            vec3 refracted;
+            // Choosing reflection with probability F keeps the weight unchanged.
+            if (rng_next(rng) < f || !refract_dir(d, ns_in, eta, refracted)) {
+                d = reflect(d, ns_in);
+                o = offset_origin(x, ng_in);
+            } else {
+                d = refracted;
+                o = offset_origin(x, -ng_in);
+                inside = front;
+                inside_absorption = m.absorption_ior.rgb;
+            }
+            specular += 1u;
+        }
+        if (luminance(weight) <= 0.0) return;
+    }
+}

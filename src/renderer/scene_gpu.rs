@@ -1,0 +1,185 @@
+//! The scene on the GPU: world-space triangles in BVH leaf order, the BVH,
+//! materials, lights, medium and the per-frame uniform block, bound as
+//! descriptor set 0 (glsl/common/scene.glsl) by every pass that reads them.
+
+use crate::bvh::Bvh;
+use crate::gpu::{GpuFrame, GpuLight, GpuMaterial, GpuMedium, GpuTriangle};
+use crate::scene::{Camera, Density, Scene};
+use crate::shader_bindings as b;
+use crate::vk::{
+    BindingKind, Buffer, BufferUsage, Context, DescriptorSet, DescriptorSetLayout, VkResult,
+};
+use glam::{Mat4, Vec3};
+use std::sync::Arc;
+
+/// Statistics of the uploaded geometry (printed by `render`, recorded in BENCHMARKS.md).
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct GeometryStats {
+    pub triangles: usize,
+    pub bvh_nodes: usize,
+    pub bvh_leaves: usize,
+    pub bvh_depth: u32,
+    pub bvh_build_ms: f64,
+}
+
+pub struct SceneGpu {
+    pub triangles: Buffer,
+    pub bvh_nodes: Buffer,
+    pub materials: Buffer,
+    pub lights: Buffer,
+    pub medium: Buffer,
+    pub density_grid: Buffer,
+    pub frame: Buffer,
+    pub layout: DescriptorSetLayout,
+    pub set: DescriptorSet,
+    pub stats: GeometryStats,
+    /// Bounding sphere (centre, radius) of the scene at the uploaded time.
+    pub sphere: (Vec3, f32),
+    pub triangle_count: u32,
+    bvh: Bvh,
+}
+
+/// View and projection for Vulkan: right-handed view, depth 0..1, y down in
+/// clip space so image row 0 is the top.
+pub fn camera_matrices(camera: &Camera, aspect: f32) -> (Mat4, Mat4) {
+    let view = Mat4::look_at_rh(camera.eye, camera.target, camera.up);
+    let mut proj = Mat4::perspective_rh(camera.fov_y_deg.to_radians(), aspect, 0.01, 1000.0);
+    proj.y_axis.y *= -1.0;
+    (view, proj)
+}
+
+impl SceneGpu {
+    pub fn set_layout(ctx: &Arc<Context>) -> VkResult<DescriptorSetLayout> {
+        DescriptorSetLayout::new(
+            ctx,
+            &[
+                (b::BINDING_FRAME, BindingKind::Uniform),
+                (b::BINDING_TRIANGLES, BindingKind::Storage),
+                (b::BINDING_BVH_NODES, BindingKind::Storage),
+                (b::BINDING_MATERIALS, BindingKind::Storage),
+                (b::BINDING_LIGHTS, BindingKind::Storage),
+                (b::BINDING_MEDIUM, BindingKind::Storage),
+                (b::BINDING_DENSITY_GRID, BindingKind::Storage),
+            ],
+        )
+    }
+
+    pub fn new(ctx: &Arc<Context>, scene: &Scene, time: f32) -> VkResult<SceneGpu> {
+        let triangles = scene.triangles(time);
+        let bvh = crate::bvh::build(&triangles);
+        let gpu_triangles = bvh.gpu_triangles(&triangles);
+        let stats = GeometryStats {
+            triangles: triangles.len(),
+            bvh_nodes: bvh.nodes.len(),
+            bvh_leaves: bvh.leaf_count,
+            bvh_depth: bvh.depth,
+            bvh_build_ms: bvh.build_ms,
+        };
+        let sphere = scene.bounding_sphere(time);
+        let materials: Vec<GpuMaterial> = scene.materials.iter().map(GpuMaterial::new).collect();
+        let lights: Vec<GpuLight> = scene
+            .lights
+            .iter()
+            .map(|l| GpuLight::new(l, sphere.1))
+            .collect();
+        let medium = scene
+            .medium
+            .as_ref()
+            .map(GpuMedium::new)
+            .unwrap_or_else(GpuMedium::none);
+        let grid: Vec<f32> = match scene.medium.as_ref().map(|m| &m.density) {
+            Some(Density::Grid { values, .. }) => values.clone(),
+            _ => vec![0.0],
+        };
+        let storage = BufferUsage::Storage;
+        let tri_data = if gpu_triangles.is_empty() {
+            vec![bytemuck::Zeroable::zeroed()]
+        } else {
+            gpu_triangles
+        };
+        let triangles_buf = Buffer::with_data::<GpuTriangle>(ctx, "triangles", &tri_data, storage)?;
+        let nodes_buf = Buffer::with_data(ctx, "bvh nodes", &bvh.nodes, storage)?;
+        let materials_buf = Buffer::with_data(ctx, "materials", &materials, storage)?;
+        let lights_buf = Buffer::with_data(ctx, "lights", &lights, storage)?;
+        let medium_buf = Buffer::with_data(ctx, "medium", &[medium], storage)?;
+        let grid_buf = Buffer::with_data(ctx, "density grid", &grid, storage)?;
+        let frame_buf = Buffer::new(
+            ctx,
+            "frame constants",
+            std::mem::size_of::<GpuFrame>() as u64,
+            BufferUsage::Uniform,
+        )?;
+        let layout = Self::set_layout(ctx)?;
+        let set = DescriptorSet::new(ctx, &layout)?;
+        set.write_buffer(b::BINDING_FRAME, &frame_buf)
+            .write_buffer(b::BINDING_TRIANGLES, &triangles_buf)
+            .write_buffer(b::BINDING_BVH_NODES, &nodes_buf)
+            .write_buffer(b::BINDING_MATERIALS, &materials_buf)
+            .write_buffer(b::BINDING_LIGHTS, &lights_buf)
+            .write_buffer(b::BINDING_MEDIUM, &medium_buf)
+            .write_buffer(b::BINDING_DENSITY_GRID, &grid_buf);
+        Ok(SceneGpu {
+            triangle_count: triangles.len() as u32,
+            triangles: triangles_buf,
+            bvh_nodes: nodes_buf,
+            materials: materials_buf,
+            lights: lights_buf,
+            medium: medium_buf,
+            density_grid: grid_buf,
+            frame: frame_buf,
+            layout,
+            set,
+            stats,
+            sphere,
+            bvh,
+        })
+    }
+
+    /// Re-uploads moved triangles and refits the BVH (animated scenes). The
+    /// caller has waited for every frame that read the old geometry.
+    pub fn update_geometry(&mut self, scene: &Scene, time: f32) -> VkResult<()> {
+        let triangles = scene.triangles(time);
+        self.bvh.refit(&triangles);
+        let gpu_triangles = self.bvh.gpu_triangles(&triangles);
+        self.triangles
+            .upload(bytemuck::cast_slice(&gpu_triangles))?;
+        self.bvh_nodes
+            .upload(bytemuck::cast_slice(&self.bvh.nodes))?;
+        self.sphere = scene.bounding_sphere(time);
+        Ok(())
+    }
+
+    /// Writes the per-frame constants for an image of `width` x `height`.
+    pub fn update_frame(
+        &self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        time: f32,
+        frame_index: u32,
+    ) -> VkResult<()> {
+        let aspect = width as f32 / height as f32;
+        let (view, proj) = camera_matrices(&scene.camera, aspect);
+        let view_proj = proj * view;
+        let data = GpuFrame {
+            view: GpuFrame::mat(view),
+            proj: GpuFrame::mat(proj),
+            view_proj: GpuFrame::mat(view_proj),
+            inv_view_proj: GpuFrame::mat(view_proj.inverse()),
+            eye: scene
+                .camera
+                .eye
+                .extend((scene.camera.fov_y_deg.to_radians() * 0.5).tan())
+                .to_array(),
+            viewport: [width as f32, height as f32, aspect, time],
+            scene_sphere: self.sphere.0.extend(self.sphere.1).to_array(),
+            counts: [
+                scene.lights.len() as u32,
+                self.triangle_count,
+                scene.materials.len() as u32,
+                frame_index,
+            ],
+        };
+        self.frame.upload(bytemuck::bytes_of(&data))
+    }
+}

@@ -1,0 +1,144 @@
+//! Techniques: each one owns its resources and records its passes into the
+//! frame, writing linear radiance (W m^-2 sr^-1) into the frame's radiance
+//! image. Parameters are declared once (`ParamSpec`) so the CLI, the demo
+//! overlay and the benchmarks read the same list.
+
+pub mod direct;
+
+use crate::renderer::{FrameTargets, SceneGpu};
+use crate::scene::Scene;
+use crate::vk::{Context, FrameRecorder, VkResult};
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// One tunable parameter of a technique.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct ParamSpec {
+    pub name: &'static str,
+    pub description: &'static str,
+    pub min: f32,
+    pub max: f32,
+    pub default: f32,
+    /// Whole numbers only (resolutions, counts).
+    pub integer: bool,
+}
+
+/// Parameter values by name, validated against a technique's specs.
+#[derive(Clone, Debug, Default)]
+pub struct Params {
+    values: BTreeMap<String, f32>,
+}
+
+impl Params {
+    /// Defaults from `specs`, overridden by `overrides` ("name=value" each).
+    /// Unknown names and out-of-range values are errors naming the parameter.
+    pub fn resolve(
+        technique: &str,
+        specs: &[ParamSpec],
+        overrides: &[String],
+    ) -> anyhow::Result<Params> {
+        let mut values: BTreeMap<String, f32> = specs
+            .iter()
+            .map(|s| (s.name.to_string(), s.default))
+            .collect();
+        for o in overrides {
+            let (name, value) = o
+                .split_once('=')
+                .ok_or_else(|| anyhow::anyhow!("--param {o:?}: expected NAME=VALUE"))?;
+            let spec = specs.iter().find(|s| s.name == name).ok_or_else(|| {
+                let known: Vec<_> = specs.iter().map(|s| s.name).collect();
+                anyhow::anyhow!(
+                    "--param {name}: technique `{technique}` has no such parameter (it has: {})",
+                    if known.is_empty() {
+                        "none".to_string()
+                    } else {
+                        known.join(", ")
+                    }
+                )
+            })?;
+            let v: f32 = value
+                .trim()
+                .parse()
+                .map_err(|_| anyhow::anyhow!("--param {name}: {value:?} is not a number"))?;
+            if !v.is_finite() || v < spec.min || v > spec.max || (spec.integer && v.fract() != 0.0)
+            {
+                anyhow::bail!(
+                    "--param {name}={value}: must be {} in [{}, {}]",
+                    if spec.integer {
+                        "a whole number"
+                    } else {
+                        "a number"
+                    },
+                    spec.min,
+                    spec.max
+                );
+            }
+            values.insert(name.to_string(), v);
+        }
+        Ok(Params { values })
+    }
+
+    pub fn get(&self, name: &str) -> f32 {
+        *self
+            .values
+            .get(name)
+            .unwrap_or_else(|| panic!("parameter {name} was not declared"))
+    }
+
+    pub fn iter(&self) -> impl Iterator<Item = (&String, &f32)> {
+        self.values.iter()
+    }
+}
+
+pub trait Technique {
+    fn name(&self) -> &'static str;
+    /// Records this frame's passes; every pass goes through `rec.pass`.
+    fn record(
+        &mut self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        targets: &FrameTargets,
+    ) -> VkResult<()>;
+}
+
+/// Every real-time technique: name, one-line description, parameters.
+pub struct TechniqueInfo {
+    pub name: &'static str,
+    pub description: &'static str,
+    pub params: &'static [ParamSpec],
+}
+
+pub const TECHNIQUES: &[TechniqueInfo] = &[TechniqueInfo {
+    name: "direct",
+    description: "direct light with shadow maps (the base frame every technique adds to)",
+    params: direct::PARAMS,
+}];
+
+pub fn find(name: &str) -> anyhow::Result<&'static TechniqueInfo> {
+    TECHNIQUES.iter().find(|t| t.name == name).ok_or_else(|| {
+        let names: Vec<_> = TECHNIQUES.iter().map(|t| t.name).collect();
+        anyhow::anyhow!("unknown technique `{name}`; available: {} (and `caustics reference` for the ground truth)", names.join(", "))
+    })
+}
+
+/// Builds the technique `name` for frames of `width` x `height`.
+pub fn create(
+    ctx: &Arc<Context>,
+    name: &str,
+    params: &Params,
+    scene: &Scene,
+    scene_gpu: &SceneGpu,
+    width: u32,
+    height: u32,
+) -> anyhow::Result<Box<dyn Technique>> {
+    Ok(match name {
+        "direct" => Box::new(direct::Direct::new(
+            ctx, params, scene, scene_gpu, width, height,
+        )?),
+        other => {
+            return Err(find(other)
+                .err()
+                .unwrap_or_else(|| anyhow::anyhow!("technique `{other}` not built")))
+        }
+    })
+}

@@ -1,0 +1,610 @@
+//! Instance, physical-device choice, logical device, queue, allocator and the
+//! validation messenger. One `Context` per process; everything else holds an
+//! `Arc<Context>` so the device is destroyed last.
+
+use super::{VkError, VkResult};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use std::ffi::{c_void, CStr};
+use std::mem::ManuallyDrop;
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::{Arc, Mutex};
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+
+#[derive(Clone, Debug, Default)]
+pub struct ContextOptions {
+    /// Turn on the Khronos validation layer and count its messages.
+    pub validation: bool,
+    /// Pick a device by index (as `caustics info` lists) or by a substring of its name.
+    pub device: Option<String>,
+}
+
+/// Every device feature the renderer relies on, checked at start-up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RequiredFeature {
+    Vulkan13,
+    GeometryShader,
+    FragmentStoresAndAtomics,
+    VertexPipelineStoresAndAtomics,
+    BufferFloat32AtomicAdd,
+    TimestampQueries,
+    MultiDrawIndirect,
+    DynamicRendering,
+    Synchronization2,
+}
+
+impl RequiredFeature {
+    pub const ALL: [RequiredFeature; 9] = [
+        RequiredFeature::Vulkan13,
+        RequiredFeature::GeometryShader,
+        RequiredFeature::FragmentStoresAndAtomics,
+        RequiredFeature::VertexPipelineStoresAndAtomics,
+        RequiredFeature::BufferFloat32AtomicAdd,
+        RequiredFeature::TimestampQueries,
+        RequiredFeature::MultiDrawIndirect,
+        RequiredFeature::DynamicRendering,
+        RequiredFeature::Synchronization2,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            RequiredFeature::Vulkan13 => "Vulkan 1.3",
+            RequiredFeature::GeometryShader => "geometryShader",
+            RequiredFeature::FragmentStoresAndAtomics => "fragmentStoresAndAtomics",
+            RequiredFeature::VertexPipelineStoresAndAtomics => "vertexPipelineStoresAndAtomics",
+            RequiredFeature::BufferFloat32AtomicAdd => {
+                "shaderBufferFloat32AtomicAdd (VK_EXT_shader_atomic_float)"
+            }
+            RequiredFeature::TimestampQueries => "timestampComputeAndGraphics",
+            RequiredFeature::MultiDrawIndirect => "multiDrawIndirect",
+            RequiredFeature::DynamicRendering => "dynamicRendering",
+            RequiredFeature::Synchronization2 => "synchronization2",
+        }
+    }
+}
+
+/// What `caustics info` prints for one device.
+#[derive(Clone, Debug)]
+pub struct DeviceInfo {
+    pub index: usize,
+    pub name: String,
+    pub kind: vk::PhysicalDeviceType,
+    pub api_version: (u32, u32, u32),
+    pub driver: String,
+    pub features: Vec<(RequiredFeature, bool)>,
+}
+
+impl DeviceInfo {
+    pub fn missing(&self) -> Vec<RequiredFeature> {
+        self.features
+            .iter()
+            .filter(|(_, ok)| !ok)
+            .map(|(f, _)| *f)
+            .collect()
+    }
+}
+
+/// Validation messages counted by the debug messenger since start-up.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ValidationCounts {
+    pub errors: u32,
+    pub warnings: u32,
+}
+
+struct Counters {
+    errors: AtomicU32,
+    warnings: AtomicU32,
+}
+
+pub struct Context {
+    pub entry: ash::Entry,
+    pub instance: ash::Instance,
+    pub physical_device: vk::PhysicalDevice,
+    pub device: ash::Device,
+    pub queue: vk::Queue,
+    pub queue_family: u32,
+    pub info: DeviceInfo,
+    /// Nanoseconds per timestamp tick.
+    pub timestamp_period: f64,
+    /// Valid bits of a timestamp on the queue (for wrapping subtraction).
+    pub timestamp_valid_bits: u32,
+    pub limits: vk::PhysicalDeviceLimits,
+    allocator: ManuallyDrop<Mutex<Allocator>>,
+    debug_instance: Option<ash::ext::debug_utils::Instance>,
+    debug_device: Option<ash::ext::debug_utils::Device>,
+    messenger: vk::DebugUtilsMessengerEXT,
+    counters: Box<Counters>,
+    command_pool: vk::CommandPool,
+}
+
+unsafe extern "system" fn debug_callback(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    kind: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    user: *mut c_void,
+) -> vk::Bool32 {
+    // SAFETY: the messenger passes the `Counters` pointer we registered, alive until the messenger is destroyed.
+    let counters = unsafe { &*(user as *const Counters) };
+    let message = unsafe { (*data).message_as_c_str() }
+        .map(|m| m.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
+        counters.errors.fetch_add(1, Ordering::SeqCst);
+        log::error!("[vulkan {kind:?}] {message}");
+    } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
+        counters.warnings.fetch_add(1, Ordering::SeqCst);
+        log::warn!("[vulkan {kind:?}] {message}");
+    } else {
+        log::debug!("[vulkan {kind:?}] {message}");
+    }
+    vk::FALSE
+}
+
+fn cstr_array(raw: &[std::ffi::c_char]) -> String {
+    // SAFETY: Vulkan guarantees these fixed arrays are NUL-terminated.
+    unsafe { CStr::from_ptr(raw.as_ptr()) }
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn query_device(instance: &ash::Instance, pd: vk::PhysicalDevice, index: usize) -> DeviceInfo {
+    unsafe {
+        let props = instance.get_physical_device_properties(pd);
+        let mut atomic = vk::PhysicalDeviceShaderAtomicFloatFeaturesEXT::default();
+        let mut v13 = vk::PhysicalDeviceVulkan13Features::default();
+        let has_atomic_ext = instance
+            .enumerate_device_extension_properties(pd)
+            .unwrap_or_default()
+            .iter()
+            .any(|e| e.extension_name_as_c_str() == Ok(ash::ext::shader_atomic_float::NAME));
+        let api = props.api_version;
+        let is_13 = vk::api_version_major(api) > 1 || vk::api_version_minor(api) >= 3;
+        let mut features2 = vk::PhysicalDeviceFeatures2::default();
+        if is_13 {
+            features2 = features2.push_next(&mut v13);
+        }
+        if has_atomic_ext {
+            features2 = features2.push_next(&mut atomic);
+        }
+        instance.get_physical_device_features2(pd, &mut features2);
+        let f = features2.features;
+        let mut driver_props = vk::PhysicalDeviceDriverProperties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver_props);
+        instance.get_physical_device_properties2(pd, &mut props2);
+        let features = RequiredFeature::ALL
+            .iter()
+            .map(|&r| {
+                let ok = match r {
+                    RequiredFeature::Vulkan13 => is_13,
+                    RequiredFeature::GeometryShader => f.geometry_shader == vk::TRUE,
+                    RequiredFeature::FragmentStoresAndAtomics => {
+                        f.fragment_stores_and_atomics == vk::TRUE
+                    }
+                    RequiredFeature::VertexPipelineStoresAndAtomics => {
+                        f.vertex_pipeline_stores_and_atomics == vk::TRUE
+                    }
+                    RequiredFeature::BufferFloat32AtomicAdd => {
+                        has_atomic_ext && atomic.shader_buffer_float32_atomic_add == vk::TRUE
+                    }
+                    RequiredFeature::TimestampQueries => {
+                        props.limits.timestamp_compute_and_graphics == vk::TRUE
+                    }
+                    RequiredFeature::MultiDrawIndirect => f.multi_draw_indirect == vk::TRUE,
+                    RequiredFeature::DynamicRendering => v13.dynamic_rendering == vk::TRUE,
+                    RequiredFeature::Synchronization2 => v13.synchronization2 == vk::TRUE,
+                };
+                (r, ok)
+            })
+            .collect();
+        DeviceInfo {
+            index,
+            name: cstr_array(&props.device_name),
+            kind: props.device_type,
+            api_version: (
+                vk::api_version_major(api),
+                vk::api_version_minor(api),
+                vk::api_version_patch(api),
+            ),
+            driver: format!(
+                "{} {}",
+                cstr_array(&driver_props.driver_name),
+                cstr_array(&driver_props.driver_info)
+            ),
+            features,
+        }
+    }
+}
+
+fn load_entry() -> VkResult<ash::Entry> {
+    // SAFETY: loading the system Vulkan loader; its symbols are trusted.
+    unsafe { ash::Entry::load() }.map_err(|e| VkError::Loader(e.to_string()))
+}
+
+fn create_instance(
+    entry: &ash::Entry,
+    validation: bool,
+    extra_extensions: &[*const std::ffi::c_char],
+) -> VkResult<ash::Instance> {
+    let app = vk::ApplicationInfo::default()
+        .application_name(c"caustics")
+        .engine_name(c"caustics")
+        .api_version(vk::API_VERSION_1_3);
+    let mut extensions: Vec<*const std::ffi::c_char> = extra_extensions.to_vec();
+    let mut layers = Vec::new();
+    if validation {
+        let available = unsafe { entry.enumerate_instance_layer_properties() }?;
+        if !available
+            .iter()
+            .any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER))
+        {
+            return Err(VkError::NoValidationLayer);
+        }
+        layers.push(VALIDATION_LAYER.as_ptr());
+    }
+    let has_debug_utils = unsafe { entry.enumerate_instance_extension_properties(None) }?
+        .iter()
+        .any(|e| e.extension_name_as_c_str() == Ok(ash::ext::debug_utils::NAME));
+    if has_debug_utils {
+        extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+    }
+    let info = vk::InstanceCreateInfo::default()
+        .application_info(&app)
+        .enabled_layer_names(&layers)
+        .enabled_extension_names(&extensions);
+    Ok(unsafe { entry.create_instance(&info, None) }?)
+}
+
+/// Lists every device with the features the renderer needs (`caustics info`).
+pub fn enumerate_devices() -> VkResult<Vec<DeviceInfo>> {
+    let entry = load_entry()?;
+    let instance = create_instance(&entry, false, &[])?;
+    let devices = unsafe { instance.enumerate_physical_devices() }?;
+    let infos = devices
+        .iter()
+        .enumerate()
+        .map(|(i, &pd)| query_device(&instance, pd, i))
+        .collect();
+    unsafe { instance.destroy_instance(None) };
+    Ok(infos)
+}
+
+impl Context {
+    pub fn list_devices() -> VkResult<Vec<DeviceInfo>> {
+        enumerate_devices()
+    }
+
+    /// Headless context (no surface extensions).
+    pub fn new(options: &ContextOptions) -> VkResult<Arc<Context>> {
+        Self::with_instance_extensions(options, &[])
+    }
+
+    /// A context whose instance also enables `extensions` (e.g. surface extensions for the demo).
+    pub fn with_instance_extensions(
+        options: &ContextOptions,
+        extensions: &[*const std::ffi::c_char],
+    ) -> VkResult<Arc<Context>> {
+        let entry = load_entry()?;
+        let instance = create_instance(&entry, options.validation, extensions)?;
+        let counters = Box::new(Counters {
+            errors: AtomicU32::new(0),
+            warnings: AtomicU32::new(0),
+        });
+        let has_debug_utils = unsafe { entry.enumerate_instance_extension_properties(None) }?
+            .iter()
+            .any(|e| e.extension_name_as_c_str() == Ok(ash::ext::debug_utils::NAME));
+        let (debug_instance, messenger) = if has_debug_utils {
+            let debug = ash::ext::debug_utils::Instance::new(&entry, &instance);
+            let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+                .message_severity(
+                    vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                        | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING
+                        | vk::DebugUtilsMessageSeverityFlagsEXT::INFO,
+                )
+                .message_type(
+                    vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                        | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                        | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+                )
+                .pfn_user_callback(Some(debug_callback))
+                .user_data(&*counters as *const Counters as *mut c_void);
+            let messenger = unsafe { debug.create_debug_utils_messenger(&info, None) }?;
+            (Some(debug), messenger)
+        } else {
+            (None, vk::DebugUtilsMessengerEXT::null())
+        };
+
+        let cleanup = |instance: &ash::Instance| unsafe {
+            if let Some(d) = &debug_instance {
+                d.destroy_debug_utils_messenger(messenger, None);
+            }
+            instance.destroy_instance(None);
+        };
+        let devices = unsafe { instance.enumerate_physical_devices() }?;
+        let infos: Vec<DeviceInfo> = devices
+            .iter()
+            .enumerate()
+            .map(|(i, &pd)| query_device(&instance, pd, i))
+            .collect();
+        let chosen = match pick_device(&infos, options.device.as_deref()) {
+            Ok(i) => i,
+            Err(e) => {
+                cleanup(&instance);
+                return Err(e);
+            }
+        };
+        let info = infos[chosen].clone();
+        let missing = info.missing();
+        if !missing.is_empty() {
+            cleanup(&instance);
+            return Err(VkError::MissingFeatures {
+                device: info.name.clone(),
+                missing: missing
+                    .iter()
+                    .map(|f| f.name())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            });
+        }
+        let physical_device = devices[chosen];
+        let props = unsafe { instance.get_physical_device_properties(physical_device) };
+        let families =
+            unsafe { instance.get_physical_device_queue_family_properties(physical_device) };
+        let Some(queue_family) = families.iter().position(|f| {
+            f.queue_flags
+                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
+                && f.timestamp_valid_bits > 0
+        }) else {
+            cleanup(&instance);
+            return Err(VkError::MissingFeatures {
+                device: info.name.clone(),
+                missing: "a graphics+compute queue with timestamps".into(),
+            });
+        };
+        let timestamp_valid_bits = families[queue_family].timestamp_valid_bits;
+        let queue_family = queue_family as u32;
+
+        let priorities = [1.0f32];
+        let queue_info = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(queue_family)
+            .queue_priorities(&priorities)];
+        let features = vk::PhysicalDeviceFeatures::default()
+            .geometry_shader(true)
+            .fragment_stores_and_atomics(true)
+            .vertex_pipeline_stores_and_atomics(true)
+            .multi_draw_indirect(true)
+            .wide_lines(
+                props.limits.line_width_range[1] > 1.0
+                    && unsafe {
+                        instance
+                            .get_physical_device_features(physical_device)
+                            .wide_lines
+                            == vk::TRUE
+                    },
+            );
+        let mut v12 = vk::PhysicalDeviceVulkan12Features::default().host_query_reset(true);
+        let mut v13 = vk::PhysicalDeviceVulkan13Features::default()
+            .dynamic_rendering(true)
+            .synchronization2(true);
+        let mut atomic = vk::PhysicalDeviceShaderAtomicFloatFeaturesEXT::default()
+            .shader_buffer_float32_atomics(true)
+            .shader_buffer_float32_atomic_add(true);
+        let extensions = [
+            ash::ext::shader_atomic_float::NAME.as_ptr(),
+            ash::khr::swapchain::NAME.as_ptr(),
+        ];
+        let has_swapchain =
+            unsafe { instance.enumerate_device_extension_properties(physical_device) }?
+                .iter()
+                .any(|e| e.extension_name_as_c_str() == Ok(ash::khr::swapchain::NAME));
+        let extensions = if has_swapchain && !extensions.is_empty() {
+            &extensions[..]
+        } else {
+            &extensions[..1]
+        };
+        let device_info = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queue_info)
+            .enabled_features(&features)
+            .enabled_extension_names(extensions)
+            .push_next(&mut v12)
+            .push_next(&mut v13)
+            .push_next(&mut atomic);
+        let device = match unsafe { instance.create_device(physical_device, &device_info, None) } {
+            Ok(d) => d,
+            Err(e) => {
+                cleanup(&instance);
+                return Err(e.into());
+            }
+        };
+        let queue = unsafe { device.get_device_queue(queue_family, 0) };
+        let mut debug_settings = gpu_allocator::AllocatorDebugSettings::default();
+        debug_settings.log_leaks_on_shutdown = true;
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device,
+            debug_settings,
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        })?;
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(queue_family)
+            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        let command_pool = unsafe { device.create_command_pool(&pool_info, None) }?;
+        let debug_device =
+            has_debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device));
+        log::info!(
+            "device: {} ({:?}), driver {}",
+            info.name,
+            info.kind,
+            info.driver
+        );
+        Ok(Arc::new(Context {
+            entry,
+            instance,
+            physical_device,
+            device,
+            queue,
+            queue_family,
+            timestamp_period: props.limits.timestamp_period as f64,
+            timestamp_valid_bits,
+            limits: props.limits,
+            info,
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            debug_instance,
+            debug_device,
+            messenger,
+            counters,
+            command_pool,
+        }))
+    }
+
+    pub fn allocator(&self) -> std::sync::MutexGuard<'_, Allocator> {
+        self.allocator
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    pub fn validation_counts(&self) -> ValidationCounts {
+        ValidationCounts {
+            errors: self.counters.errors.load(Ordering::SeqCst),
+            warnings: self.counters.warnings.load(Ordering::SeqCst),
+        }
+    }
+
+    /// True when the device is a CPU implementation (lavapipe), whose timestamps
+    /// do not measure compute dispatches (GUIDE §8).
+    pub fn is_cpu(&self) -> bool {
+        self.info.kind == vk::PhysicalDeviceType::CPU
+    }
+
+    /// Opens a debug-utils label region (visible in RenderDoc and validation messages).
+    pub fn begin_label(&self, cmd: vk::CommandBuffer, name: &str) {
+        if let Some(d) = &self.debug_device {
+            let name = std::ffi::CString::new(name).unwrap_or_default();
+            let label = vk::DebugUtilsLabelEXT::default().label_name(&name);
+            unsafe { d.cmd_begin_debug_utils_label(cmd, &label) };
+        }
+    }
+
+    pub fn end_label(&self, cmd: vk::CommandBuffer) {
+        if let Some(d) = &self.debug_device {
+            unsafe { d.cmd_end_debug_utils_label(cmd) };
+        }
+    }
+
+    /// Names a Vulkan object for validation messages and captures.
+    pub fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
+        if let Some(d) = &self.debug_device {
+            let name = std::ffi::CString::new(name).unwrap_or_default();
+            let info = vk::DebugUtilsObjectNameInfoEXT::default()
+                .object_handle(handle)
+                .object_name(&name);
+            let _ = unsafe { d.set_debug_utils_object_name(&info) };
+        }
+    }
+
+    pub fn allocate_command_buffer(&self) -> VkResult<vk::CommandBuffer> {
+        let info = vk::CommandBufferAllocateInfo::default()
+            .command_pool(self.command_pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        Ok(unsafe { self.device.allocate_command_buffers(&info) }?[0])
+    }
+
+    pub fn free_command_buffer(&self, cmd: vk::CommandBuffer) {
+        unsafe { self.device.free_command_buffers(self.command_pool, &[cmd]) };
+    }
+
+    /// Records `record` into a fresh command buffer, submits it and waits for
+    /// it to finish: the synchronisation point of headless rendering, after
+    /// which the host may read results and drop what the commands used.
+    pub fn submit_and_wait<R>(&self, record: impl FnOnce(vk::CommandBuffer) -> R) -> VkResult<R> {
+        let cmd = self.allocate_command_buffer()?;
+        let result = (|| {
+            unsafe {
+                self.device.begin_command_buffer(
+                    cmd,
+                    &vk::CommandBufferBeginInfo::default()
+                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                )?
+            };
+            let r = record(cmd);
+            unsafe { self.device.end_command_buffer(cmd)? };
+            let fence = unsafe {
+                self.device
+                    .create_fence(&vk::FenceCreateInfo::default(), None)
+            }?;
+            let cmd_infos = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmd_infos);
+            let waited = unsafe {
+                self.device
+                    .queue_submit2(self.queue, &[submit], fence)
+                    .and_then(|_| self.device.wait_for_fences(&[fence], true, u64::MAX))
+            };
+            unsafe { self.device.destroy_fence(fence, None) };
+            waited?;
+            Ok(r)
+        })();
+        self.free_command_buffer(cmd);
+        result
+    }
+
+    pub fn wait_idle(&self) {
+        let _ = unsafe { self.device.device_wait_idle() };
+    }
+}
+
+fn pick_device(infos: &[DeviceInfo], wanted: Option<&str>) -> VkResult<usize> {
+    if infos.is_empty() {
+        return Err(VkError::NoDevice);
+    }
+    if let Some(w) = wanted {
+        if let Ok(i) = w.parse::<usize>() {
+            return if i < infos.len() {
+                Ok(i)
+            } else {
+                Err(VkError::DeviceNotFound(w.into()))
+            };
+        }
+        let lw = w.to_lowercase();
+        return infos
+            .iter()
+            .position(|d| d.name.to_lowercase().contains(&lw))
+            .ok_or_else(|| VkError::DeviceNotFound(w.into()));
+    }
+    // Prefer a discrete GPU with every feature, then any complete device, then
+    // whatever exists (the caller reports what it lacks).
+    let rank = |d: &DeviceInfo| {
+        let complete = d.missing().is_empty();
+        let kind = match d.kind {
+            vk::PhysicalDeviceType::DISCRETE_GPU => 0,
+            vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
+            vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+            vk::PhysicalDeviceType::CPU => 3,
+            _ => 4,
+        };
+        (!complete, kind)
+    };
+    Ok(infos
+        .iter()
+        .min_by_key(|d| rank(d))
+        .map(|d| d.index)
+        .unwrap_or(0))
+}
+
+impl Drop for Context {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            self.device.destroy_command_pool(self.command_pool, None);
+            // The allocator frees its memory blocks; it must go before the device.
+            ManuallyDrop::drop(&mut self.allocator);
+            self.device.destroy_device(None);
+            if let Some(d) = &self.debug_instance {
+                d.destroy_debug_utils_messenger(self.messenger, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}

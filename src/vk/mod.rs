@@ -1,0 +1,64 @@
+//! The Vulkan backend: instance and device, memory, buffers and images,
+//! pipelines and descriptors, command submission, barriers, the GPU profiler
+//! and readback. It knows nothing about caustics; passes and techniques are
+//! built on top of it (docs/ARCHITECTURE.md).
+//!
+//! Lifetime model: every object is owned by a Rust value and destroyed by its
+//! `Drop`. Values hold an `Arc` of the device, so the device outlives them.
+//! The renderer waits for the frame's fence before it drops anything that
+//! frame used, so `Drop` never frees what the GPU may still read.
+
+mod context;
+mod pipeline;
+mod profiler;
+mod resources;
+mod sync;
+
+pub use context::{Context, ContextOptions, DeviceInfo, RequiredFeature, ValidationCounts};
+pub use pipeline::{
+    begin_rendering, end_rendering, BindingKind, ComputePipeline, DescriptorSet,
+    DescriptorSetLayout, GraphicsPipeline, GraphicsPipelineDesc, Sampler,
+};
+pub use profiler::{FrameRecorder, PassTiming, Profiler, TimingSource};
+pub use resources::{Buffer, BufferUsage, Image, ImageDesc};
+pub use sync::{barrier, Access, BufferAccess, ImageAccess};
+
+pub use ash::vk;
+
+/// Errors at the backend boundary: typed, so callers can tell a device
+/// problem from a missing feature or a driver error.
+#[derive(Debug, thiserror::Error)]
+pub enum VkError {
+    #[error("could not load the Vulkan loader (libvulkan.so.1): {0}. Install it with `apt-get install libvulkan1 mesa-vulkan-drivers`")]
+    Loader(String),
+    #[error("no Vulkan device found. Install Mesa's lavapipe with `apt-get install mesa-vulkan-drivers`")]
+    NoDevice,
+    #[error("no device matches --device {0:?}; `caustics info` lists them")]
+    DeviceNotFound(String),
+    #[error("device \"{device}\" lacks required feature(s): {missing}")]
+    MissingFeatures { device: String, missing: String },
+    #[error("the Khronos validation layer (VK_LAYER_KHRONOS_validation) is not installed: `apt-get install vulkan-validationlayers`")]
+    NoValidationLayer,
+    #[error("out of device or host memory")]
+    OutOfMemory,
+    #[error("the device was lost")]
+    DeviceLost,
+    #[error("memory allocation failed: {0}")]
+    Allocation(#[from] gpu_allocator::AllocationError),
+    #[error("Vulkan call failed: {0}")]
+    Vulkan(vk::Result),
+}
+
+impl From<vk::Result> for VkError {
+    fn from(r: vk::Result) -> Self {
+        match r {
+            vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => {
+                VkError::OutOfMemory
+            }
+            vk::Result::ERROR_DEVICE_LOST => VkError::DeviceLost,
+            other => VkError::Vulkan(other),
+        }
+    }
+}
+
+pub type VkResult<T> = Result<T, VkError>;

@@ -1,0 +1,561 @@
+//! Shader modules, descriptor set layouts and sets, samplers, compute and
+//! graphics pipelines. Bindings are declared by number (constants shared with
+//! GLSL through `shader_bindings.rs`), never by call order.
+
+use super::{Buffer, Context, Image, VkResult};
+use crate::shaders;
+use ash::vk;
+use std::sync::Arc;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BindingKind {
+    Uniform,
+    Storage,
+    StorageImage,
+    /// Combined image sampler.
+    Sampled,
+}
+
+impl BindingKind {
+    fn descriptor_type(self) -> vk::DescriptorType {
+        match self {
+            BindingKind::Uniform => vk::DescriptorType::UNIFORM_BUFFER,
+            BindingKind::Storage => vk::DescriptorType::STORAGE_BUFFER,
+            BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
+            BindingKind::Sampled => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+        }
+    }
+}
+
+pub struct DescriptorSetLayout {
+    ctx: Arc<Context>,
+    pub raw: vk::DescriptorSetLayout,
+    bindings: Vec<(u32, BindingKind)>,
+}
+
+impl DescriptorSetLayout {
+    /// Every binding is visible to all stages: sets are shared between compute
+    /// and graphics passes, and the cost of wide stage masks is nil.
+    pub fn new(ctx: &Arc<Context>, bindings: &[(u32, BindingKind)]) -> VkResult<Self> {
+        let raw_bindings: Vec<_> = bindings
+            .iter()
+            .map(|&(binding, kind)| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(binding)
+                    .descriptor_type(kind.descriptor_type())
+                    .descriptor_count(1)
+                    .stage_flags(vk::ShaderStageFlags::ALL)
+            })
+            .collect();
+        let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&raw_bindings);
+        let raw = unsafe { ctx.device.create_descriptor_set_layout(&info, None) }?;
+        Ok(Self {
+            ctx: ctx.clone(),
+            raw,
+            bindings: bindings.to_vec(),
+        })
+    }
+}
+
+impl Drop for DescriptorSetLayout {
+    fn drop(&mut self) {
+        unsafe {
+            self.ctx
+                .device
+                .destroy_descriptor_set_layout(self.raw, None)
+        };
+    }
+}
+
+/// One descriptor set with its own small pool (sets are few and long-lived here).
+pub struct DescriptorSet {
+    ctx: Arc<Context>,
+    pool: vk::DescriptorPool,
+    pub raw: vk::DescriptorSet,
+    bindings: Vec<(u32, BindingKind)>,
+}
+
+impl DescriptorSet {
+    pub fn new(ctx: &Arc<Context>, layout: &DescriptorSetLayout) -> VkResult<Self> {
+        let sizes: Vec<_> = layout
+            .bindings
+            .iter()
+            .map(|(_, k)| vk::DescriptorPoolSize {
+                ty: k.descriptor_type(),
+                descriptor_count: 1,
+            })
+            .collect();
+        let info = vk::DescriptorPoolCreateInfo::default()
+            .max_sets(1)
+            .pool_sizes(&sizes);
+        let pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }?;
+        let layouts = [layout.raw];
+        let alloc = vk::DescriptorSetAllocateInfo::default()
+            .descriptor_pool(pool)
+            .set_layouts(&layouts);
+        let raw = match unsafe { ctx.device.allocate_descriptor_sets(&alloc) } {
+            Ok(s) => s[0],
+            Err(e) => {
+                unsafe { ctx.device.destroy_descriptor_pool(pool, None) };
+                return Err(e.into());
+            }
+        };
+        Ok(Self {
+            ctx: ctx.clone(),
+            pool,
+            raw,
+            bindings: layout.bindings.clone(),
+        })
+    }
+
+    fn kind_of(&self, binding: u32) -> BindingKind {
+        self.bindings
+            .iter()
+            .find(|(b, _)| *b == binding)
+            .map(|(_, k)| *k)
+            .unwrap_or_else(|| panic!("binding {binding} is not in this set's layout"))
+    }
+
+    pub fn write_buffer(&self, binding: u32, buffer: &Buffer) -> &Self {
+        let info = [buffer.descriptor_info()];
+        let write = vk::WriteDescriptorSet::default()
+            .dst_set(self.raw)
+            .dst_binding(binding)
+            .descriptor_type(self.kind_of(binding).descriptor_type())
+            .buffer_info(&info);
+        unsafe { self.ctx.device.update_descriptor_sets(&[write], &[]) };
+        self
+    }
+
+    /// A storage image in GENERAL layout.
+    pub fn write_storage_image(&self, binding: u32, image: &Image) -> &Self {
+        let info = [vk::DescriptorImageInfo::default()
+            .image_view(image.view)
+            .image_layout(vk::ImageLayout::GENERAL)];
+        let write = vk::WriteDescriptorSet::default()
+            .dst_set(self.raw)
+            .dst_binding(binding)
+            .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+            .image_info(&info);
+        unsafe { self.ctx.device.update_descriptor_sets(&[write], &[]) };
+        self
+    }
+
+    /// A sampled image (all layers) read in the layout `Access::FragmentRead`/`ComputeRead` gives it.
+    pub fn write_sampled_image(
+        &self,
+        binding: u32,
+        image: &Image,
+        sampler: &Sampler,
+        layout: vk::ImageLayout,
+    ) -> &Self {
+        let info = [vk::DescriptorImageInfo::default()
+            .image_view(image.view)
+            .sampler(sampler.raw)
+            .image_layout(layout)];
+        let write = vk::WriteDescriptorSet::default()
+            .dst_set(self.raw)
+            .dst_binding(binding)
+            .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+            .image_info(&info);
+        unsafe { self.ctx.device.update_descriptor_sets(&[write], &[]) };
+        self
+    }
+}
+
+impl Drop for DescriptorSet {
+    fn drop(&mut self) {
+        unsafe { self.ctx.device.destroy_descriptor_pool(self.pool, None) };
+    }
+}
+
+pub struct Sampler {
+    ctx: Arc<Context>,
+    pub raw: vk::Sampler,
+}
+
+impl Sampler {
+    pub fn new(ctx: &Arc<Context>, filter: vk::Filter) -> VkResult<Self> {
+        let info = vk::SamplerCreateInfo::default()
+            .mag_filter(filter)
+            .min_filter(filter)
+            .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .max_lod(0.0);
+        Ok(Self {
+            ctx: ctx.clone(),
+            raw: unsafe { ctx.device.create_sampler(&info, None) }?,
+        })
+    }
+}
+
+impl Drop for Sampler {
+    fn drop(&mut self) {
+        unsafe { self.ctx.device.destroy_sampler(self.raw, None) };
+    }
+}
+
+fn shader_module(ctx: &Context, name: &str) -> VkResult<vk::ShaderModule> {
+    let code = shaders::spirv(name);
+    let info = vk::ShaderModuleCreateInfo::default().code(&code);
+    Ok(unsafe { ctx.device.create_shader_module(&info, None) }?)
+}
+
+fn pipeline_layout(
+    ctx: &Context,
+    sets: &[&DescriptorSetLayout],
+    push_size: u32,
+) -> VkResult<vk::PipelineLayout> {
+    let raw_sets: Vec<_> = sets.iter().map(|s| s.raw).collect();
+    let ranges = [vk::PushConstantRange {
+        stage_flags: vk::ShaderStageFlags::ALL,
+        offset: 0,
+        size: push_size,
+    }];
+    let info = vk::PipelineLayoutCreateInfo::default()
+        .set_layouts(&raw_sets)
+        .push_constant_ranges(if push_size > 0 { &ranges[..] } else { &[] });
+    Ok(unsafe { ctx.device.create_pipeline_layout(&info, None) }?)
+}
+
+fn bind_sets(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    point: vk::PipelineBindPoint,
+    layout: vk::PipelineLayout,
+    sets: &[&DescriptorSet],
+) {
+    let raw: Vec<_> = sets.iter().map(|s| s.raw).collect();
+    unsafe {
+        ctx.device
+            .cmd_bind_descriptor_sets(cmd, point, layout, 0, &raw, &[])
+    };
+}
+
+fn push(ctx: &Context, cmd: vk::CommandBuffer, layout: vk::PipelineLayout, data: &[u8]) {
+    if !data.is_empty() {
+        unsafe {
+            ctx.device
+                .cmd_push_constants(cmd, layout, vk::ShaderStageFlags::ALL, 0, data)
+        };
+    }
+}
+
+pub struct ComputePipeline {
+    ctx: Arc<Context>,
+    pub raw: vk::Pipeline,
+    pub layout: vk::PipelineLayout,
+    pub name: String,
+}
+
+impl ComputePipeline {
+    /// `shader` is a path under glsl/, e.g. "reference/trace.comp".
+    pub fn new(
+        ctx: &Arc<Context>,
+        shader: &str,
+        sets: &[&DescriptorSetLayout],
+        push_size: u32,
+    ) -> VkResult<Self> {
+        let module = shader_module(ctx, shader)?;
+        let layout = pipeline_layout(ctx, sets, push_size)?;
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(module)
+            .name(c"main");
+        let info = vk::ComputePipelineCreateInfo::default()
+            .stage(stage)
+            .layout(layout);
+        let result = unsafe {
+            ctx.device
+                .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
+        };
+        unsafe { ctx.device.destroy_shader_module(module, None) };
+        let raw = match result {
+            Ok(p) => p[0],
+            Err((_, e)) => {
+                unsafe { ctx.device.destroy_pipeline_layout(layout, None) };
+                return Err(e.into());
+            }
+        };
+        ctx.set_name(raw, shader);
+        Ok(Self {
+            ctx: ctx.clone(),
+            raw,
+            layout,
+            name: shader.to_string(),
+        })
+    }
+
+    /// Binds the pipeline and sets, pushes constants and dispatches `groups`.
+    pub fn dispatch(
+        &self,
+        cmd: vk::CommandBuffer,
+        sets: &[&DescriptorSet],
+        push_data: &[u8],
+        groups: [u32; 3],
+    ) {
+        let ctx = &self.ctx;
+        unsafe {
+            ctx.device
+                .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.raw)
+        };
+        bind_sets(ctx, cmd, vk::PipelineBindPoint::COMPUTE, self.layout, sets);
+        push(ctx, cmd, self.layout, push_data);
+        unsafe {
+            ctx.device
+                .cmd_dispatch(cmd, groups[0], groups[1], groups[2])
+        };
+    }
+}
+
+impl Drop for ComputePipeline {
+    fn drop(&mut self) {
+        unsafe {
+            self.ctx.device.destroy_pipeline(self.raw, None);
+            self.ctx.device.destroy_pipeline_layout(self.layout, None);
+        }
+    }
+}
+
+/// How a graphics pipeline is built. Geometry comes from storage buffers
+/// (vertex pulling), so there is no vertex input state.
+#[derive(Clone, Debug)]
+pub struct GraphicsPipelineDesc<'a> {
+    pub vertex: &'a str,
+    pub geometry: Option<&'a str>,
+    pub fragment: &'a str,
+    pub color_formats: Vec<vk::Format>,
+    pub depth_format: Option<vk::Format>,
+    pub depth_test: bool,
+    pub depth_write: bool,
+    /// Additive blending (one + one) on every colour attachment.
+    pub additive: bool,
+    pub cull: vk::CullModeFlags,
+    pub topology: vk::PrimitiveTopology,
+    pub push_size: u32,
+}
+
+impl<'a> GraphicsPipelineDesc<'a> {
+    pub fn new(vertex: &'a str, fragment: &'a str) -> Self {
+        Self {
+            vertex,
+            geometry: None,
+            fragment,
+            color_formats: Vec::new(),
+            depth_format: None,
+            depth_test: false,
+            depth_write: false,
+            additive: false,
+            cull: vk::CullModeFlags::NONE,
+            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            push_size: 0,
+        }
+    }
+}
+
+pub struct GraphicsPipeline {
+    ctx: Arc<Context>,
+    pub raw: vk::Pipeline,
+    pub layout: vk::PipelineLayout,
+}
+
+impl GraphicsPipeline {
+    pub fn new(
+        ctx: &Arc<Context>,
+        desc: &GraphicsPipelineDesc,
+        sets: &[&DescriptorSetLayout],
+    ) -> VkResult<Self> {
+        let mut modules = vec![(
+            vk::ShaderStageFlags::VERTEX,
+            shader_module(ctx, desc.vertex)?,
+        )];
+        if let Some(g) = desc.geometry {
+            modules.push((vk::ShaderStageFlags::GEOMETRY, shader_module(ctx, g)?));
+        }
+        modules.push((
+            vk::ShaderStageFlags::FRAGMENT,
+            shader_module(ctx, desc.fragment)?,
+        ));
+        let stages: Vec<_> = modules
+            .iter()
+            .map(|&(stage, module)| {
+                vk::PipelineShaderStageCreateInfo::default()
+                    .stage(stage)
+                    .module(module)
+                    .name(c"main")
+            })
+            .collect();
+        let layout = pipeline_layout(ctx, sets, desc.push_size)?;
+        let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
+        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(desc.topology);
+        let viewport = vk::PipelineViewportStateCreateInfo::default()
+            .viewport_count(1)
+            .scissor_count(1);
+        let raster = vk::PipelineRasterizationStateCreateInfo::default()
+            .polygon_mode(vk::PolygonMode::FILL)
+            .cull_mode(desc.cull)
+            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+            .line_width(1.0);
+        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+            .depth_test_enable(desc.depth_test)
+            .depth_write_enable(desc.depth_write)
+            .depth_compare_op(vk::CompareOp::LESS_OR_EQUAL);
+        let attachment = if desc.additive {
+            vk::PipelineColorBlendAttachmentState::default()
+                .blend_enable(true)
+                .src_color_blend_factor(vk::BlendFactor::ONE)
+                .dst_color_blend_factor(vk::BlendFactor::ONE)
+                .color_blend_op(vk::BlendOp::ADD)
+                .src_alpha_blend_factor(vk::BlendFactor::ONE)
+                .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+                .alpha_blend_op(vk::BlendOp::ADD)
+                .color_write_mask(vk::ColorComponentFlags::RGBA)
+        } else {
+            vk::PipelineColorBlendAttachmentState::default()
+                .color_write_mask(vk::ColorComponentFlags::RGBA)
+        };
+        let attachments = vec![attachment; desc.color_formats.len()];
+        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
+        let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+        let mut rendering = vk::PipelineRenderingCreateInfo::default()
+            .color_attachment_formats(&desc.color_formats)
+            .depth_attachment_format(desc.depth_format.unwrap_or(vk::Format::UNDEFINED));
+        let info = vk::GraphicsPipelineCreateInfo::default()
+            .stages(&stages)
+            .vertex_input_state(&vertex_input)
+            .input_assembly_state(&assembly)
+            .viewport_state(&viewport)
+            .rasterization_state(&raster)
+            .multisample_state(&multisample)
+            .depth_stencil_state(&depth)
+            .color_blend_state(&blend)
+            .dynamic_state(&dynamic)
+            .layout(layout)
+            .push_next(&mut rendering);
+        let result = unsafe {
+            ctx.device
+                .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
+        };
+        for (_, m) in modules {
+            unsafe { ctx.device.destroy_shader_module(m, None) };
+        }
+        let raw = match result {
+            Ok(p) => p[0],
+            Err((_, e)) => {
+                unsafe { ctx.device.destroy_pipeline_layout(layout, None) };
+                return Err(e.into());
+            }
+        };
+        ctx.set_name(raw, desc.fragment);
+        Ok(Self {
+            ctx: ctx.clone(),
+            raw,
+            layout,
+        })
+    }
+
+    /// Binds the pipeline, its sets and push constants, and sets a full viewport and scissor.
+    pub fn bind(
+        &self,
+        cmd: vk::CommandBuffer,
+        sets: &[&DescriptorSet],
+        push_data: &[u8],
+        extent: vk::Extent2D,
+    ) {
+        let ctx = &self.ctx;
+        unsafe {
+            ctx.device
+                .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.raw);
+            let viewport = vk::Viewport {
+                x: 0.0,
+                y: 0.0,
+                width: extent.width as f32,
+                height: extent.height as f32,
+                min_depth: 0.0,
+                max_depth: 1.0,
+            };
+            ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
+            ctx.device.cmd_set_scissor(
+                cmd,
+                0,
+                &[vk::Rect2D {
+                    offset: vk::Offset2D::default(),
+                    extent,
+                }],
+            );
+        }
+        bind_sets(ctx, cmd, vk::PipelineBindPoint::GRAPHICS, self.layout, sets);
+        push(ctx, cmd, self.layout, push_data);
+    }
+}
+
+impl Drop for GraphicsPipeline {
+    fn drop(&mut self) {
+        unsafe {
+            self.ctx.device.destroy_pipeline(self.raw, None);
+            self.ctx.device.destroy_pipeline_layout(self.layout, None);
+        }
+    }
+}
+
+/// Begins dynamic rendering into `colors` (cleared to `clear` when given) and an optional depth image (cleared to 1).
+pub fn begin_rendering(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    extent: vk::Extent2D,
+    colors: &[(vk::ImageView, Option<[f32; 4]>)],
+    depth: Option<vk::ImageView>,
+) {
+    let color_attachments: Vec<_> = colors
+        .iter()
+        .map(|&(view, clear)| {
+            vk::RenderingAttachmentInfo::default()
+                .image_view(view)
+                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .load_op(if clear.is_some() {
+                    vk::AttachmentLoadOp::CLEAR
+                } else {
+                    vk::AttachmentLoadOp::LOAD
+                })
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue {
+                    color: vk::ClearColorValue {
+                        float32: clear.unwrap_or_default(),
+                    },
+                })
+        })
+        .collect();
+    let depth_attachment = depth.map(|view| {
+        vk::RenderingAttachmentInfo::default()
+            .image_view(view)
+            .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue {
+                depth_stencil: vk::ClearDepthStencilValue {
+                    depth: 1.0,
+                    stencil: 0,
+                },
+            })
+    });
+    let mut info = vk::RenderingInfo::default()
+        .render_area(vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent,
+        })
+        .layer_count(1)
+        .color_attachments(&color_attachments);
+    if let Some(d) = depth_attachment.as_ref() {
+        info = info.depth_attachment(d);
+    }
+    unsafe { ctx.device.cmd_begin_rendering(cmd, &info) };
+}
+
+pub fn end_rendering(ctx: &Context, cmd: vk::CommandBuffer) {
+    unsafe { ctx.device.cmd_end_rendering(cmd) };
+}

@@ -1,0 +1,418 @@
+//! Buffers and images backed by gpu-allocator. Each owns its allocation and
+//! returns it (and destroys the Vulkan handle) on `Drop`; see the lifetime
+//! note in `vk/mod.rs`.
+
+use super::sync::ResourceState;
+use super::{Context, VkResult};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::MemoryLocation;
+use std::cell::Cell;
+use std::sync::Arc;
+
+/// What a buffer is for, which decides its usage flags and memory location.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BufferUsage {
+    /// Device-local storage buffer, filled by upload or by shaders.
+    Storage,
+    /// Device-local storage buffer that is also read as indirect-draw arguments.
+    StorageIndirect,
+    /// Host-visible uniform buffer, written by the CPU every frame.
+    Uniform,
+    /// Host-visible buffer the GPU copies into for the CPU to read.
+    Readback,
+    /// Host-visible staging buffer the CPU writes for the GPU to copy from.
+    Upload,
+}
+
+pub struct Buffer {
+    ctx: Arc<Context>,
+    pub raw: vk::Buffer,
+    pub size: u64,
+    pub usage: BufferUsage,
+    pub(super) state: Cell<ResourceState>,
+    allocation: Option<Allocation>,
+}
+
+impl Buffer {
+    pub fn new(ctx: &Arc<Context>, name: &str, size: u64, usage: BufferUsage) -> VkResult<Buffer> {
+        let size = size.max(16);
+        let transfer = vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST;
+        let (flags, location) = match usage {
+            BufferUsage::Storage => (
+                vk::BufferUsageFlags::STORAGE_BUFFER | transfer,
+                MemoryLocation::GpuOnly,
+            ),
+            BufferUsage::StorageIndirect => (
+                vk::BufferUsageFlags::STORAGE_BUFFER
+                    | vk::BufferUsageFlags::INDIRECT_BUFFER
+                    | transfer,
+                MemoryLocation::GpuOnly,
+            ),
+            BufferUsage::Uniform => (
+                vk::BufferUsageFlags::UNIFORM_BUFFER,
+                MemoryLocation::CpuToGpu,
+            ),
+            BufferUsage::Readback => (vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu),
+            BufferUsage::Upload => (vk::BufferUsageFlags::TRANSFER_SRC, MemoryLocation::CpuToGpu),
+        };
+        let info = vk::BufferCreateInfo::default()
+            .size(size)
+            .usage(flags)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        let raw = unsafe { ctx.device.create_buffer(&info, None) }?;
+        let requirements = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
+        let allocation = ctx.allocator().allocate(&AllocationCreateDesc {
+            name,
+            requirements,
+            location,
+            linear: true,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        });
+        let allocation = match allocation {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { ctx.device.destroy_buffer(raw, None) };
+                return Err(e.into());
+            }
+        };
+        unsafe {
+            ctx.device
+                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
+        }?;
+        ctx.set_name(raw, name);
+        Ok(Buffer {
+            ctx: ctx.clone(),
+            raw,
+            size,
+            usage,
+            state: Cell::new(ResourceState::default()),
+            allocation: Some(allocation),
+        })
+    }
+
+    /// A device-local storage buffer holding `data`, uploaded through a staging buffer.
+    pub fn with_data<T: bytemuck::Pod>(
+        ctx: &Arc<Context>,
+        name: &str,
+        data: &[T],
+        usage: BufferUsage,
+    ) -> VkResult<Buffer> {
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        let buffer = Buffer::new(ctx, name, bytes.len() as u64, usage)?;
+        buffer.upload(bytes)?;
+        Ok(buffer)
+    }
+
+    /// Copies `bytes` to the start of the buffer: directly when host-visible,
+    /// else through a staging buffer and a blocking submission.
+    pub fn upload(&self, bytes: &[u8]) -> VkResult<()> {
+        if bytes.is_empty() {
+            return Ok(());
+        }
+        if let Some(dst) = self.mapped() {
+            // SAFETY: the mapping is at least `size` bytes and host-coherent (gpu-allocator CpuToGpu).
+            unsafe {
+                std::ptr::copy_nonoverlapping(
+                    bytes.as_ptr(),
+                    dst,
+                    bytes.len().min(self.size as usize),
+                )
+            };
+            return Ok(());
+        }
+        let staging = Buffer::new(
+            &self.ctx,
+            "staging",
+            bytes.len() as u64,
+            BufferUsage::Upload,
+        )?;
+        staging.upload(bytes)?;
+        self.ctx.submit_and_wait(|cmd| unsafe {
+            let region = vk::BufferCopy::default().size(bytes.len() as u64);
+            self.ctx
+                .device
+                .cmd_copy_buffer(cmd, staging.raw, self.raw, &[region]);
+        })?;
+        Ok(())
+    }
+
+    /// Reads the whole buffer back to the host (blocking).
+    pub fn download(&self) -> VkResult<Vec<u8>> {
+        if let Some(src) = self.mapped() {
+            let mut out = vec![0u8; self.size as usize];
+            // SAFETY: mapping covers `size` bytes; the caller has waited for the writes.
+            unsafe { std::ptr::copy_nonoverlapping(src, out.as_mut_ptr(), out.len()) };
+            return Ok(out);
+        }
+        let readback = Buffer::new(&self.ctx, "readback", self.size, BufferUsage::Readback)?;
+        self.ctx.submit_and_wait(|cmd| unsafe {
+            let before = vk::MemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                .src_access_mask(vk::AccessFlags2::MEMORY_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::COPY)
+                .dst_access_mask(vk::AccessFlags2::TRANSFER_READ);
+            let after = vk::MemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::COPY)
+                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+                .dst_access_mask(vk::AccessFlags2::HOST_READ);
+            self.ctx.device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().memory_barriers(&[before]),
+            );
+            let region = vk::BufferCopy::default().size(self.size);
+            self.ctx
+                .device
+                .cmd_copy_buffer(cmd, self.raw, readback.raw, &[region]);
+            self.ctx.device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().memory_barriers(&[after]),
+            );
+        })?;
+        readback.download()
+    }
+
+    pub fn download_pod<T: bytemuck::Pod>(&self) -> VkResult<Vec<T>> {
+        let bytes = self.download()?;
+        Ok(bytemuck::pod_collect_to_vec(
+            &bytes[..bytes.len() / std::mem::size_of::<T>() * std::mem::size_of::<T>()],
+        ))
+    }
+
+    fn mapped(&self) -> Option<*mut u8> {
+        self.allocation
+            .as_ref()?
+            .mapped_ptr()
+            .map(|p| p.as_ptr() as *mut u8)
+    }
+
+    pub fn descriptor_info(&self) -> vk::DescriptorBufferInfo {
+        vk::DescriptorBufferInfo::default()
+            .buffer(self.raw)
+            .offset(0)
+            .range(vk::WHOLE_SIZE)
+    }
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        if let Some(a) = self.allocation.take() {
+            let _ = self.ctx.allocator().free(a);
+        }
+        unsafe { self.ctx.device.destroy_buffer(self.raw, None) };
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct ImageDesc {
+    pub width: u32,
+    pub height: u32,
+    pub layers: u32,
+    pub format: vk::Format,
+    pub usage: vk::ImageUsageFlags,
+}
+
+impl ImageDesc {
+    pub fn new_2d(width: u32, height: u32, format: vk::Format, usage: vk::ImageUsageFlags) -> Self {
+        Self {
+            width,
+            height,
+            layers: 1,
+            format,
+            usage,
+        }
+    }
+}
+
+/// A 2D image (or 2D array of `layers`), its full view and one view per layer
+/// (for rendering into single layers). It tracks its current layout and last
+/// access so `sync::barrier` can build the transition.
+pub struct Image {
+    ctx: Arc<Context>,
+    pub raw: vk::Image,
+    /// View of every layer (2D, or 2D array when layers > 1).
+    pub view: vk::ImageView,
+    /// One 2D view per layer.
+    pub layer_views: Vec<vk::ImageView>,
+    pub desc: ImageDesc,
+    pub(super) state: Cell<ResourceState>,
+    allocation: Option<Allocation>,
+}
+
+impl Image {
+    pub fn new(ctx: &Arc<Context>, name: &str, desc: ImageDesc) -> VkResult<Image> {
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(desc.format)
+            .extent(vk::Extent3D {
+                width: desc.width,
+                height: desc.height,
+                depth: 1,
+            })
+            .mip_levels(1)
+            .array_layers(desc.layers)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(
+                desc.usage | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST,
+            )
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        let raw = unsafe { ctx.device.create_image(&info, None) }?;
+        let requirements = unsafe { ctx.device.get_image_memory_requirements(raw) };
+        let allocation = match ctx.allocator().allocate(&AllocationCreateDesc {
+            name,
+            requirements,
+            location: MemoryLocation::GpuOnly,
+            linear: false,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        }) {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { ctx.device.destroy_image(raw, None) };
+                return Err(e.into());
+            }
+        };
+        unsafe {
+            ctx.device
+                .bind_image_memory(raw, allocation.memory(), allocation.offset())
+        }?;
+        ctx.set_name(raw, name);
+        let aspect = aspect_of(desc.format);
+        let make_view = |base: u32, count: u32, ty: vk::ImageViewType| {
+            let info = vk::ImageViewCreateInfo::default()
+                .image(raw)
+                .view_type(ty)
+                .format(desc.format)
+                .subresource_range(vk::ImageSubresourceRange {
+                    aspect_mask: aspect,
+                    base_mip_level: 0,
+                    level_count: 1,
+                    base_array_layer: base,
+                    layer_count: count,
+                });
+            unsafe { ctx.device.create_image_view(&info, None) }
+        };
+        let ty = if desc.layers > 1 {
+            vk::ImageViewType::TYPE_2D_ARRAY
+        } else {
+            vk::ImageViewType::TYPE_2D
+        };
+        let mut image = Image {
+            ctx: ctx.clone(),
+            raw,
+            view: vk::ImageView::null(),
+            layer_views: Vec::new(),
+            desc,
+            state: Cell::new(ResourceState::default()),
+            allocation: Some(allocation),
+        };
+        image.view = make_view(0, desc.layers, ty)?;
+        for layer in 0..desc.layers {
+            image
+                .layer_views
+                .push(make_view(layer, 1, vk::ImageViewType::TYPE_2D)?);
+        }
+        Ok(image)
+    }
+
+    pub fn extent(&self) -> vk::Extent2D {
+        vk::Extent2D {
+            width: self.desc.width,
+            height: self.desc.height,
+        }
+    }
+
+    pub fn aspect(&self) -> vk::ImageAspectFlags {
+        aspect_of(self.desc.format)
+    }
+
+    pub fn layout(&self) -> vk::ImageLayout {
+        self.state.get().layout
+    }
+
+    /// Reads layer 0 back as 32-bit floats, four per pixel (the image must be
+    /// RGBA32F; the caller has recorded the last write into an earlier submission).
+    pub fn download_rgba32f(&self) -> VkResult<Vec<f32>> {
+        assert_eq!(
+            self.desc.format,
+            vk::Format::R32G32B32A32_SFLOAT,
+            "download_rgba32f needs an RGBA32F image"
+        );
+        let bytes = self.download_bytes(16)?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+
+    /// Reads layer 0 back as raw texels of `texel_size` bytes.
+    pub fn download_bytes(&self, texel_size: u64) -> VkResult<Vec<u8>> {
+        let size = self.desc.width as u64 * self.desc.height as u64 * texel_size;
+        let readback = Buffer::new(&self.ctx, "image readback", size, BufferUsage::Readback)?;
+        self.ctx.submit_and_wait(|cmd| {
+            super::sync::barrier(
+                &self.ctx,
+                cmd,
+                &[super::ImageAccess::new(self, super::Access::TransferRead)],
+                &[],
+            );
+            let region = vk::BufferImageCopy::default()
+                .image_subresource(vk::ImageSubresourceLayers {
+                    aspect_mask: self.aspect(),
+                    mip_level: 0,
+                    base_array_layer: 0,
+                    layer_count: 1,
+                })
+                .image_extent(vk::Extent3D {
+                    width: self.desc.width,
+                    height: self.desc.height,
+                    depth: 1,
+                });
+            unsafe {
+                self.ctx.device.cmd_copy_image_to_buffer(
+                    cmd,
+                    self.raw,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    readback.raw,
+                    &[region],
+                );
+            }
+            readback.state.set(ResourceState {
+                current: super::Access::TransferWrite,
+                ..Default::default()
+            });
+            super::sync::barrier(
+                &self.ctx,
+                cmd,
+                &[],
+                &[super::BufferAccess::new(&readback, super::Access::HostRead)],
+            );
+        })?;
+        readback.download()
+    }
+}
+
+pub(super) fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
+    match format {
+        vk::Format::D32_SFLOAT | vk::Format::D16_UNORM | vk::Format::X8_D24_UNORM_PACK32 => {
+            vk::ImageAspectFlags::DEPTH
+        }
+        vk::Format::D24_UNORM_S8_UINT | vk::Format::D32_SFLOAT_S8_UINT => {
+            vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL
+        }
+        _ => vk::ImageAspectFlags::COLOR,
+    }
+}
+
+impl Drop for Image {
+    fn drop(&mut self) {
+        unsafe {
+            for v in self.layer_views.drain(..) {
+                self.ctx.device.destroy_image_view(v, None);
+            }
+            self.ctx.device.destroy_image_view(self.view, None);
+        }
+        if let Some(a) = self.allocation.take() {
+            let _ = self.ctx.allocator().free(a);
+        }
+        unsafe { self.ctx.device.destroy_image(self.raw, None) };
+    }
+}

@@ -1,0 +1,245 @@
+//! Barriers from one function. A pass declares how it is about to use each
+//! image and buffer (an `Access`); `barrier` looks up how the resource was
+//! last used, and emits the synchronization2 barrier (stages, access masks,
+//! layout transition) between the two. Every resource remembers its last
+//! access, so passes never spell out source stages by hand.
+
+use super::{Buffer, Context, Image};
+use ash::vk;
+
+/// How a pass uses a resource.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Access {
+    /// Contents are not needed (first use, or about to be overwritten entirely).
+    #[default]
+    Undefined,
+    /// Read by compute shaders (storage buffer / storage image / sampled).
+    ComputeRead,
+    /// Written (and possibly read) by compute shaders.
+    ComputeWrite,
+    /// Sampled or read as storage by fragment shaders.
+    FragmentRead,
+    /// Read as storage by vertex or geometry shaders (vertex pulling).
+    VertexRead,
+    /// Written as storage (e.g. atomics) by fragment shaders.
+    FragmentWrite,
+    /// Colour attachment written by rendering.
+    ColorAttachment,
+    /// Depth attachment tested and written by rendering.
+    DepthAttachment,
+    /// Read by vkCmdDraw*Indirect as arguments.
+    IndirectRead,
+    TransferRead,
+    TransferWrite,
+    /// Read by the host after the submission's fence.
+    HostRead,
+    /// Handed to the presentation engine.
+    Present,
+}
+
+/// What a barrier needs to know of a resource's past: its last writer (whose
+/// writes must be made visible) and its current use (which a following write
+/// must wait for, the write-after-read hazard).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ResourceState {
+    pub layout: vk::ImageLayout,
+    pub last_write: Access,
+    pub current: Access,
+}
+
+impl ResourceState {
+    fn src_stage(&self) -> vk::PipelineStageFlags2 {
+        self.last_write.stage() | self.current.stage()
+    }
+    fn src_access(&self) -> vk::AccessFlags2 {
+        self.last_write.writes() | self.current.writes()
+    }
+    fn after(&self, next: Access, layout: vk::ImageLayout) -> ResourceState {
+        let last_write = if next.writes().is_empty() {
+            self.last_write
+        } else {
+            next
+        };
+        ResourceState {
+            layout,
+            last_write,
+            current: next,
+        }
+    }
+}
+
+impl Access {
+    fn stage(self) -> vk::PipelineStageFlags2 {
+        use vk::PipelineStageFlags2 as S;
+        match self {
+            Access::Undefined => S::NONE,
+            Access::ComputeRead | Access::ComputeWrite => S::COMPUTE_SHADER,
+            Access::FragmentRead | Access::FragmentWrite => S::FRAGMENT_SHADER,
+            Access::VertexRead => S::VERTEX_SHADER | S::GEOMETRY_SHADER,
+            Access::ColorAttachment => S::COLOR_ATTACHMENT_OUTPUT,
+            Access::DepthAttachment => S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
+            Access::IndirectRead => S::DRAW_INDIRECT,
+            Access::TransferRead | Access::TransferWrite => S::ALL_TRANSFER,
+            Access::HostRead => S::HOST,
+            Access::Present => S::NONE,
+        }
+    }
+
+    fn access(self) -> vk::AccessFlags2 {
+        use vk::AccessFlags2 as A;
+        match self {
+            Access::Undefined | Access::Present => A::NONE,
+            Access::ComputeRead | Access::FragmentRead | Access::VertexRead => A::SHADER_READ,
+            Access::ComputeWrite | Access::FragmentWrite => A::SHADER_READ | A::SHADER_WRITE,
+            Access::ColorAttachment => A::COLOR_ATTACHMENT_READ | A::COLOR_ATTACHMENT_WRITE,
+            Access::DepthAttachment => {
+                A::DEPTH_STENCIL_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_WRITE
+            }
+            Access::IndirectRead => A::INDIRECT_COMMAND_READ,
+            Access::TransferRead => A::TRANSFER_READ,
+            Access::TransferWrite => A::TRANSFER_WRITE,
+            Access::HostRead => A::HOST_READ,
+        }
+    }
+
+    /// Only the write part of the access: what a later barrier must make available.
+    fn writes(self) -> vk::AccessFlags2 {
+        use vk::AccessFlags2 as A;
+        self.access()
+            & (A::SHADER_WRITE
+                | A::COLOR_ATTACHMENT_WRITE
+                | A::DEPTH_STENCIL_ATTACHMENT_WRITE
+                | A::TRANSFER_WRITE)
+    }
+
+    fn layout(self, format_is_depth: bool) -> vk::ImageLayout {
+        use vk::ImageLayout as L;
+        match self {
+            Access::Undefined => L::UNDEFINED,
+            Access::ComputeRead | Access::ComputeWrite | Access::FragmentWrite => L::GENERAL,
+            Access::FragmentRead | Access::VertexRead => {
+                if format_is_depth {
+                    L::DEPTH_STENCIL_READ_ONLY_OPTIMAL
+                } else {
+                    L::SHADER_READ_ONLY_OPTIMAL
+                }
+            }
+            Access::ColorAttachment => L::COLOR_ATTACHMENT_OPTIMAL,
+            Access::DepthAttachment => L::DEPTH_ATTACHMENT_OPTIMAL,
+            Access::IndirectRead | Access::HostRead => L::GENERAL,
+            Access::TransferRead => L::TRANSFER_SRC_OPTIMAL,
+            Access::TransferWrite => L::TRANSFER_DST_OPTIMAL,
+            Access::Present => L::PRESENT_SRC_KHR,
+        }
+    }
+}
+
+/// An image about to be used as `next`. `discard` drops its contents (layout UNDEFINED as source).
+pub struct ImageAccess<'a> {
+    pub image: &'a Image,
+    pub next: Access,
+    pub discard: bool,
+}
+
+impl<'a> ImageAccess<'a> {
+    pub fn new(image: &'a Image, next: Access) -> Self {
+        Self {
+            image,
+            next,
+            discard: false,
+        }
+    }
+    /// The pass overwrites the whole image: earlier contents need not be kept.
+    pub fn discard(image: &'a Image, next: Access) -> Self {
+        Self {
+            image,
+            next,
+            discard: true,
+        }
+    }
+}
+
+pub struct BufferAccess<'a> {
+    pub buffer: &'a Buffer,
+    pub next: Access,
+}
+
+impl<'a> BufferAccess<'a> {
+    pub fn new(buffer: &'a Buffer, next: Access) -> Self {
+        Self { buffer, next }
+    }
+}
+
+/// Emits one vkCmdPipelineBarrier2 that orders every listed resource's last
+/// access before its next one, and records the new state. Read-after-read
+/// with an unchanged layout needs no barrier and is skipped.
+pub fn barrier(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    images: &[ImageAccess],
+    buffers: &[BufferAccess],
+) {
+    let mut image_barriers = Vec::new();
+    for ia in images {
+        let prev = ia.image.state.get();
+        let is_depth = ia.image.aspect().contains(vk::ImageAspectFlags::DEPTH);
+        let new_layout = ia.next.layout(is_depth);
+        let old_layout = if ia.discard {
+            vk::ImageLayout::UNDEFINED
+        } else {
+            prev.layout
+        };
+        if old_layout == new_layout && prev.current == ia.next && ia.next.writes().is_empty() {
+            continue;
+        }
+        image_barriers.push(
+            vk::ImageMemoryBarrier2::default()
+                .src_stage_mask(prev.src_stage())
+                .src_access_mask(prev.src_access())
+                .dst_stage_mask(ia.next.stage())
+                .dst_access_mask(ia.next.access())
+                .old_layout(old_layout)
+                .new_layout(new_layout)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .image(ia.image.raw)
+                .subresource_range(vk::ImageSubresourceRange {
+                    aspect_mask: ia.image.aspect(),
+                    base_mip_level: 0,
+                    level_count: 1,
+                    base_array_layer: 0,
+                    layer_count: ia.image.desc.layers,
+                }),
+        );
+        ia.image.state.set(prev.after(ia.next, new_layout));
+    }
+    let mut buffer_barriers = Vec::new();
+    for ba in buffers {
+        let prev = ba.buffer.state.get();
+        if prev.current == ba.next && ba.next.writes().is_empty() {
+            continue;
+        }
+        buffer_barriers.push(
+            vk::BufferMemoryBarrier2::default()
+                .src_stage_mask(prev.src_stage())
+                .src_access_mask(prev.src_access())
+                .dst_stage_mask(ba.next.stage())
+                .dst_access_mask(ba.next.access())
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .buffer(ba.buffer.raw)
+                .offset(0)
+                .size(vk::WHOLE_SIZE),
+        );
+        ba.buffer
+            .state
+            .set(prev.after(ba.next, vk::ImageLayout::UNDEFINED));
+    }
+    if image_barriers.is_empty() && buffer_barriers.is_empty() {
+        return;
+    }
+    let dep = vk::DependencyInfo::default()
+        .image_memory_barriers(&image_barriers)
+        .buffer_memory_barriers(&buffer_barriers);
+    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
+}
