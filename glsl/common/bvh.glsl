@@ -11,8 +11,9 @@
 //   fails them; edges inclusive. Hits need 0 < t < t_max;
 //   the traversals additionally need t > t_min (caller's offset, t_min >= 0).
 // - Slab test: direction components with |d| < 1e-30 become +-1e-30 before
-//   inverting (no inf, no 0 * inf = NaN); the box exit distance is scaled by
-//   1 + 2*gamma_3 (Ize 2013) so rounding never culls a touched box.
+//   inverting (no inf, no 0 * inf = NaN); the box exit distance, clamped to
+//   the closest hit so far, is scaled by 1 + 2*gamma_3 (Ize 2013) so rounding
+//   never culls a touched box.
 // Empty tree: node 0 with count == 0 and left_or_first == 0 is the sentinel
 // for "no triangles": every trace misses.
 #ifndef COMMON_BVH_GLSL
@@ -69,7 +70,7 @@ bool bvh_ray_box(uint n, vec3 o, vec3 inv_d, float t_min, float t_max, out float
     vec3 tn = min(t0, t1);
     vec3 tf = max(t0, t1);
     t_near = max(max(tn.x, tn.y), max(tn.z, t_min));
-    float t_far = min(min(min(tf.x, tf.y), tf.z) * BVH_BOX_EXIT_SCALE, t_max);
+    float t_far = min(min(min(tf.x, tf.y), tf.z), t_max) * BVH_BOX_EXIT_SCALE;
     return t_near <= t_far;
 }
 

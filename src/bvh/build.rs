@@ -120,12 +120,23 @@ struct Prims {
 }
 
 pub(crate) fn build(triangles: &[Triangle]) -> Bvh {
+    build_with_max_depth(triangles, MAX_DEPTH)
+}
+
+/// `build` with another depth limit (tests use it to exercise the median
+/// fallback and to measure unconstrained SAH depth). Needs
+/// `max_depth >= ceil(log2(triangles.len()))`.
+pub(crate) fn build_with_max_depth(triangles: &[Triangle], max_depth: u32) -> Bvh {
     let start = Instant::now();
     let n = triangles.len();
     if n == 0 {
         return empty_tree(start);
     }
     assert!(n < u32::MAX as usize, "BVH: too many triangles ({n})");
+    assert!(
+        max_depth >= ceil_log2(n),
+        "BVH: depth limit {max_depth} below log2 of {n} triangles"
+    );
     let boxes: Vec<Aabb> = triangles
         .iter()
         .map(|t| Aabb::of_triangle(&t.positions))
@@ -158,7 +169,7 @@ pub(crate) fn build(triangles: &[Triangle]) -> Bvh {
         let split = if task.count <= LEAF_SIZE {
             None
         } else {
-            choose_split(slice, &prims, &bounds, &cbounds, task.depth)
+            choose_split(slice, &prims, &bounds, &cbounds, task.depth, max_depth)
         };
         let node = &mut nodes[task.node];
         node.bounds_min = bounds.min.to_array();
@@ -191,7 +202,7 @@ pub(crate) fn build(triangles: &[Triangle]) -> Bvh {
             }
         }
     }
-    debug_assert!(depth <= MAX_DEPTH);
+    debug_assert!(depth <= max_depth);
     Bvh {
         nodes,
         triangle_order: order,
@@ -226,6 +237,7 @@ fn choose_split(
     bounds: &Aabb,
     cbounds: &Aabb,
     depth: u32,
+    max_depth: u32,
 ) -> Option<usize> {
     let count = slice.len();
     let extent = cbounds.max - cbounds.min;
@@ -242,7 +254,7 @@ fn choose_split(
         // All centroids equal (or non-finite input): no plane separates them; split by count.
         return Some(count / 2);
     }
-    if depth + ceil_log2(count) >= MAX_DEPTH {
+    if depth.saturating_add(ceil_log2(count)) >= max_depth {
         return Some(median_split(slice, prims, axis));
     }
 

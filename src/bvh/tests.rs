@@ -162,6 +162,27 @@ fn check_tree(bvh: &Bvh, triangles: &[Triangle]) {
     );
 }
 
+/// x_i = e^(160 i / n - 80): spans nearly the whole f32 range. Binned SAH on
+/// such input peels off everything outside the first bin (the top ln 16 of
+/// the log range) at each level: about 160 / ln 16 = 58 levels.
+fn exp_x(i: usize, n: usize) -> f32 {
+    (i as f32 * 160.0 / n as f32 - 80.0).exp()
+}
+
+fn exponential_line(n: usize) -> Vec<Triangle> {
+    (0..n)
+        .map(|i| {
+            let x = exp_x(i, n);
+            let s = 1e-3 * x;
+            tri(
+                Vec3::new(x, 0.0, 0.0),
+                Vec3::new(x + s, s, 0.0),
+                Vec3::new(x, s, s),
+            )
+        })
+        .collect()
+}
+
 fn brute_force(tris: &[GpuTriangle], o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> Option<Hit> {
     let mut closest = t_max;
     let mut best = None;
@@ -250,40 +271,58 @@ fn every_triangle_once_and_bounds_contain() {
     assert!(bvh.leaf_count > 1 && bvh.depth > 1);
 }
 
-#[test]
-fn depth_bounded_on_exponential_line() {
-    // 100k triangles along x at exponentially growing spacing (x_i = e^(i * 80 / n)):
-    // a SAH split peels off the far end each time, so without the median
-    // fallback the tree would be thousands of levels deep.
-    let n = 100_000;
-    let tris: Vec<Triangle> = (0..n)
-        .map(|i| {
-            let x = (i as f32 * 80.0 / n as f32).exp();
-            let s = 1e-3 * x;
-            tri(
-                Vec3::new(x, 0.0, 0.0),
-                Vec3::new(x + s, s, 0.0),
-                Vec3::new(x, s, s),
-            )
-        })
-        .collect();
-    let bvh = Bvh::build(&tris);
-    println!(
-        "exponential line: depth {} leaves {} in {:.1} ms",
-        bvh.depth, bvh.leaf_count, bvh.build_ms
-    );
-    check_tree(&bvh, &tris);
-    // Rays along the line and across it still agree with brute force.
-    let mut rng = Rng(7);
-    let rays: Vec<(Vec3, Vec3)> = (0..200)
+/// Rays across the exponential line, each at the scale of the triangle it
+/// aims at (tests rays_for would aim at triangles far below one ulp of the
+/// origin, where any two float evaluations of the hit distance disagree),
+/// plus rays along it.
+fn line_rays(n: usize, seed: u64) -> Vec<(Vec3, Vec3)> {
+    let mut rng = Rng(seed);
+    (0..200)
         .map(|_| {
-            let i = (rng.next_u64() % n as u64) as f32;
-            let x = (i * 80.0 / n as f32).exp();
-            (Vec3::new(x * 1.0001, 0.5e-3 * x, -1.0), Vec3::Z)
+            let x = exp_x((rng.next_u64() % n as u64) as usize, n);
+            (Vec3::new(x * 1.0001, 0.5e-3 * x, -x), Vec3::Z)
         })
         .chain((0..50).map(|_| (Vec3::new(-1.0, 0.0005, 0.0005), Vec3::X)))
-        .collect();
-    cross_check(&bvh, &tris, &rays);
+        .collect()
+}
+
+#[test]
+fn depth_bounded_on_exponential_line() {
+    // 100k triangles along x at exponentially growing spacing (x_i = e^(160 i / n - 80)):
+    // a SAH split peels off the far end each time, so without the median
+    // fallback the tree would be far deeper than the GLSL stack.
+    let n = 100_000;
+    let tris = exponential_line(n);
+    let unconstrained = super::build::build_with_max_depth(&tris, u32::MAX);
+    let bvh = Bvh::build(&tris);
+    println!(
+        "exponential line: depth {} (SAH alone: {}), leaves {} in {:.1} ms",
+        bvh.depth, unconstrained.depth, bvh.leaf_count, bvh.build_ms
+    );
+    assert!(
+        unconstrained.depth > MAX_DEPTH,
+        "input no longer adversarial: SAH depth {}",
+        unconstrained.depth
+    );
+    check_tree(&bvh, &tris);
+    cross_check(&bvh, &tris, &line_rays(n, 7));
+}
+
+#[test]
+fn tight_depth_limit_forces_median_splits() {
+    // The tightest limit the invariant allows: ceil(log2(n)) levels.
+    let n = 20_000;
+    let line = exponential_line(n);
+    let soup = soup(n, 5);
+    for (tris, rays) in [
+        (&line, line_rays(n, 6)),
+        (&soup, rays_for(&soup, 500, 6, -12.0, 12.0)),
+    ] {
+        let bvh = super::build::build_with_max_depth(tris, 15);
+        check_tree(&bvh, tris);
+        assert!(bvh.depth <= 15, "depth {} > limit 15", bvh.depth);
+        cross_check(&bvh, tris, &rays);
+    }
 }
 
 #[test]

@@ -17,8 +17,10 @@
 //! - Ray-box (slab test): direction components with |d| < 1e-30 are replaced
 //!   by ±1e-30 (sign of d, +0 and -0 both positive) before inverting, so the
 //!   inverse is finite and `0 * inf = NaN` never occurs. The box's exit
-//!   distance is scaled by 1 + 2γ₃ (Ize 2013, "Robust BVH ray traversal") so
-//!   rounding never culls a box the ray touches.
+//!   distance, after clamping to the current closest hit, is scaled by 1 + 2γ₃
+//!   (Ize 2013, "Robust BVH ray traversal") so rounding never culls a box the
+//!   ray touches, nor a box entered a few ulps beyond the closest hit (the
+//!   triangle test's own t carries rounding error too).
 
 use super::Bvh;
 use crate::gpu::{GpuBvhNode, GpuTriangle};
@@ -112,7 +114,7 @@ fn ray_box(n: &GpuBvhNode, o: Vec3, inv_d: Vec3, t_min: f32, t_max: f32) -> Opti
     let tn = t0.min(t1);
     let tf = t0.max(t1);
     let t_near = tn.x.max(tn.y).max(tn.z.max(t_min));
-    let t_far = (tf.x.min(tf.y).min(tf.z) * BOX_EXIT_SCALE).min(t_max);
+    let t_far = tf.x.min(tf.y).min(tf.z).min(t_max) * BOX_EXIT_SCALE;
     if t_near <= t_far {
         Some(t_near)
     } else {
