@@ -20,7 +20,7 @@
 #define COMMON_BVH_GLSL
 
 #define BVH_MIN_DIR_COMPONENT 1e-30
-#define BVH_BOX_EXIT_SCALE 1.00000036
+#define BVH_BOX_EXIT_SCALE 1.00000048 // 1 + 4 * 2^-23 >= 1 + 2 * gamma_3
 #define BVH_DET_EPSILON 1e-5
 
 float bvh_max_abs(vec3 v) {

@@ -41,8 +41,9 @@ pub struct Hit {
 pub const MIN_DIR_COMPONENT: f32 = 1e-30;
 /// Relative determinant threshold of the ray-triangle test (see module docs).
 pub const DET_EPSILON: f32 = 1e-5;
-/// 1 + 2γ₃ with γₙ = nε / (1 - nε), ε = 2⁻²⁴.
-pub const BOX_EXIT_SCALE: f32 = 1.000_000_36;
+/// At least 1 + 2γ₃ (γₙ = nε / (1 - nε), ε = 2⁻²⁴, so 2γ₃ ≈ 3.58e-7),
+/// rounded up to the next float: 1 + 4 · 2⁻²³ = 1.00000048.
+pub const BOX_EXIT_SCALE: f32 = 1.0 + 4.0 * f32::EPSILON;
 
 #[inline]
 fn v3(a: [f32; 4]) -> Vec3 {
@@ -55,7 +56,9 @@ fn max_abs(v: Vec3) -> f32 {
 }
 
 /// Möller–Trumbore (1997), two-sided. Returns (t, u, v) for `0 < t < t_max`.
+/// The negated comparisons are deliberate: NaN fails every test (a miss).
 #[inline]
+#[allow(clippy::neg_cmp_op_on_partial_ord, clippy::manual_range_contains)]
 pub fn intersect_triangle(
     tri: &GpuTriangle,
     o: Vec3,
