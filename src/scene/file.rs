@@ -329,22 +329,23 @@ fn object(
     defined: usize,
 ) -> R<Object> {
     let shape = t.str("shape")?;
-    let extra: &[&str] =
-        match shape {
-            "sphere" => &["center", "radius", "segments"],
-            "plane" => &["center", "normal", "size", "tangent"],
-            "box" => &["min", "max"],
-            "torus" => &["center", "axis", "radii", "segments"],
-            "cylinder" => &["p0", "p1", "radius", "caps", "segments"],
-            "mesh" => &["path"],
-            "water" => return Err(t.err("shape", "shape `water` is not supported yet")),
-            other => return Err(t.err(
+    let extra: &[&str] = match shape {
+        "sphere" => &["center", "radius", "segments"],
+        "plane" => &["center", "normal", "size", "tangent"],
+        "box" => &["min", "max"],
+        "torus" => &["center", "axis", "radii", "segments"],
+        "cylinder" => &["p0", "p1", "radius", "caps", "segments"],
+        "mesh" => &["path"],
+        "water" => return Err(t.err("shape", "shape `water` is not supported yet")),
+        other => {
+            return Err(t.err(
                 "shape",
                 format!(
                     "unknown shape `{other}`; expected sphere, plane, box, torus, cylinder or mesh"
                 ),
-            )),
-        };
+            ))
+        }
+    };
     let allowed: Vec<&str> = COMMON_OBJECT_KEYS.iter().chain(extra).copied().collect();
     t.check_keys(&allowed, &format!("a {shape} object"))?;
 
