@@ -18,7 +18,16 @@ pub(crate) fn parse(text: &str, path: &Path) -> R<Scene> {
     let src = Source { path, text };
     let entries = node::parse_document(text).map_err(|e| {
         let span = e.span().unwrap_or(0..0);
-        src.err(&span, "syntax", e.message().trim_end().to_owned())
+        src.err(
+            &span,
+            "syntax",
+            e.message()
+                .trim()
+                .lines()
+                .map(str::trim)
+                .collect::<Vec<_>>()
+                .join("; "),
+        )
     })?;
     let root = Tbl::root(&src, &entries);
     root.check_keys(

@@ -84,7 +84,6 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
         single_index: false,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let (models, materials) = tobj::load_obj_buf(&mut reader, &options, |mtl: &Path| {
         let full = dir.join(mtl);
