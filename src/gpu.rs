@@ -3,8 +3,8 @@
 //! agree without padding rules; the const assertions below pin sizes and
 //! offsets, and the GLSL side mirrors the same field order.
 
-use crate::scene::{Density, Light, LightKind, Material, MaterialKind, Medium, Triangle};
 use crate::shader_bindings as b;
+use crate::scene::{Density, LightKind, Material, MaterialKind, Medium, Light, Triangle};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3, Vec4};
 use std::mem::{offset_of, size_of};
@@ -132,10 +132,7 @@ impl GpuMaterial {
             MaterialKind::Mirror => b::MATERIAL_MIRROR,
             MaterialKind::Dielectric => b::MATERIAL_DIELECTRIC,
         };
-        Self {
-            color: v4(m.color, f32::from_bits(kind)),
-            absorption_ior: v4(m.absorption, m.ior),
-        }
+        Self { color: v4(m.color, f32::from_bits(kind)), absorption_ior: v4(m.absorption, m.ior) }
     }
 }
 
@@ -152,9 +149,7 @@ impl GpuLight {
             LightKind::Directional => b::LIGHT_DIRECTIONAL,
         };
         let outer = l.cone_angle_deg.to_radians();
-        let inner = (l.cone_angle_deg - l.cone_falloff_deg)
-            .max(0.0)
-            .to_radians();
+        let inner = (l.cone_angle_deg - l.cone_falloff_deg).max(0.0).to_radians();
         let (cos_outer, cos_inner) = match l.kind {
             LightKind::Spot => (outer.cos(), inner.cos()),
             _ => (-1.0, -1.0),
@@ -163,12 +158,7 @@ impl GpuLight {
             position: v4(l.position, f32::from_bits(kind)),
             direction: v4(l.direction.normalize_or_zero(), cos_outer),
             intensity: v4(l.intensity, cos_inner),
-            power: [
-                crate::radiometry::light_power(l, scene_radius).dot(LUMINANCE),
-                0.0,
-                0.0,
-                0.0,
-            ],
+            power: [crate::radiometry::light_power(l, scene_radius).dot(LUMINANCE), 0.0, 0.0, 0.0],
         }
     }
 }
@@ -183,23 +173,10 @@ impl GpuMedium {
     pub fn new(m: &Medium) -> Self {
         let (kind, scale, noise, dims) = match &m.density {
             Density::Constant(d) => (b::DENSITY_CONSTANT, *d, Vec4::ZERO, [0; 4]),
-            Density::Noise {
-                scale,
-                frequency,
-                octaves,
-                offset,
-            } => (
-                b::DENSITY_NOISE,
-                *scale,
-                offset.extend(*frequency),
-                [0, 0, 0, *octaves],
-            ),
-            Density::Grid { dims, .. } => (
-                b::DENSITY_GRID,
-                1.0,
-                Vec4::ZERO,
-                [dims[0], dims[1], dims[2], 0],
-            ),
+            Density::Noise { scale, frequency, octaves, offset } => {
+                (b::DENSITY_NOISE, *scale, offset.extend(*frequency), [0, 0, 0, *octaves])
+            }
+            Density::Grid { dims, .. } => (b::DENSITY_GRID, 1.0, Vec4::ZERO, [dims[0], dims[1], dims[2], 0]),
         };
         Self {
             sigma_s: v4(m.sigma_s, m.g),

@@ -25,10 +25,7 @@ pub fn light_power(light: &Light, scene_radius: f32) -> Vec3 {
         LightKind::Point => light.intensity * 4.0 * PI,
         LightKind::Spot => {
             let cos_outer = light.cone_angle_deg.to_radians().cos();
-            let cos_inner = (light.cone_angle_deg - light.cone_falloff_deg)
-                .max(0.0)
-                .to_radians()
-                .cos();
+            let cos_inner = (light.cone_angle_deg - light.cone_falloff_deg).max(0.0).to_radians().cos();
             light.intensity * 2.0 * PI * ((1.0 - cos_inner) + 0.5 * (cos_inner - cos_outer))
         }
         LightKind::Directional => light.intensity * PI * scene_radius * scene_radius,
@@ -67,11 +64,7 @@ mod tests {
         let f0 = ((n - 1.0) / (n + 1.0)).powi(2);
         assert!((fresnel_dielectric(1.0, 1.0 / n) - f0).abs() < 1e-6);
         assert!((fresnel_dielectric(1.0, n) - f0).abs() < 1e-6);
-        assert_eq!(
-            fresnel_dielectric(0.1, 1.5),
-            1.0,
-            "total internal reflection"
-        );
+        assert_eq!(fresnel_dielectric(0.1, 1.5), 1.0, "total internal reflection");
     }
 
     #[test]

@@ -110,12 +110,7 @@ pub enum Density {
     Constant(f32),
     /// Procedural fractal value noise in [0, 1] scaled by `scale`:
     /// density(x) = scale * fbm(x * frequency + offset) (glsl/common/medium.glsl).
-    Noise {
-        scale: f32,
-        frequency: f32,
-        octaves: u32,
-        offset: Vec3,
-    },
+    Noise { scale: f32, frequency: f32, octaves: u32, offset: Vec3 },
     /// A grid of densities over the medium bounds, x fastest, trilinear.
     Grid { dims: [u32; 3], values: Vec<f32> },
 }
