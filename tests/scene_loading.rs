@@ -108,6 +108,13 @@ fn every_canonical_scene_loads() {
                 "{name}"
             );
             assert!((t.material as usize) < scene.materials.len(), "{name}");
+            // Counter-clockwise about the shading normals.
+            let n = (t.positions[1] - t.positions[0]).cross(t.positions[2] - t.positions[0]);
+            let avg = t.normals[0] + t.normals[1] + t.normals[2];
+            assert!(
+                n.dot(avg) > 0.0,
+                "{name}: triangle winds against its normals: {t:?}"
+            );
         }
         let (c, r) = scene.bounding_sphere(0.0);
         assert!(c.is_finite() && r > 0.0, "{name}");
@@ -156,7 +163,16 @@ fn canonical_scene_contents() {
     assert_eq!(glass.materials[m].kind, MaterialKind::Dielectric);
     assert_eq!(glass.materials[m].ior, 1.5);
 
+    assert!(
+        signed_volume(&glass.objects[0].mesh) > 0.0,
+        "goblet winds inward"
+    );
+
     let gem = Scene::load(&manifest("assets/scenes/gemstone.toml")).expect("gemstone");
+    assert!(
+        signed_volume(&gem.objects[0].mesh) > 0.0,
+        "gem winds inward"
+    );
     assert!(gem.is_animated());
     assert!(gem.objects[0].mesh.indices.len() >= 24);
 
@@ -176,6 +192,17 @@ fn canonical_scene_contents() {
         .materials
         .iter()
         .all(|m| m.kind == MaterialKind::Diffuse));
+}
+
+/// Signed volume enclosed by a mesh: positive when closed and wound outward.
+fn signed_volume(m: &Mesh) -> f32 {
+    m.indices
+        .iter()
+        .map(|t| {
+            let p = t.map(|i| m.positions[i as usize]);
+            p[0].dot(p[1].cross(p[2])) / 6.0
+        })
+        .sum()
 }
 
 // ---------------------------------------------------------------- rejections
