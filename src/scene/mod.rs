@@ -1,8 +1,172 @@
 //! Scenes: TOML files (docs/SCENES.md) parsed, validated and resolved into
 //! the model of `types.rs`, with procedural shapes and OBJ meshes triangulated.
+//!
+//! - `file.rs`: the schema and its validation (every error located `FILE:LINE:COL: FIELD`).
+//! - `node.rs`: the span-carrying TOML tree the schema reads from.
+//! - `shapes.rs`: procedural tessellation; `obj.rs`: OBJ/MTL through tobj.
+//! - this file: loading, animation and world-space queries.
 
+mod error;
+mod file;
+mod node;
+pub mod obj;
+pub mod shapes;
 mod types;
+
+pub use error::SceneError;
+pub use file::DEFAULT_FOV_Y_DEG;
 pub use types::*;
+
+use glam::{Mat3, Mat4, Quat, Vec3};
+use std::path::Path;
+
+/// The scene the CLI and demo open when none is given.
+pub const DEFAULT_SCENE: &str = "assets/scenes/ball_lens.toml";
+
+impl Scene {
+    /// Reads and validates a scene file. Relative paths inside it (OBJ meshes,
+    /// density grids) resolve against the file's folder.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_str(&text, path)
+    }
+
+    /// Parses scene text as if read from `source` (used in messages and to
+    /// resolve relative paths; the file itself need not exist).
+    pub fn from_str(text: &str, source: &Path) -> Result<Scene, SceneError> {
+        file::parse(text, source)
+    }
+
+    /// Index of the material called `name`.
+    pub fn material_index(&self, name: &str) -> Option<u32> {
+        self.materials
+            .iter()
+            .position(|m| m.name == name)
+            .map(|i| i as u32)
+    }
+
+    /// Total triangle count over all objects.
+    pub fn triangle_count(&self) -> usize {
+        self.objects.iter().map(|o| o.mesh.indices.len()).sum()
+    }
+
+    /// Whether any object moves with time.
+    pub fn is_animated(&self) -> bool {
+        self.objects
+            .iter()
+            .any(|o| o.animation.is_some_and(|a| a.is_moving()))
+    }
+
+    /// Local -> world transform of object `index` at `time` seconds:
+    ///
+    /// `T(offset(t)) * T(p) * R_spin(t) * T(-p) * transform`, where `transform` is the
+    /// static `T * Rz * Ry * Rx * S` from the file and `p` its translation. So the
+    /// object is scaled, rotated, spun about `spin_axis` through its own origin,
+    /// translated, and then moved by the animation offset (orbit + bob, see
+    /// [`Animation::offset`]). Without an `animate` table this is `transform`.
+    ///
+    /// Panics if `index` is not an object index.
+    pub fn object_transform(&self, index: usize, time: f32) -> Mat4 {
+        let o = &self.objects[index];
+        match &o.animation {
+            None => o.transform,
+            Some(a) => {
+                let p = o.transform.w_axis.truncate();
+                Mat4::from_translation(a.offset(time) + p)
+                    * Mat4::from_quat(a.spin(time))
+                    * Mat4::from_translation(-p)
+                    * o.transform
+            }
+        }
+    }
+
+    /// All triangles in world space at `time`: positions by the object
+    /// transform, normals by its inverse transpose (normalised). Winding is
+    /// kept counter-clockwise about the normal when a transform mirrors.
+    pub fn triangles(&self, time: f32) -> Vec<Triangle> {
+        let mut out = Vec::with_capacity(self.triangle_count());
+        for (oi, o) in self.objects.iter().enumerate() {
+            let m = self.object_transform(oi, time);
+            let n = Mat3::from_mat4(m).inverse().transpose();
+            let flip = m.determinant() < 0.0;
+            let positions: Vec<Vec3> = o
+                .mesh
+                .positions
+                .iter()
+                .map(|&p| m.transform_point3(p))
+                .collect();
+            let normals: Vec<Vec3> = o
+                .mesh
+                .normals
+                .iter()
+                .map(|&v| (n * v).normalize_or_zero())
+                .collect();
+            for (t, &material) in o.mesh.indices.iter().zip(&o.mesh.materials) {
+                let t = if flip { [t[0], t[2], t[1]] } else { *t };
+                out.push(Triangle {
+                    positions: t.map(|i| positions[i as usize]),
+                    normals: t.map(|i| normals[i as usize]),
+                    material,
+                    object: oi as u32,
+                });
+            }
+        }
+        out
+    }
+
+    /// Axis-aligned bounds `(min, max)` of every triangle at `time`
+    /// (both zero for a scene without geometry).
+    pub fn bounds(&self, time: f32) -> (Vec3, Vec3) {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for (oi, o) in self.objects.iter().enumerate() {
+            let m = self.object_transform(oi, time);
+            for &p in &o.mesh.positions {
+                let w = m.transform_point3(p);
+                lo = lo.min(w);
+                hi = hi.max(w);
+            }
+        }
+        if lo.x > hi.x {
+            (Vec3::ZERO, Vec3::ZERO)
+        } else {
+            (lo, hi)
+        }
+    }
+
+    /// Sphere around [`Scene::bounds`]: its centre, radius half the diagonal.
+    pub fn bounding_sphere(&self, time: f32) -> (Vec3, f32) {
+        let (lo, hi) = self.bounds(time);
+        ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
+    }
+}
+
+impl Animation {
+    /// Whether this animation changes anything with time.
+    pub fn is_moving(&self) -> bool {
+        self.spin_deg_per_s != 0.0
+            || (self.orbit_deg_per_s != 0.0 && self.orbit_radius != 0.0)
+            || (self.bob_amplitude != 0.0 && self.bob_hz != 0.0)
+    }
+
+    /// Rotation about `spin_axis` by `spin * time` degrees (right-handed).
+    pub fn spin(&self, time: f32) -> Quat {
+        Quat::from_axis_angle(self.spin_axis, (self.spin_deg_per_s * time).to_radians())
+    }
+
+    /// World-space translation added at `time`:
+    /// `orbit_center + orbit_radius * (cos a, 0, -sin a) + (0, bob_amplitude * sin(2 pi bob_hz time), 0)`
+    /// with `a = orbit_speed * time` (counter-clockwise seen from +y). The
+    /// object's own `translate` is relative to this point.
+    pub fn offset(&self, time: f32) -> Vec3 {
+        let (s, c) = (self.orbit_deg_per_s * time).to_radians().sin_cos();
+        let bob = self.bob_amplitude * (std::f32::consts::TAU * self.bob_hz * time).sin();
+        self.orbit_center + self.orbit_radius * Vec3::new(c, 0.0, -s) + Vec3::new(0.0, bob, 0.0)
+    }
+}
 
 impl Medium {
     /// The largest density anywhere in the medium: the majorant's multiplier for

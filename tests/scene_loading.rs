@@ -1,0 +1,1034 @@
+//! Scene loading: canonical scenes, every rejection path (message names the
+//! file, the line and the field), OBJ meshes from the wild, transforms and
+//! animation.
+
+use caustics::scene::*;
+use glam::Vec3;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+// ---------------------------------------------------------------- helpers
+
+/// A fresh, empty folder under the system temp dir.
+fn temp_dir(name: &str) -> PathBuf {
+    static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::SeqCst);
+    let dir =
+        std::env::temp_dir().join(format!("caustics-scene-{}-{name}-{n}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("create temp dir");
+    dir
+}
+
+fn write(path: &Path, contents: impl AsRef<[u8]>) {
+    if let Some(parent) = path.parent() {
+        std::fs::create_dir_all(parent).expect("create dir");
+    }
+    std::fs::write(path, contents).expect("write fixture");
+}
+
+const CAMERA: &str = "[camera]\neye = [0.0, 2.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n";
+const LIGHT: &str =
+    "[[light]]\nkind = \"point\"\nposition = [0.0, 5.0, 0.0]\nintensity = [10.0, 10.0, 10.0]\n";
+const MATERIAL: &str = "[[material]]\nname = \"white\"\nkind = \"diffuse\"\nalbedo = 0.5\n";
+const OBJECT: &str = "[[object]]\nshape = \"sphere\"\nradius = 1.0\nmaterial = \"white\"\n";
+
+/// A valid scene with `extra` appended.
+fn base(extra: &str) -> String {
+    format!("{CAMERA}\n{LIGHT}\n{MATERIAL}\n{OBJECT}\n{extra}")
+}
+
+/// A valid scene whose camera table body is `camera`.
+fn with_camera(camera: &str) -> String {
+    format!("[camera]\n{camera}\n\n{LIGHT}\n{MATERIAL}\n{OBJECT}")
+}
+
+/// 1-based line of the first line containing `needle`.
+fn line_of(text: &str, needle: &str) -> usize {
+    text.lines()
+        .position(|l| l.contains(needle))
+        .unwrap_or_else(|| panic!("`{needle}` not in text"))
+        + 1
+}
+
+/// Asserts `text` is rejected with `FILE:LINE:COL: FIELD: ...message...`, LINE the line holding `needle`.
+fn rejects(text: &str, field: &str, needle: &str, message: &str) -> String {
+    let file = Path::new("scenes/bad.toml");
+    let err = match Scene::from_str(text, file) {
+        Ok(_) => panic!("accepted a scene that should fail at {field}:\n{text}"),
+        Err(e) => e,
+    };
+    let s = err.to_string();
+    let line = line_of(text, needle);
+    let prefix = format!("{}:{line}:", file.display());
+    assert!(
+        s.starts_with(&prefix),
+        "expected prefix `{prefix}` in `{s}`"
+    );
+    assert!(
+        s.contains(&format!(": {field}: ")),
+        "expected field `{field}` in `{s}`"
+    );
+    assert!(s.contains(message), "expected `{message}` in `{s}`");
+    assert_eq!(err.field(), Some(field));
+    assert_eq!(err.line(), Some(line));
+    s
+}
+
+fn manifest(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
+}
+
+// ---------------------------------------------------------------- canonical scenes
+
+#[test]
+fn every_canonical_scene_loads() {
+    let names = [
+        "ball_lens",
+        "ring",
+        "gemstone",
+        "volume_cone",
+        "smoke",
+        "mesh_glass",
+        "diffuse_room",
+    ];
+    for name in names {
+        let path = manifest(&format!("assets/scenes/{name}.toml"));
+        let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(
+            !scene.lights.is_empty() && !scene.objects.is_empty(),
+            "{name}"
+        );
+        let tris = scene.triangles(0.0);
+        assert!(!tris.is_empty(), "{name}");
+        for t in &tris {
+            assert!(
+                t.positions.iter().chain(&t.normals).all(|v| v.is_finite()),
+                "{name}"
+            );
+            assert!((t.material as usize) < scene.materials.len(), "{name}");
+            // Counter-clockwise about the shading normals.
+            let n = (t.positions[1] - t.positions[0]).cross(t.positions[2] - t.positions[0]);
+            let avg = t.normals[0] + t.normals[1] + t.normals[2];
+            assert!(
+                n.dot(avg) > 0.0,
+                "{name}: triangle winds against its normals: {t:?}"
+            );
+        }
+        let (c, r) = scene.bounding_sphere(0.0);
+        assert!(c.is_finite() && r > 0.0, "{name}");
+    }
+    let found: Vec<String> = std::fs::read_dir(manifest("assets/scenes"))
+        .expect("assets/scenes")
+        .filter_map(|e| e.ok()?.path().file_stem()?.to_str().map(str::to_owned))
+        .collect();
+    for name in names {
+        assert!(found.iter().any(|f| f == name), "{name} missing");
+    }
+}
+
+#[test]
+fn default_scene_is_the_ball_lens() {
+    assert_eq!(DEFAULT_SCENE, "assets/scenes/ball_lens.toml");
+    let scene = Scene::load(&manifest(DEFAULT_SCENE)).expect("default scene");
+    let glass = scene.material_index("glass").expect("glass") as usize;
+    assert_eq!(scene.materials[glass].kind, MaterialKind::Dielectric);
+    assert_eq!(scene.materials[glass].ior, 1.5);
+    assert_eq!(scene.lights[0].kind, LightKind::Point);
+    assert!((scene.lights[0].position.y - 8.0).abs() < 0.5);
+    let (lo, hi) = scene.bounds(0.0);
+    assert!((lo - Vec3::new(-5.0, 0.0, -5.0)).length() < 1e-4, "{lo}");
+    assert!((hi - Vec3::new(5.0, 2.6, 5.0)).length() < 1e-4, "{hi}");
+}
+
+#[test]
+fn canonical_scene_contents() {
+    let ring = Scene::load(&manifest("assets/scenes/ring.toml")).expect("ring");
+    let r = &ring.objects[0].mesh;
+    // Open cylinder: every vertex on the side at radius 1, no cap centres.
+    assert!(r
+        .positions
+        .iter()
+        .all(|p| (Vec3::new(p.x, 0.0, p.z).length() - 1.0).abs() < 1e-4));
+    assert_eq!(
+        ring.materials[r.materials[0] as usize].kind,
+        MaterialKind::Mirror
+    );
+
+    let glass = Scene::load(&manifest("assets/scenes/mesh_glass.toml")).expect("mesh_glass");
+    let m = glass
+        .material_index("glass.obj:glass")
+        .expect("MTL material") as usize;
+    assert_eq!(glass.materials[m].kind, MaterialKind::Dielectric);
+    assert_eq!(glass.materials[m].ior, 1.5);
+
+    assert!(
+        signed_volume(&glass.objects[0].mesh) > 0.0,
+        "goblet winds inward"
+    );
+
+    let gem = Scene::load(&manifest("assets/scenes/gemstone.toml")).expect("gemstone");
+    assert!(
+        signed_volume(&gem.objects[0].mesh) > 0.0,
+        "gem winds inward"
+    );
+    assert!(gem.is_animated());
+    assert!(gem.objects[0].mesh.indices.len() >= 24);
+
+    let smoke = Scene::load(&manifest("assets/scenes/smoke.toml")).expect("smoke");
+    assert!(matches!(
+        smoke.medium.as_ref().map(|m| &m.density),
+        Some(Density::Noise { octaves: 4, .. })
+    ));
+    let cone = Scene::load(&manifest("assets/scenes/volume_cone.toml")).expect("volume_cone");
+    assert_eq!(
+        cone.medium.as_ref().map(|m| m.density.clone()),
+        Some(Density::Constant(1.0))
+    );
+
+    let room = Scene::load(&manifest("assets/scenes/diffuse_room.toml")).expect("diffuse_room");
+    assert!(room
+        .materials
+        .iter()
+        .all(|m| m.kind == MaterialKind::Diffuse));
+}
+
+/// Signed volume enclosed by a mesh: positive when closed and wound outward.
+fn signed_volume(m: &Mesh) -> f32 {
+    m.indices
+        .iter()
+        .map(|t| {
+            let p = t.map(|i| m.positions[i as usize]);
+            p[0].dot(p[1].cross(p[2])) / 6.0
+        })
+        .sum()
+}
+
+// ---------------------------------------------------------------- rejections
+
+#[test]
+fn missing_scene_file_names_the_path() {
+    let path = temp_dir("missing").join("nope.toml");
+    let e = Scene::load(&path).expect_err("missing file");
+    let s = e.to_string();
+    assert!(
+        s.contains(&path.display().to_string()) && s.contains("cannot read scene file"),
+        "{s}"
+    );
+}
+
+#[test]
+fn syntax_errors_carry_line_and_column() {
+    let text = base("[output]\nexposure = = 2\n");
+    rejects(&text, "syntax", "exposure = = 2", "");
+    let text = base("[[material]]\nname = \"x\"\nname = \"y\"\nkind = \"diffuse\"\n");
+    rejects(&text, "syntax", "name = \"y\"", "duplicate key");
+}
+
+#[test]
+fn unknown_keys_are_rejected() {
+    rejects(
+        &base("[[object]]\nshape = \"sphere\"\nradius = 1.0\nraduis = 2.0\nmaterial = \"white\"\n"),
+        "object[1].raduis",
+        "raduis",
+        "unknown field",
+    );
+    rejects(
+        &base("[outptu]\nexposure = 1.0\n"),
+        "outptu",
+        "[outptu]",
+        "unknown field",
+    );
+    rejects(
+        &with_camera("eye = [0.0, 2.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nfov = 40.0"),
+        "camera.fov",
+        "fov = 40",
+        "unknown field",
+    );
+    // A field of another light kind.
+    rejects(&base("[[light]]\nkind = \"point\"\nposition = [0.0, 1.0, 0.0]\nintensity = 1.0\ncone_angle = 10.0\n"), "light[1].cone_angle", "cone_angle", "unknown field");
+    rejects(&base("[medium]\nsigma_s = 0.1\nbounds = { min = [0.0, 0.0, 0.0], max = [1.0, 1.0, 1.0], mx = 1 }\n"), "medium.bounds.mx", "bounds =", "unknown field");
+}
+
+#[test]
+fn wrong_types_are_rejected() {
+    rejects(
+        &base("[[object]]\nshape = \"sphere\"\nradius = \"one\"\nmaterial = \"white\"\n"),
+        "object[1].radius",
+        "radius = \"one\"",
+        "expected a number, got a string",
+    );
+    rejects(
+        &with_camera("eye = [0.0, 2.0]\ntarget = [0.0, 0.0, 0.0]"),
+        "camera.eye",
+        "eye = [0.0, 2.0]",
+        "3 numbers",
+    );
+    rejects(
+        &with_camera("eye = [0.0, true, 5.0]\ntarget = [0.0, 0.0, 0.0]"),
+        "camera.eye[1]",
+        "eye = [0.0, true",
+        "boolean",
+    );
+    rejects(
+        &base(
+            "[[object]]\nshape = \"sphere\"\nradius = 1.0\nsegments = 12.5\nmaterial = \"white\"\n",
+        ),
+        "object[1].segments",
+        "segments",
+        "integer",
+    );
+    rejects(
+        &base("[camera2]\n"),
+        "camera2",
+        "[camera2]",
+        "unknown field",
+    );
+    let text = format!("{CAMERA}\n[light]\nkind = \"point\"\n\n{MATERIAL}\n{OBJECT}");
+    rejects(&text, "light", "[light]", "array of tables");
+}
+
+#[test]
+fn missing_required_fields_are_rejected() {
+    rejects(
+        &base("[[object]] # two\nshape = \"sphere\"\nmaterial = \"white\"\n"),
+        "object[1].radius",
+        "# two",
+        "missing required field",
+    );
+    rejects(
+        &with_camera("eye = [0.0, 2.0, 5.0]"),
+        "camera.target",
+        "[camera]",
+        "missing required field",
+    );
+    let no_camera = format!("{LIGHT}\n{MATERIAL}\n{OBJECT}");
+    rejects(
+        &no_camera,
+        "camera",
+        "[[light]]",
+        "missing required table [camera]",
+    );
+    let no_light = format!("{CAMERA}\n{MATERIAL}\n{OBJECT}");
+    rejects(&no_light, "light", "[camera]", "at least one [[light]]");
+    let no_object = format!("{CAMERA}\n{LIGHT}\n{MATERIAL}");
+    rejects(&no_object, "object", "[camera]", "at least one [[object]]");
+    rejects(
+        &base("[[object]] # nomat\nshape = \"sphere\"\nradius = 1.0\n"),
+        "object[1].material",
+        "# nomat",
+        "missing required field",
+    );
+}
+
+#[test]
+fn missing_required_field_points_at_its_table() {
+    // The object table's header is the located line.
+    let text =
+        base("[[object]] # second\nshape = \"box\"\nmin = [0.0, 0.0, 0.0]\nmaterial = \"white\"\n");
+    rejects(&text, "object[1].max", "# second", "missing required field");
+}
+
+#[test]
+fn material_references_and_names() {
+    rejects(
+        &base("[[object]]\nshape = \"sphere\"\nradius = 1.0\nmaterial = \"gold\"\n"),
+        "object[1].material",
+        "\"gold\"",
+        "unknown material `gold`; defined: white",
+    );
+    rejects(
+        &base("[[material]]\nname = \"white\" # again\nkind = \"mirror\"\n"),
+        "material[1].name",
+        "# again",
+        "duplicate material name `white`",
+    );
+    rejects(
+        &base("[[material]]\nname = \"x\"\nkind = \"metal\"\n"),
+        "material[1].kind",
+        "\"metal\"",
+        "unknown material kind",
+    );
+}
+
+#[test]
+fn non_finite_numbers_are_rejected() {
+    rejects(
+        &base("[[object]]\nshape = \"sphere\"\nradius = nan\nmaterial = \"white\"\n"),
+        "object[1].radius",
+        "nan",
+        "finite",
+    );
+    rejects(&base("[[object]]\nshape = \"sphere\"\ncenter = [0.0, inf, 0.0]\nradius = 1.0\nmaterial = \"white\"\n"), "object[1].center[1]", "inf", "finite");
+    rejects(
+        &base("[output]\nexposure = -inf\n"),
+        "output.exposure",
+        "-inf",
+        "finite",
+    );
+    rejects(
+        &base("[output]\nexposure = 1e300\n"),
+        "output.exposure",
+        "1e300",
+        "finite",
+    );
+}
+
+#[test]
+fn sizes_must_be_positive() {
+    let s = rejects(
+        &base("[[object]]\nshape = \"sphere\"\nradius = -1\nmaterial = \"white\"\n"),
+        "object[1].radius",
+        "radius = -1",
+        "must be positive, got -1",
+    );
+    assert!(
+        s.contains("bad.toml:") && s.contains(":10: object[1].radius"),
+        "column of the value: {s}"
+    );
+    rejects(
+        &base("[[object]]\nshape = \"sphere\"\nradius = 0\nmaterial = \"white\"\n"),
+        "object[1].radius",
+        "radius = 0",
+        "must be positive",
+    );
+    rejects(
+        &base("[[object]]\nshape = \"plane\"\nsize = [1.0, 0.0]\nmaterial = \"white\"\n"),
+        "object[1].size[1]",
+        "size =",
+        "must be positive",
+    );
+    rejects(&base("[[object]]\nshape = \"cylinder\"\np0 = [0.0, 0.0, 0.0]\np1 = [0.0, 1.0, 0.0]\nradius = -0.5\nmaterial = \"white\"\n"), "object[1].radius", "radius = -0.5", "must be positive");
+    rejects(
+        &base("[[object]]\nshape = \"torus\"\nradii = [1.0, 2.0]\nmaterial = \"white\"\n"),
+        "object[1].radii",
+        "radii",
+        "minor radius",
+    );
+    rejects(&base("[[object]]\nshape = \"sphere\"\nradius = 1.0\nscale = [1.0, 0.0, 1.0]\nmaterial = \"white\"\n"), "object[1].scale", "scale", "zero");
+    rejects(
+        &base("[[object]]\nshape = \"sphere\"\nradius = 1.0\nsegments = 2\nmaterial = \"white\"\n"),
+        "object[1].segments",
+        "segments",
+        "within",
+    );
+}
+
+#[test]
+fn degenerate_boxes_and_cylinders_are_rejected() {
+    rejects(&base("[[object]]\nshape = \"box\"\nmin = [0.0, 0.0, 0.0]\nmax = [1.0, 0.0, 1.0]\nmaterial = \"white\"\n"), "object[1].max", "max = [1.0, 0.0", "must exceed min");
+    rejects(&base("[[object]]\nshape = \"cylinder\"\np0 = [0.0, 1.0, 0.0]\np1 = [0.0, 1.0, 0.0]\nradius = 1.0\nmaterial = \"white\"\n"), "object[1].p1", "p1 =", "must differ from p0");
+    rejects(
+        &base(
+            "[medium]\nsigma_s = 0.1\nbounds = { min = [0.0, 0.0, 0.0], max = [1.0, -1.0, 1.0] }\n",
+        ),
+        "medium.bounds.max",
+        "bounds =",
+        "must exceed min",
+    );
+}
+
+#[test]
+fn material_values_are_checked() {
+    rejects(
+        &base("[[material]]\nname = \"g\"\nkind = \"dielectric\"\nior = 0.9\n"),
+        "material[1].ior",
+        "ior = 0.9",
+        "at least 1",
+    );
+    rejects(
+        &base("[[material]]\nname = \"d\"\nkind = \"diffuse\"\nalbedo = [0.5, 1.2, 0.5]\n"),
+        "material[1].albedo",
+        "albedo = [0.5, 1.2",
+        "within [0, 1]",
+    );
+    rejects(
+        &base("[[material]]\nname = \"m\"\nkind = \"mirror\"\nreflectance = -0.1\n"),
+        "material[1].reflectance",
+        "reflectance",
+        "negative",
+    );
+    rejects(
+        &base("[[material]]\nname = \"g\"\nkind = \"dielectric\"\nabsorption = [0.0, -1.0, 0.0]\n"),
+        "material[1].absorption",
+        "absorption",
+        "negative",
+    );
+}
+
+#[test]
+fn medium_values_are_checked() {
+    let bounds = "bounds = { min = [0.0, 0.0, 0.0], max = [1.0, 1.0, 1.0] }\n";
+    rejects(
+        &base(&format!("[medium]\nsigma_s = [0.1, -0.1, 0.1]\n{bounds}")),
+        "medium.sigma_s",
+        "sigma_s",
+        "negative",
+    );
+    rejects(
+        &base(&format!("[medium]\nsigma_s = 0.1\nsigma_a = -1\n{bounds}")),
+        "medium.sigma_a",
+        "sigma_a",
+        "negative",
+    );
+    rejects(
+        &base(&format!("[medium]\nsigma_s = 0.1\ng = 1.0\n{bounds}")),
+        "medium.g",
+        "g = 1.0",
+        "(-1, 1)",
+    );
+    rejects(
+        &base(&format!("[medium]\nsigma_s = 0.1\ng = -1.5\n{bounds}")),
+        "medium.g",
+        "g = -1.5",
+        "(-1, 1)",
+    );
+    rejects(
+        &base("[medium]\nsigma_s = 0.1\n"),
+        "medium.bounds",
+        "[medium]",
+        "missing required field",
+    );
+    rejects(
+        &base(&format!(
+            "[medium]\nsigma_s = 0.1\n{bounds}density = -2.0\n"
+        )),
+        "medium.density",
+        "density",
+        "negative",
+    );
+    rejects(
+        &base(&format!(
+            "[medium]\nsigma_s = 0.1\n{bounds}density = {{ noise = {{ octaves = 0 }} }}\n"
+        )),
+        "medium.density.noise.octaves",
+        "density",
+        "[1, 16]",
+    );
+    rejects(
+        &base(&format!(
+            "[medium]\nsigma_s = 0.1\n{bounds}density = {{ fog = 1 }}\n"
+        )),
+        "medium.density.fog",
+        "density",
+        "unknown field",
+    );
+}
+
+#[test]
+fn zero_directions_are_rejected() {
+    rejects(
+        &base("[[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, 0.0]\nirradiance = 1.0\n"),
+        "light[1].direction",
+        "direction = [0.0, 0.0, 0.0]",
+        "non-zero",
+    );
+    rejects(&base("[[object]]\nshape = \"plane\"\nnormal = [0, 0, 0]\nsize = [1.0, 1.0]\nmaterial = \"white\"\n"), "object[1].normal", "normal", "non-zero");
+    rejects(&base("[[object]]\nshape = \"torus\"\naxis = [0.0, 0.0, 0.0]\nradii = [1.0, 0.2]\nmaterial = \"white\"\n"), "object[1].axis", "axis", "non-zero");
+    rejects(&base("[[object]]\nshape = \"plane\"\nnormal = [0, 1, 0]\ntangent = [0, 2, 0]\nsize = [1.0, 1.0]\nmaterial = \"white\"\n"), "object[1].tangent", "tangent", "parallel");
+    rejects(&base("[[object]]\nshape = \"sphere\"\nradius = 1.0\nmaterial = \"white\"\nanimate = { spin = 1.0, spin_axis = [0.0, 0.0, 0.0] }\n"), "object[1].animate.spin_axis", "animate", "non-zero");
+}
+
+#[test]
+fn camera_is_validated() {
+    rejects(
+        &with_camera("eye = [1.0, 1.0, 1.0]\ntarget = [1.0, 1.0, 1.0]"),
+        "camera.target",
+        "target",
+        "must differ",
+    );
+    rejects(
+        &with_camera("eye = [0.0, 5.0, 0.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]"),
+        "camera.up",
+        "up =",
+        "parallel",
+    );
+    rejects(
+        &with_camera("eye = [0.0, 5.0, 1.0]\ntarget = [0.0, 0.0, 0.0]\nfov_y = 180.0"),
+        "camera.fov_y",
+        "fov_y",
+        "(0, 180)",
+    );
+    rejects(
+        &with_camera("eye = [0.0, 5.0, 1.0]\ntarget = [0.0, 0.0, 0.0]\nfov_y = 0"),
+        "camera.fov_y",
+        "fov_y",
+        "(0, 180)",
+    );
+}
+
+#[test]
+fn lights_are_validated() {
+    let spot = |angle: &str, falloff: &str| {
+        base(&format!("[[light]]\nkind = \"spot\"\nposition = [0.0, 4.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\nintensity = 5.0\ncone_angle = {angle}\ncone_falloff = {falloff}\n"))
+    };
+    rejects(
+        &spot("20.0", "25.0"),
+        "light[1].cone_falloff",
+        "cone_falloff",
+        "must not exceed cone_angle",
+    );
+    rejects(
+        &spot("0.0", "0.0"),
+        "light[1].cone_angle",
+        "cone_angle",
+        "(0, 90]",
+    );
+    rejects(
+        &base("[[light]]\nkind = \"area\"\n"),
+        "light[1].kind",
+        "\"area\"",
+        "unknown light kind",
+    );
+    rejects(&base("[[light]]\nkind = \"point\"\nposition = [0.0, 1.0, 0.0]\nintensity = [1.0, -1.0, 1.0]\n"), "light[1].intensity", "[1.0, -1.0", "negative");
+    let ok = Scene::from_str(&spot("20.0", "5.0"), Path::new("ok.toml")).expect("valid spot");
+    let l = ok.lights[1];
+    assert_eq!(
+        (l.kind, l.cone_angle_deg, l.cone_falloff_deg),
+        (LightKind::Spot, 20.0, 5.0)
+    );
+    assert_eq!(l.direction, Vec3::NEG_Y);
+}
+
+#[test]
+fn at_most_eight_lights() {
+    let max = caustics::shader_bindings::MAX_LIGHTS as usize;
+    let lights: String = (0..max)
+        .map(|i| LIGHT.replace("5.0, 0.0]", &format!("5.0, {i}.0]")))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let ok = format!("{CAMERA}\n{lights}\n{MATERIAL}\n{OBJECT}");
+    assert_eq!(
+        Scene::from_str(&ok, Path::new("ok.toml"))
+            .expect("8 lights")
+            .lights
+            .len(),
+        max
+    );
+    let too_many = format!("{CAMERA}\n{lights}\n[[light]] # ninth\nkind = \"point\"\nposition = [0.0, 1.0, 0.0]\nintensity = 1.0\n\n{MATERIAL}\n{OBJECT}");
+    rejects(
+        &too_many,
+        &format!("light[{max}]"),
+        "# ninth",
+        "too many lights",
+    );
+}
+
+#[test]
+fn water_is_not_supported_yet() {
+    rejects(
+        &base("[[object]]\nshape = \"water\"\nmaterial = \"white\"\n"),
+        "object[1].shape",
+        "\"water\"",
+        "not supported yet",
+    );
+    rejects(
+        &base("[[object]]\nshape = \"cone\"\nmaterial = \"white\"\n"),
+        "object[1].shape",
+        "\"cone\"",
+        "unknown shape",
+    );
+}
+
+#[test]
+fn density_grids_load_and_wrong_sizes_are_rejected() {
+    let dir = temp_dir("grid");
+    let values: Vec<u8> = (0..2 * 3 * 4)
+        .flat_map(|i| (i as f32 * 0.5).to_le_bytes())
+        .collect();
+    write(&dir.join("vol/d.raw"), &values);
+    let scene = |dims: &str| {
+        base(&format!("[medium]\nsigma_s = 0.1\nbounds = {{ min = [0.0, 0.0, 0.0], max = [1.0, 1.0, 1.0] }}\ndensity = {{ grid = \"vol/d.raw\", dims = {dims} }}\n"))
+    };
+    let path = dir.join("s.toml");
+    write(&path, scene("[2, 3, 4]"));
+    let s = Scene::load(&path).expect("grid scene");
+    let m = s.medium.expect("medium");
+    assert_eq!(m.max_density(), 11.5);
+    assert!(matches!(&m.density, Density::Grid { dims: [2, 3, 4], values } if values[3] == 1.5));
+
+    let text = scene("[2, 3, 5]");
+    write(&path, &text);
+    let e = Scene::load(&path).expect_err("wrong size").to_string();
+    let line = line_of(&text, "density =");
+    assert!(e.starts_with(&format!("{}:{line}:", path.display())), "{e}");
+    assert!(
+        e.contains("medium.density.grid") && e.contains("96 bytes") && e.contains("need 120"),
+        "{e}"
+    );
+
+    let text = scene("[2, 3, 4]").replace("vol/d.raw", "vol/missing.raw");
+    write(&path, &text);
+    let e = Scene::load(&path).expect_err("missing grid").to_string();
+    assert!(
+        e.contains("medium.density.grid") && e.contains("missing.raw"),
+        "{e}"
+    );
+}
+
+// ---------------------------------------------------------------- OBJ meshes
+
+/// Writes `obj` (and `files`) next to a scene whose only extra object is the mesh
+/// with `object_fields`; returns the scene path.
+fn mesh_scene(name: &str, obj: &str, object_fields: &str, files: &[(&str, &str)]) -> PathBuf {
+    let dir = temp_dir(name);
+    write(&dir.join("m.obj"), obj);
+    for (f, text) in files {
+        write(&dir.join(f), text);
+    }
+    let path = dir.join("scene.toml");
+    write(
+        &path,
+        base(&format!(
+            "[[object]]\nshape = \"mesh\"\npath = \"m.obj\"\n{object_fields}\n"
+        )),
+    );
+    path
+}
+
+fn mesh_of(scene: &Scene) -> &Mesh {
+    &scene.objects[1].mesh
+}
+
+#[test]
+fn obj_without_normals_gets_smooth_area_weighted_normals() {
+    // A tent: two triangles of different areas sharing the edge 1-2.
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 0 -1\nv 3 3 -3\nf 1 2 3\nf 2 4 3\n";
+    let s = Scene::load(&mesh_scene("nonormals", obj, "material = \"white\"", &[])).expect("loads");
+    let m = mesh_of(&s);
+    assert_eq!(m.indices.len(), 2);
+    let p = &m.positions;
+    let face = |t: [u32; 3]| {
+        (p[t[1] as usize] - p[t[0] as usize]).cross(p[t[2] as usize] - p[t[0] as usize])
+    };
+    let (a, b) = (face(m.indices[0]), face(m.indices[1]));
+    // Vertex 0 belongs to the first face only; the shared vertices average by area.
+    let shared = m.indices[0][1] as usize;
+    assert!((m.normals[m.indices[0][0] as usize] - a.normalize()).length() < 1e-5);
+    assert!((m.normals[shared] - (a + b).normalize()).length() < 1e-5);
+    assert!(m.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-5));
+}
+
+#[test]
+fn obj_normals_are_used_when_present() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 2\nvn 0 0.6 0.8\nf 1//1 2//1 3//2\n";
+    let s = Scene::load(&mesh_scene("normals", obj, "material = \"white\"", &[])).expect("loads");
+    let m = mesh_of(&s);
+    let n: Vec<Vec3> = m.indices[0]
+        .iter()
+        .map(|&i| m.normals[i as usize])
+        .collect();
+    assert_eq!(n[0], Vec3::Z);
+    assert!((n[2] - Vec3::new(0.0, 0.6, 0.8)).length() < 1e-6);
+}
+
+#[test]
+fn obj_quads_ngons_and_negative_indices() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n\
+               v 0 0 1\nv 1 0 1\nv 1.5 0.5 1\nv 1 1 1\nv 0 1 1\nf -5 -4 -3 -2 -1\n\
+               v 0 0 2\nv 1 0 2\nv 0 1 2\nf -3 -2 -1\n";
+    let s = Scene::load(&mesh_scene("ngons", obj, "material = \"white\"", &[])).expect("loads");
+    let m = mesh_of(&s);
+    assert_eq!(m.indices.len(), 2 + 3 + 1);
+    // Everything faces +z and lies where the file put it.
+    for t in &m.indices {
+        let p = t.map(|i| m.positions[i as usize]);
+        assert!((p[1] - p[0]).cross(p[2] - p[0]).z > 0.0);
+    }
+    let last = m.indices[5].map(|i| m.positions[i as usize]);
+    assert_eq!(
+        last,
+        [
+            Vec3::new(0.0, 0.0, 2.0),
+            Vec3::new(1.0, 0.0, 2.0),
+            Vec3::new(0.0, 1.0, 2.0)
+        ]
+    );
+}
+
+#[test]
+fn obj_open_surface_loads() {
+    // A box without its top: unclosed, loads as-is.
+    let obj = "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nv 0 1 0\nv 1 1 0\nv 1 1 1\nv 0 1 1\n\
+               f 1 2 3 4\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n";
+    let s = Scene::load(&mesh_scene("open", obj, "material = \"white\"", &[])).expect("loads");
+    assert_eq!(mesh_of(&s).indices.len(), 10);
+}
+
+#[test]
+fn obj_without_mtl_needs_a_material() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let path = mesh_scene("nomtl", obj, "", &[]);
+    let e = Scene::load(&path).expect_err("no material").to_string();
+    assert!(
+        e.contains("object[1].material") && e.contains("m.obj"),
+        "{e}"
+    );
+    let path = mesh_scene("nomtl-ok", obj, "material = \"white\"", &[]);
+    let s = Scene::load(&path).expect("material applies");
+    assert_eq!(
+        mesh_of(&s).materials,
+        vec![s.material_index("white").expect("white")]
+    );
+}
+
+const MTL: &str = "newmtl clear\nNi 1.45\nd 0.2\nillum 2\n\
+                   newmtl chrome\nKs 0.9 0.8 0.7\nillum 3\n\
+                   newmtl paint\nKd 0.2 0.3 0.4\nillum 2\n\
+                   newmtl crystal\nNi 1.7\nillum 7\n";
+const MTL_OBJ: &str = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n\
+                       usemtl clear\nf 1 2 3\nusemtl chrome\nf 2 4 3\nusemtl paint\nf 1 3 4\nusemtl crystal\nf 1 4 2\n";
+
+#[test]
+fn mtl_materials_become_scene_materials() {
+    let s = Scene::load(&mesh_scene("mtl", MTL_OBJ, "", &[("m.mtl", MTL)])).expect("loads");
+    let m = mesh_of(&s);
+    let mat = |i: usize| &s.materials[m.materials[i] as usize];
+    assert_eq!(
+        (mat(0).name.as_str(), mat(0).kind, mat(0).ior),
+        ("m.obj:clear", MaterialKind::Dielectric, 1.45)
+    );
+    assert_eq!(
+        (mat(1).name.as_str(), mat(1).kind),
+        ("m.obj:chrome", MaterialKind::Mirror)
+    );
+    assert_eq!(mat(1).color, Vec3::new(0.9, 0.8, 0.7));
+    assert_eq!(
+        (mat(2).kind, mat(2).color),
+        (MaterialKind::Diffuse, Vec3::new(0.2, 0.3, 0.4))
+    );
+    assert_eq!((mat(3).kind, mat(3).ior), (MaterialKind::Dielectric, 1.7));
+    // The object's material overrides the MTL.
+    let s = Scene::load(&mesh_scene(
+        "mtl-override",
+        MTL_OBJ,
+        "material = \"white\"",
+        &[("m.mtl", MTL)],
+    ))
+    .expect("loads");
+    assert!(mesh_of(&s)
+        .materials
+        .iter()
+        .all(|&i| s.materials[i as usize].name == "white"));
+    assert_eq!(s.materials.len(), 1);
+}
+
+#[test]
+fn same_obj_twice_shares_its_materials() {
+    let dir = temp_dir("twice");
+    write(&dir.join("m.obj"), MTL_OBJ);
+    write(&dir.join("m.mtl"), MTL);
+    let path = dir.join("s.toml");
+    write(&path, base("[[object]]\nshape = \"mesh\"\npath = \"m.obj\"\n\n[[object]]\nshape = \"mesh\"\npath = \"m.obj\"\ntranslate = [2.0, 0.0, 0.0]\n"));
+    let s = Scene::load(&path).expect("loads");
+    assert_eq!(s.materials.len(), 1 + 4);
+    assert_eq!(s.objects[1].mesh.materials, s.objects[2].mesh.materials);
+}
+
+#[test]
+fn missing_mtl_is_an_error_unless_material_is_set() {
+    let path = mesh_scene("missing-mtl", MTL_OBJ, "", &[]);
+    let e = Scene::load(&path).expect_err("missing mtl").to_string();
+    assert!(
+        e.contains("object[1].path") && e.contains("m.mtl") && e.contains("MTL"),
+        "{e}"
+    );
+    let text = std::fs::read_to_string(&path).expect("scene");
+    assert!(
+        e.contains(&format!(":{}:", line_of(&text, "path = \"m.obj\""))),
+        "{e}"
+    );
+    let path = mesh_scene("missing-mtl-ok", MTL_OBJ, "material = \"white\"", &[]);
+    Scene::load(&path).expect("falls back to the object's material");
+}
+
+#[test]
+fn missing_broken_and_empty_objs_are_rejected() {
+    let dir = temp_dir("broken");
+    let path = dir.join("s.toml");
+    let text =
+        base("[[object]]\nshape = \"mesh\"\npath = \"nowhere/gone.obj\"\nmaterial = \"white\"\n");
+    write(&path, &text);
+    let e = Scene::load(&path).expect_err("missing obj").to_string();
+    let line = line_of(&text, "gone.obj");
+    assert!(e.starts_with(&format!("{}:{line}:", path.display())), "{e}");
+    assert!(
+        e.contains("object[1].path") && e.contains("gone.obj"),
+        "{e}"
+    );
+
+    for (name, obj, why) in [
+        (
+            "oob",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
+            "out of bounds",
+        ),
+        ("zero", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "m.obj"),
+        ("garbage", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", "m.obj"),
+        ("badpos", "v 0 zero 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "m.obj"),
+        (
+            "nanpos",
+            "v 0 nan 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+            "not finite",
+        ),
+        ("empty", "# nothing here\nv 0 0 0\nv 1 0 0\n", "no faces"),
+        ("lines-only", "v 0 0 0\nv 1 0 0\nl 1 2\n", "no faces"),
+    ] {
+        let e = Scene::load(&mesh_scene(name, obj, "material = \"white\"", &[]))
+            .expect_err(name)
+            .to_string();
+        assert!(
+            e.contains("object[1].path") && e.contains("m.obj") && e.contains(why),
+            "{name}: {e}"
+        );
+    }
+}
+
+#[test]
+fn obj_path_is_relative_to_the_scene_file() {
+    let dir = temp_dir("relative");
+    write(
+        &dir.join("meshes/tri.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    );
+    let path = dir.join("scenes/deep/s.toml");
+    write(
+        &path,
+        base(
+            "[[object]]\nshape = \"mesh\"\npath = \"../../meshes/tri.obj\"\nmaterial = \"white\"\n",
+        ),
+    );
+    let s = Scene::load(&path).expect("relative to the scene file, not the cwd");
+    assert_eq!(mesh_of(&s).indices.len(), 1);
+}
+
+#[test]
+fn large_obj_loads_quickly() {
+    // 317 x 317 quads = 200,978 triangles, no normals.
+    let n = 317;
+    let mut obj = String::with_capacity(12_000_000);
+    for j in 0..=n {
+        for i in 0..=n {
+            obj.push_str(&format!(
+                "v {} {} {}\n",
+                i as f32 * 0.01,
+                ((i * j) % 7) as f32 * 0.001,
+                j as f32 * -0.01
+            ));
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let a = j * (n + 1) + i + 1;
+            obj.push_str(&format!("f {} {} {} {}\n", a, a + 1, a + n + 2, a + n + 1));
+        }
+    }
+    let path = mesh_scene("large", &obj, "material = \"white\"", &[]);
+    let start = Instant::now();
+    let s = Scene::load(&path).expect("large mesh");
+    let load = start.elapsed();
+    let tris = s.triangles(0.0);
+    let total = start.elapsed();
+    assert_eq!(mesh_of(&s).indices.len(), 2 * n * n);
+    assert!(tris.len() > 200_000);
+    eprintln!("200k-triangle OBJ: load {load:?}, load + triangles {total:?}");
+    assert!(total.as_secs_f32() < 4.0, "took {total:?}");
+}
+
+// ---------------------------------------------------------------- transforms and animation
+
+#[test]
+fn translated_sphere_bounds_move() {
+    let s = Scene::from_str(
+        &with_camera("eye = [0.0, 2.0, 5.0]\ntarget = [0.0, 0.0, 0.0]").replace(
+            "radius = 1.0\n",
+            "radius = 1.0\ntranslate = [3.0, -1.0, 2.0]\n",
+        ),
+        Path::new("t.toml"),
+    )
+    .expect("loads");
+    let (lo, hi) = s.bounds(0.0);
+    assert!((lo - Vec3::new(2.0, -2.0, 1.0)).length() < 1e-5, "{lo}");
+    assert!((hi - Vec3::new(4.0, 0.0, 3.0)).length() < 1e-5, "{hi}");
+    let (c, r) = s.bounding_sphere(0.0);
+    assert!((c - Vec3::new(3.0, -1.0, 2.0)).length() < 1e-5);
+    assert!((r - 3f32.sqrt()).abs() < 1e-5);
+    assert!(!s.is_animated());
+}
+
+#[test]
+fn rotate_scale_and_mirroring_transforms() {
+    let text = base("[[object]]\nshape = \"box\"\nmin = [0.0, 0.0, 0.0]\nmax = [1.0, 2.0, 3.0]\nrotate = [90.0, 0.0, 0.0]\nscale = 2\nmaterial = \"white\"\n\n\
+                     [[object]]\nshape = \"box\"\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, 1.0]\nscale = [-1.0, 1.0, 1.0]\ntranslate = [10.0, 0.0, 0.0]\nmaterial = \"white\"\n");
+    let s = Scene::from_str(&text, Path::new("t.toml")).expect("loads");
+    // Scale 2 then +90 degrees about X: y -> z, z -> -y.
+    let m = s.object_transform(1, 0.0);
+    assert!(
+        (m.transform_point3(Vec3::new(1.0, 2.0, 3.0)) - Vec3::new(2.0, -6.0, 4.0)).length() < 1e-5
+    );
+    let tris = s.triangles(0.0);
+    for t in tris.iter().filter(|t| t.object >= 1) {
+        let n = (t.positions[1] - t.positions[0]).cross(t.positions[2] - t.positions[0]);
+        let centre = if t.object == 1 {
+            Vec3::new(1.0, -3.0, 2.0)
+        } else {
+            Vec3::new(10.0, 0.0, 0.0)
+        };
+        let centroid = (t.positions[0] + t.positions[1] + t.positions[2]) / 3.0;
+        assert!(
+            n.dot(centroid - centre) > 0.0,
+            "object {} winds inward",
+            t.object
+        );
+        for v in t.normals {
+            assert!((v.length() - 1.0).abs() < 1e-5 && v.dot(n) > 0.0);
+        }
+    }
+}
+
+#[test]
+fn rotations_apply_x_then_y_then_z() {
+    let text = base("[[object]]\nshape = \"sphere\"\nradius = 1.0\nrotate = [90.0, 90.0, 0.0]\nmaterial = \"white\"\n");
+    let s = Scene::from_str(&text, Path::new("t.toml")).expect("loads");
+    // +y --Rx(90)--> +z --Ry(90)--> +x.
+    let v = s.object_transform(1, 0.0).transform_vector3(Vec3::Y);
+    assert!((v - Vec3::X).length() < 1e-5, "{v}");
+}
+
+#[test]
+fn animation_moves_objects_with_time() {
+    let text = base("[[object]]\nshape = \"sphere\"\nradius = 0.5\ntranslate = [0.0, 1.0, 0.0]\nmaterial = \"white\"\n\
+                     animate = { orbit_radius = 2.0, orbit_speed = 90.0, bob_amplitude = 0.5, bob_frequency = 0.25 }\n\n\
+                     [[object]]\nshape = \"box\"\nmin = [-1.0, -0.1, -0.1]\nmax = [1.0, 0.1, 0.1]\ntranslate = [5.0, 0.0, 0.0]\nmaterial = \"white\"\n\
+                     animate = { spin = 90.0 }\n");
+    let s = Scene::from_str(&text, Path::new("t.toml")).expect("loads");
+    assert!(s.is_animated());
+    // Orbit: +x at t = 0, a quarter turn counter-clockwise (seen from +y) at t = 1 -> -z; bob at its peak at t = 1.
+    let origin = |t: f32| s.object_transform(1, t).transform_point3(Vec3::ZERO);
+    assert!(
+        (origin(0.0) - Vec3::new(2.0, 1.0, 0.0)).length() < 1e-5,
+        "{}",
+        origin(0.0)
+    );
+    assert!(
+        (origin(1.0) - Vec3::new(0.0, 1.5, -2.0)).length() < 1e-5,
+        "{}",
+        origin(1.0)
+    );
+    // Spin about the object's own origin (its translate stays put).
+    let spin = |t: f32, p: Vec3| s.object_transform(2, t).transform_point3(p);
+    assert!((spin(1.0, Vec3::ZERO) - Vec3::new(5.0, 0.0, 0.0)).length() < 1e-5);
+    assert!(
+        (spin(1.0, Vec3::X) - Vec3::new(5.0, 0.0, -1.0)).length() < 1e-5,
+        "{}",
+        spin(1.0, Vec3::X)
+    );
+    // Triangles and bounds follow.
+    let (lo0, _) = s.bounds(0.0);
+    let (lo1, _) = s.bounds(1.0);
+    assert_ne!(lo0, lo1);
+    assert_ne!(s.triangles(0.0), s.triangles(1.0));
+    // The static object does not move.
+    assert_eq!(s.object_transform(0, 0.0), s.object_transform(0, 3.0));
+}
