@@ -66,7 +66,7 @@ impl SceneGpu {
 
     pub fn new(ctx: &Arc<Context>, scene: &Scene, time: f32) -> VkResult<SceneGpu> {
         let triangles = scene.triangles(time);
-        let bvh = crate::bvh::build(&triangles);
+        let bvh = Bvh::build(&triangles);
         let gpu_triangles = bvh.gpu_triangles(&triangles);
         let stats = GeometryStats {
             triangles: triangles.len(),
