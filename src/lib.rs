@@ -12,3 +12,4 @@ pub mod shader_bindings;
 pub mod shaders;
 pub mod techniques;
 pub mod vk;
+pub mod reference;

@@ -1,1 +1,341 @@
-fn main() {}
+//! The `caustics` command line: render, reference, bench, info.
+
+use anyhow::Context as _;
+use caustics::output::{self, ImageFormat};
+use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
+use caustics::renderer::Renderer;
+use caustics::scene::{Scene, DEFAULT_SCENE};
+use caustics::techniques::{self, Params};
+use caustics::vk::{Context, ContextOptions, PassTiming};
+use clap::{Args, Parser, Subcommand};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+
+#[derive(Parser)]
+#[command(name = "caustics", version, about = "Real-time caustics techniques on Vulkan, side by side against a GPU ground truth")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Args, Clone)]
+struct DeviceArgs {
+    /// Vulkan device by index or name substring (`caustics info` lists them).
+    #[arg(long)]
+    device: Option<String>,
+    /// Turn on the Khronos validation layer (default in debug builds); any validation error makes the command fail.
+    #[arg(long)]
+    validate: bool,
+}
+
+#[derive(Args, Clone)]
+struct SceneArgs {
+    /// Scene file (TOML, docs/SCENES.md).
+    #[arg(long, default_value = DEFAULT_SCENE)]
+    scene: PathBuf,
+    #[arg(long, default_value_t = 512)]
+    width: u32,
+    #[arg(long, default_value_t = 512)]
+    height: u32,
+    /// Animation time in seconds.
+    #[arg(long, default_value_t = 0.0)]
+    time: f32,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene with a real-time technique and write PNG (tonemapped) or EXR (linear radiance).
+    Render {
+        #[command(flatten)]
+        scene: SceneArgs,
+        /// Technique name, or `list` to print them with their parameters.
+        #[arg(long, default_value = "direct")]
+        technique: String,
+        /// Technique parameter, NAME=VALUE (repeatable; `--technique list` shows them).
+        #[arg(long = "param")]
+        params: Vec<String>,
+        /// Frames to render (time advances 1/60 s per frame); timings are averaged over them.
+        #[arg(long, default_value_t = 1)]
+        frames: u32,
+        /// Output image; .png or .exr (the other format is written beside it).
+        #[arg(long, default_value = "out/render.png")]
+        out: PathBuf,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    /// Render the ground truth with the GPU light tracer.
+    Reference {
+        #[command(flatten)]
+        scene: SceneArgs,
+        /// Photons to trace.
+        #[arg(long, default_value_t = 20_000_000)]
+        photons: u64,
+        /// Path-type component to write: direct, surface_caustics, airlight, volume_caustics, other, all.
+        #[arg(long, default_value = "all")]
+        component: String,
+        /// Diffuse bounces photons continue through (0: direct light and caustics only).
+        #[arg(long, default_value_t = 0)]
+        diffuse_bounces: u32,
+        /// Output image; .png or .exr (the other format is written beside it).
+        #[arg(long, default_value = "out/reference.png")]
+        out: PathBuf,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    /// Per-pass GPU timings averaged over frames after a warm-up.
+    Bench {
+        #[command(flatten)]
+        scene: SceneArgs,
+        #[arg(long, default_value = "direct")]
+        technique: String,
+        #[arg(long = "param")]
+        params: Vec<String>,
+        #[arg(long, default_value_t = 20)]
+        frames: u32,
+        /// Frames rendered before timing starts (pipeline compilation, caches).
+        #[arg(long, default_value_t = 2)]
+        warmup: u32,
+        /// Also write the results as JSON.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    /// List Vulkan devices and the features this renderer needs.
+    Info,
+}
+
+fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).format_timestamp(None).init();
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn context(args: &DeviceArgs) -> anyhow::Result<Arc<Context>> {
+    let options = ContextOptions { validation: args.validate || cfg!(debug_assertions), device: args.device.clone() };
+    let ctx = Context::new(&options)?;
+    eprintln!("device: {} ({})", ctx.info.name, ctx.info.driver.trim());
+    Ok(ctx)
+}
+
+/// Fails the command if the validation layer reported errors.
+fn check_validation(ctx: &Context) -> anyhow::Result<()> {
+    let counts = ctx.validation_counts();
+    if counts.errors > 0 {
+        anyhow::bail!("the Vulkan validation layer reported {} error(s) (see the log above)", counts.errors);
+    }
+    Ok(())
+}
+
+fn load_scene(path: &Path) -> anyhow::Result<Scene> {
+    Ok(Scene::load(path)?)
+}
+
+fn check_size(args: &SceneArgs) -> anyhow::Result<()> {
+    for (name, v) in [("--width", args.width), ("--height", args.height)] {
+        if !(1..=16384).contains(&v) {
+            anyhow::bail!("{name} {v}: must be between 1 and 16384");
+        }
+    }
+    if !args.time.is_finite() {
+        anyhow::bail!("--time must be a finite number of seconds");
+    }
+    Ok(())
+}
+
+fn print_timings(title: &str, timings: &[PassTiming], source: &str) {
+    println!("{title} ({source}):");
+    let mut total = 0.0;
+    for t in timings {
+        println!("  {:<28} {:>9.3} ms", t.name, t.ms);
+        total += t.ms;
+    }
+    println!("  {:<28} {:>9.3} ms", "total", total);
+}
+
+/// Averages per-pass timings over frames (passes matched by position and name).
+fn average(frames: &[Vec<PassTiming>]) -> Vec<PassTiming> {
+    let Some(first) = frames.first() else { return Vec::new() };
+    first
+        .iter()
+        .enumerate()
+        .map(|(i, p)| PassTiming {
+            name: p.name.clone(),
+            ms: frames.iter().filter_map(|f| f.get(i)).map(|t| t.ms).sum::<f64>() / frames.len() as f64,
+        })
+        .collect()
+}
+
+fn write_outputs(out: &Path, width: u32, height: u32, radiance: &[f32], display: &[u8]) -> anyhow::Result<()> {
+    let format = output::format_of(out)?;
+    let (exr, png) = match format {
+        ImageFormat::Exr => (out.to_path_buf(), output::sibling(out, ImageFormat::Png)),
+        ImageFormat::Png => (output::sibling(out, ImageFormat::Exr), out.to_path_buf()),
+    };
+    if radiance.iter().any(|v| !v.is_finite()) {
+        anyhow::bail!("the rendered radiance contains NaN or Inf; no image written");
+    }
+    output::write_exr(&exr, width, height, radiance)?;
+    output::write_png(&png, width, height, display)?;
+    println!("wrote {} (linear radiance) and {} (tonemapped)", exr.display(), png.display());
+    Ok(())
+}
+
+fn list_techniques() {
+    println!("techniques (caustics render --technique NAME):");
+    for t in techniques::TECHNIQUES {
+        println!("  {:<14} {}", t.name, t.description);
+        for p in t.params {
+            println!(
+                "      --param {}=VALUE  {} [{} .. {}], default {}",
+                p.name, p.description, p.min, p.max, p.default
+            );
+        }
+    }
+    println!("  {:<14} ground-truth light tracer: run `caustics reference`", "reference");
+}
+
+fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Info => {
+            let devices = Context::list_devices()?;
+            if devices.is_empty() {
+                anyhow::bail!("no Vulkan device found; install Mesa's lavapipe: apt-get install mesa-vulkan-drivers");
+            }
+            for d in devices {
+                println!(
+                    "[{}] {} ({:?}), Vulkan {}.{}.{}, {}",
+                    d.index, d.name, d.kind, d.api_version.0, d.api_version.1, d.api_version.2, d.driver.trim()
+                );
+                for (f, ok) in &d.features {
+                    println!("    {} {}", if *ok { "yes" } else { "NO " }, f.name());
+                }
+            }
+            Ok(())
+        }
+        Command::Render { scene, technique, params, frames, out, device } => {
+            if technique == "list" {
+                list_techniques();
+                return Ok(());
+            }
+            let info = techniques::find(&technique)?;
+            let params = Params::resolve(&technique, info.params, &params)?;
+            check_size(&scene)?;
+            output::format_of(&out)?;
+            if frames == 0 {
+                anyhow::bail!("--frames must be at least 1");
+            }
+            let loaded = load_scene(&scene.scene)?;
+            let ctx = context(&device)?;
+            let mut renderer = Renderer::new(&ctx, loaded, &technique, &params, scene.width, scene.height, scene.time)?;
+            let mut all = Vec::new();
+            for i in 0..frames {
+                all.push(renderer.render_frame(scene.time + i as f32 / 60.0)?);
+            }
+            let title = format!("{} at {}x{}, {} frame(s), mean per pass", technique, scene.width, scene.height, frames);
+            print_timings(&title, &average(&all), renderer.profiler.source.describe());
+            let stats = renderer.scene_gpu.stats;
+            println!(
+                "geometry: {} triangles, BVH {} nodes ({} leaves, depth {}) built in {:.1} ms",
+                stats.triangles, stats.bvh_nodes, stats.bvh_leaves, stats.bvh_depth, stats.bvh_build_ms
+            );
+            let radiance = renderer.radiance()?;
+            let display = renderer.display()?;
+            check_validation(&ctx)?;
+            write_outputs(&out, scene.width, scene.height, &radiance, &display)
+        }
+        Command::Reference { scene, photons, component, diffuse_bounces, out, device } => {
+            check_size(&scene)?;
+            output::format_of(&out)?;
+            let component = Component::parse(&component)?;
+            if photons == 0 {
+                anyhow::bail!("--photons must be at least 1");
+            }
+            let loaded = load_scene(&scene.scene)?;
+            let ctx = context(&device)?;
+            let settings = ReferenceSettings { diffuse_bounces, ..Default::default() };
+            let mut reference = ReferenceRenderer::new(&ctx, loaded, scene.width, scene.height, scene.time, settings)?;
+            let bar = indicatif::ProgressBar::new(photons);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template("{bar:40} {percent:>3}% {human_pos}/{human_len} photons, {per_sec}, eta {eta}")
+                    .context("progress style")?,
+            );
+            reference.trace(photons, |done, _| bar.set_position(done))?;
+            bar.finish_and_clear();
+            println!(
+                "traced {} photons in {:.2} s: {:.3} M photons/s, {} camera-chain passes",
+                reference.reference.photons,
+                reference.trace_seconds,
+                reference.photons_per_second() / 1e6,
+                reference.reference.camera_passes
+            );
+            let radiance = reference.resolve(component)?;
+            let display = reference.display()?;
+            check_validation(&ctx)?;
+            write_outputs(&out, scene.width, scene.height, &radiance, &display)
+        }
+        Command::Bench { scene, technique, params, frames, warmup, json, device } => {
+            let info = techniques::find(&technique)?;
+            let params = Params::resolve(&technique, info.params, &params)?;
+            check_size(&scene)?;
+            if frames == 0 {
+                anyhow::bail!("--frames must be at least 1");
+            }
+            let loaded = load_scene(&scene.scene)?;
+            let ctx = context(&device)?;
+            let mut renderer = Renderer::new(&ctx, loaded, &technique, &params, scene.width, scene.height, scene.time)?;
+            for i in 0..warmup {
+                renderer.render_frame(scene.time + i as f32 / 60.0)?;
+            }
+            let mut all = Vec::new();
+            let mut frame_ms = Vec::new();
+            for i in 0..frames {
+                let start = std::time::Instant::now();
+                all.push(renderer.render_frame(scene.time + (warmup + i) as f32 / 60.0)?);
+                frame_ms.push(start.elapsed().as_secs_f64() * 1e3);
+            }
+            check_validation(&ctx)?;
+            let passes = average(&all);
+            let frame_mean = frame_ms.iter().sum::<f64>() / frame_ms.len() as f64;
+            let title = format!(
+                "bench {} on {} at {}x{}, {} frames after {} warm-up",
+                technique,
+                scene.scene.display(),
+                scene.width,
+                scene.height,
+                frames,
+                warmup
+            );
+            print_timings(&title, &passes, renderer.profiler.source.describe());
+            println!("  {:<28} {:>9.3} ms (host wall clock, submit to fence)", "frame", frame_mean);
+            if let Some(path) = json {
+                let report = serde_json::json!({
+                    "device": ctx.info.name,
+                    "driver": ctx.info.driver.trim(),
+                    "timing_source": renderer.profiler.source.describe(),
+                    "scene": scene.scene.display().to_string(),
+                    "technique": technique,
+                    "params": params.iter().map(|(k, v)| (k.clone(), *v)).collect::<std::collections::BTreeMap<_, _>>(),
+                    "width": scene.width,
+                    "height": scene.height,
+                    "frames": frames,
+                    "warmup": warmup,
+                    "passes_ms": passes,
+                    "frame_ms": frame_mean,
+                    "geometry": renderer.scene_gpu.stats,
+                });
+                std::fs::write(&path, serde_json::to_string_pretty(&report)?)
+                    .with_context(|| format!("cannot write {}", path.display()))?;
+                println!("wrote {}", path.display());
+            }
+            Ok(())
+        }
+    }
+}

@@ -95,6 +95,8 @@ pub struct ValidationCounts {
 struct Counters {
     errors: AtomicU32,
     warnings: AtomicU32,
+    /// The first error messages, kept so tests can show why they failed.
+    first_errors: Mutex<Vec<String>>,
 }
 
 pub struct Context {
@@ -132,6 +134,11 @@ unsafe extern "system" fn debug_callback(
     if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
         counters.errors.fetch_add(1, Ordering::SeqCst);
         log::error!("[vulkan {kind:?}] {message}");
+        if let Ok(mut first) = counters.first_errors.lock() {
+            if first.len() < 16 {
+                first.push(message);
+            }
+        }
     } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
         counters.warnings.fetch_add(1, Ordering::SeqCst);
         log::warn!("[vulkan {kind:?}] {message}");
@@ -282,13 +289,14 @@ impl Context {
     /// A context whose instance also enables `extensions` (e.g. surface extensions for the demo).
     pub fn with_instance_extensions(
         options: &ContextOptions,
-        extensions: &[*const std::ffi::c_char],
+        instance_extensions: &[*const std::ffi::c_char],
     ) -> VkResult<Arc<Context>> {
         let entry = load_entry()?;
-        let instance = create_instance(&entry, options.validation, extensions)?;
+        let instance = create_instance(&entry, options.validation, instance_extensions)?;
         let counters = Box::new(Counters {
             errors: AtomicU32::new(0),
             warnings: AtomicU32::new(0),
+            first_errors: Mutex::new(Vec::new()),
         });
         let has_debug_utils = unsafe { entry.enumerate_instance_extension_properties(None) }?
             .iter()
@@ -393,15 +401,9 @@ impl Context {
             ash::ext::shader_atomic_float::NAME.as_ptr(),
             ash::khr::swapchain::NAME.as_ptr(),
         ];
-        let has_swapchain =
-            unsafe { instance.enumerate_device_extension_properties(physical_device) }?
-                .iter()
-                .any(|e| e.extension_name_as_c_str() == Ok(ash::khr::swapchain::NAME));
-        let extensions = if has_swapchain && !extensions.is_empty() {
-            &extensions[..]
-        } else {
-            &extensions[..1]
-        };
+        // Swapchains only when the instance has surface extensions (the demo):
+        // VK_KHR_swapchain requires VK_KHR_surface on the instance.
+        let extensions = if instance_extensions.is_empty() { &extensions[..1] } else { &extensions[..] };
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_info)
             .enabled_features(&features)
@@ -470,6 +472,11 @@ impl Context {
             errors: self.counters.errors.load(Ordering::SeqCst),
             warnings: self.counters.warnings.load(Ordering::SeqCst),
         }
+    }
+
+    /// The first validation error messages (at most 16).
+    pub fn validation_errors(&self) -> Vec<String> {
+        self.counters.first_errors.lock().map(|v| v.clone()).unwrap_or_default()
     }
 
     /// True when the device is a CPU implementation (lavapipe), whose timestamps

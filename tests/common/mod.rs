@@ -1,0 +1,173 @@
+//! Helpers shared by the integration tests: a validated lavapipe context,
+//! scenes built in code, camera rays, and image statistics.
+#![allow(dead_code)]
+
+use caustics::renderer::camera_matrices;
+use caustics::scene::*;
+use caustics::vk::{Context, ContextOptions};
+use glam::{Mat4, Vec3};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// A context with the Khronos validation layer on; tests end with `assert_validation_clean`.
+pub fn validated_context() -> Arc<Context> {
+    Context::new(&ContextOptions { validation: true, device: None }).expect("Vulkan context with validation")
+}
+
+pub fn assert_validation_clean(ctx: &Context) {
+    let counts = ctx.validation_counts();
+    assert_eq!(
+        counts.errors,
+        0,
+        "the validation layer reported {} error(s):\n{}",
+        counts.errors,
+        ctx.validation_errors().join("\n")
+    );
+}
+
+pub fn diffuse(name: &str, albedo: f32) -> Material {
+    Material { name: name.into(), kind: MaterialKind::Diffuse, color: Vec3::splat(albedo), ior: 1.0, absorption: Vec3::ZERO }
+}
+
+pub fn dielectric(name: &str, ior: f32) -> Material {
+    Material { name: name.into(), kind: MaterialKind::Dielectric, color: Vec3::ONE, ior, absorption: Vec3::ZERO }
+}
+
+/// An axis-aligned rectangle at height `y`, normal +y, centred on the origin.
+pub fn floor_mesh(half: f32, y: f32, material: u32) -> Mesh {
+    Mesh {
+        positions: vec![
+            Vec3::new(-half, y, -half),
+            Vec3::new(half, y, -half),
+            Vec3::new(half, y, half),
+            Vec3::new(-half, y, half),
+        ],
+        normals: vec![Vec3::Y; 4],
+        indices: vec![[0, 2, 1], [0, 3, 2]],
+        materials: vec![material; 2],
+    }
+}
+
+/// A closed axis-aligned box with flat outward normals.
+pub fn box_mesh(min: Vec3, max: Vec3, material: u32) -> Mesh {
+    let mut m = Mesh::default();
+    let faces: [(Vec3, [Vec3; 4]); 6] = [
+        (Vec3::X, [Vec3::new(max.x, min.y, min.z), Vec3::new(max.x, max.y, min.z), Vec3::new(max.x, max.y, max.z), Vec3::new(max.x, min.y, max.z)]),
+        (Vec3::NEG_X, [Vec3::new(min.x, min.y, max.z), Vec3::new(min.x, max.y, max.z), Vec3::new(min.x, max.y, min.z), Vec3::new(min.x, min.y, min.z)]),
+        (Vec3::Y, [Vec3::new(min.x, max.y, min.z), Vec3::new(min.x, max.y, max.z), Vec3::new(max.x, max.y, max.z), Vec3::new(max.x, max.y, min.z)]),
+        (Vec3::NEG_Y, [Vec3::new(min.x, min.y, max.z), Vec3::new(min.x, min.y, min.z), Vec3::new(max.x, min.y, min.z), Vec3::new(max.x, min.y, max.z)]),
+        (Vec3::Z, [Vec3::new(max.x, min.y, max.z), Vec3::new(max.x, max.y, max.z), Vec3::new(min.x, max.y, max.z), Vec3::new(min.x, min.y, max.z)]),
+        (Vec3::NEG_Z, [Vec3::new(min.x, min.y, min.z), Vec3::new(min.x, max.y, min.z), Vec3::new(max.x, max.y, min.z), Vec3::new(max.x, min.y, min.z)]),
+    ];
+    for (n, corners) in faces {
+        let base = m.positions.len() as u32;
+        // Wind counter-clockwise seen from outside (along n).
+        let [a, b, c, _] = corners;
+        let ccw = (b - a).cross(c - a).dot(n) > 0.0;
+        for p in corners {
+            m.positions.push(p);
+            m.normals.push(n);
+        }
+        if ccw {
+            m.indices.push([base, base + 1, base + 2]);
+            m.indices.push([base, base + 2, base + 3]);
+        } else {
+            m.indices.push([base, base + 2, base + 1]);
+            m.indices.push([base, base + 3, base + 2]);
+        }
+        m.materials.extend([material, material]);
+    }
+    m
+}
+
+/// A UV sphere with smooth outward normals.
+pub fn sphere_mesh(center: Vec3, radius: f32, material: u32, segments: u32) -> Mesh {
+    let (nu, nv) = (segments * 2, segments);
+    let mut m = Mesh::default();
+    for j in 0..=nv {
+        let theta = std::f32::consts::PI * j as f32 / nv as f32;
+        for i in 0..=nu {
+            let phi = 2.0 * std::f32::consts::PI * i as f32 / nu as f32;
+            let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            m.positions.push(center + n * radius);
+            m.normals.push(n);
+        }
+    }
+    let row = nu + 1;
+    for j in 0..nv {
+        for i in 0..nu {
+            let a = j * row + i;
+            let (b, c, d) = (a + 1, a + row, a + row + 1);
+            if j != 0 {
+                m.indices.push([a, b, c]);
+                m.materials.push(material);
+            }
+            if j != nv - 1 {
+                m.indices.push([b, d, c]);
+                m.materials.push(material);
+            }
+        }
+    }
+    m
+}
+
+pub fn object(name: &str, mesh: Mesh) -> Object {
+    Object { name: name.into(), mesh, transform: Mat4::IDENTITY, animation: None }
+}
+
+pub fn point_light(position: Vec3, intensity: f32) -> Light {
+    Light {
+        kind: LightKind::Point,
+        position,
+        direction: Vec3::NEG_Y,
+        intensity: Vec3::splat(intensity),
+        cone_angle_deg: 0.0,
+        cone_falloff_deg: 0.0,
+    }
+}
+
+pub fn directional_light(direction: Vec3, irradiance: f32) -> Light {
+    Light {
+        kind: LightKind::Directional,
+        position: Vec3::ZERO,
+        direction: direction.normalize(),
+        intensity: Vec3::splat(irradiance),
+        cone_angle_deg: 0.0,
+        cone_falloff_deg: 0.0,
+    }
+}
+
+pub fn scene(camera: Camera, lights: Vec<Light>, materials: Vec<Material>, objects: Vec<Object>) -> Scene {
+    Scene {
+        source: PathBuf::from("<test>"),
+        camera,
+        lights,
+        materials,
+        objects,
+        medium: None,
+        output: Output { exposure: 1.0 },
+    }
+}
+
+pub fn camera(eye: Vec3, target: Vec3, fov_y_deg: f32) -> Camera {
+    Camera { eye, target, up: Vec3::Y, fov_y_deg }
+}
+
+/// The world-space ray through the centre of pixel (px, py) (row 0 at the top).
+pub fn pixel_ray(camera: &Camera, width: u32, height: u32, px: u32, py: u32) -> (Vec3, Vec3) {
+    let (view, proj) = camera_matrices(camera, width as f32 / height as f32);
+    let inv = (proj * view).inverse();
+    let ndc_x = 2.0 * (px as f32 + 0.5) / width as f32 - 1.0;
+    let ndc_y = 2.0 * (py as f32 + 0.5) / height as f32 - 1.0;
+    let far = inv.project_point3(Vec3::new(ndc_x, ndc_y, 1.0));
+    (camera.eye, (far - camera.eye).normalize())
+}
+
+/// Red channel of pixel (x, y) of an RGBA f32 image.
+pub fn red(rgba: &[f32], width: u32, x: u32, y: u32) -> f32 {
+    rgba[((y * width + x) * 4) as usize]
+}
+
+pub fn assert_finite(rgba: &[f32]) {
+    assert!(rgba.iter().all(|v| v.is_finite()), "image has NaN or Inf");
+}
