@@ -292,42 +292,73 @@ fn spot_light_on_plane_matches_analytic() {
 }
 
 #[test]
+fn wide_spot_light_uses_a_cube_and_matches_analytic() {
+    // Wider than SPOT_CUBE_THRESHOLD_DEG: rendered as a cube like a point light.
+    check_analytic(Light {
+        kind: LightKind::Spot,
+        position: Vec3::new(0.0, 1.5, 0.0),
+        direction: Vec3::new(0.2, -1.0, -0.1).normalize(),
+        intensity: Vec3::new(5.0, 5.0, 5.0),
+        cone_angle_deg: 75.0,
+        cone_falloff_deg: 15.0,
+    });
+}
+
+#[test]
 fn directional_light_on_plane_matches_analytic() {
     check_analytic(Light {
         kind: LightKind::Directional,
         position: Vec3::ZERO,
-        direction: Vec3::new(0.3, -1.0, 0.2).normalize(),
+        // Grazing (76° from the normal): stresses the slope-scaled bias.
+        direction: Vec3::new(1.0, -0.25, 0.3).normalize(),
         intensity: Vec3::new(3.0, 2.0, 1.0),
         cone_angle_deg: 0.0,
         cone_falloff_deg: 0.0,
     });
 }
 
-#[test]
-fn box_casts_a_shadow_from_a_point_light() {
-    let light = point_light();
+/// The floor with the box on it: pixels whose floor point is analytically
+/// occluded from `light` (by more than `margin`) read under 1% of the
+/// unshadowed value; pixels clear of the box by `margin` are lit within 1%.
+fn check_box_shadow(light: Light) {
     let s = scene(vec![light], true);
     let camera = s.camera;
     let (ctx, radiance) = render(s);
     // Margin around the box (m) inside which the shadow edge may fall: a few
-    // shadow texels (about 5 mm at 1024² here) plus the PCF window and bias.
+    // shadow texels (about 5-10 mm at 1024² here) plus the PCF window and bias.
     let margin = 0.05;
-    let lpos = light.position.as_dvec3();
-    let (mut shadowed, mut lit) = (0, 0);
-    let (mut max_shadow_ratio, mut max_lit_rel) = (0.0f64, 0.0f64);
+    // Floor points the camera sees clear of the box (by `margin`).
+    let mut floor = Vec::new();
     for py in 0..SIZE {
         for px in 0..SIZE {
             let (o, d) = camera_ray(&camera, px, py);
-            let Some(x) = hit_floor(o, d, 1e-3) else {
-                continue;
+            if let Some(x) = hit_floor(o, d, 1e-3) {
+                if !segment_hits_box(o, d, 0.0, (x - o).length(), margin) {
+                    floor.push((px, py, x));
+                }
+            }
+        }
+    }
+    let peak = floor
+        .iter()
+        .map(|&(_, _, x)| irradiance(&light, x).max_element())
+        .fold(0.0, f64::max);
+    let (mut shadowed, mut lit) = (0, 0);
+    let (mut max_shadow_ratio, mut max_lit_rel) = (0.0f64, 0.0f64);
+    {
+        for (px, py, x) in floor {
+            let (dir, dist) = match light.kind {
+                LightKind::Directional => (-light.direction.as_dvec3().normalize(), 1e9),
+                _ => {
+                    let v = light.position.as_dvec3() - x;
+                    (v.normalize(), v.length())
+                }
             };
-            // Skip pixels where the camera sees the box (or nearly).
-            if segment_hits_box(o, d, 0.0, (x - o).length(), margin) {
+            // Only where the light is brighter than 1e-3 of its peak (outside
+            // a spot's cone or deep in its falloff, relative error means nothing).
+            if irradiance(&light, x).min_element() < 1e-3 * peak {
                 continue;
             }
-            let to_light = lpos - x;
-            let dist = to_light.length();
-            let dir = to_light / dist;
             let unshadowed = irradiance(&light, x) * (ALBEDO as f64 / PI);
             let got = pixel(&radiance, px, py);
             if segment_hits_box(x, dir, 1e-6, dist, -margin) {
@@ -344,14 +375,47 @@ fn box_casts_a_shadow_from_a_point_light() {
         }
     }
     println!(
-        "box shadow: {shadowed} shadowed pixels (max {max_shadow_ratio:.2e} of lit), {lit} lit pixels (max relative error {max_lit_rel:.2e})"
+        "{:?} box shadow: {shadowed} shadowed pixels (max {max_shadow_ratio:.2e} of lit), {lit} lit pixels (max relative error {max_lit_rel:.2e})",
+        light.kind
     );
-    assert!(shadowed > 50, "too few shadowed pixels to judge: {shadowed}");
-    assert!(lit > 2000);
+    assert!(
+        shadowed > 50,
+        "too few shadowed pixels to judge: {shadowed}"
+    );
+    assert!(lit > 1000, "too few lit pixels to judge: {lit}");
     assert!(
         max_shadow_ratio < 0.01,
         "shadowed pixel at {max_shadow_ratio} of lit"
     );
     assert!(max_lit_rel <= 0.01, "lit pixel off by {max_lit_rel}");
     assert_eq!(ctx.validation_counts().errors, 0, "validation errors");
+}
+
+#[test]
+fn box_casts_a_shadow_from_a_point_light() {
+    check_box_shadow(point_light());
+}
+
+#[test]
+fn box_casts_a_shadow_from_a_spot_light() {
+    check_box_shadow(Light {
+        kind: LightKind::Spot,
+        position: Vec3::new(0.0, 2.0, 0.0),
+        direction: Vec3::new(1.2, -2.0, 0.0).normalize(),
+        intensity: Vec3::new(8.0, 6.0, 4.0),
+        cone_angle_deg: 50.0,
+        cone_falloff_deg: 10.0,
+    });
+}
+
+#[test]
+fn box_casts_a_shadow_from_a_directional_light() {
+    check_box_shadow(Light {
+        kind: LightKind::Directional,
+        position: Vec3::ZERO,
+        direction: Vec3::new(1.0, -0.6, 0.3).normalize(),
+        intensity: Vec3::new(3.0, 2.0, 1.0),
+        cone_angle_deg: 0.0,
+        cone_falloff_deg: 0.0,
+    });
 }

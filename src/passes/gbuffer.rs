@@ -12,8 +12,7 @@
 use crate::renderer::SceneGpu;
 use crate::vk::{
     barrier, begin_rendering, end_rendering, Access, BufferAccess, Context, DescriptorSetLayout,
-    FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageAccess, ImageDesc,
-    VkResult,
+    FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageAccess, ImageDesc, VkResult,
 };
 use ash::vk;
 use std::sync::Arc;

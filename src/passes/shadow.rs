@@ -24,8 +24,8 @@ use crate::scene::{Light, LightKind};
 use crate::shader_bindings as b;
 use crate::vk::{
     barrier, begin_rendering, end_rendering, Access, Buffer, BufferAccess, BufferUsage, Context,
-    DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image,
-    ImageAccess, ImageDesc, VkResult,
+    DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageAccess,
+    ImageDesc, VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -182,7 +182,11 @@ impl ShadowMaps {
                 b::MAX_LIGHTS
             );
         }
-        let scene_lights: Vec<Light> = lights.iter().take(b::MAX_LIGHTS as usize).copied().collect();
+        let scene_lights: Vec<Light> = lights
+            .iter()
+            .take(b::MAX_LIGHTS as usize)
+            .copied()
+            .collect();
         let layers = b::SHADOW_LAYERS_PER_LIGHT * (scene_lights.len() as u32).max(1);
         let map = Image::new(
             ctx,
