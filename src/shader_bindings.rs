@@ -41,3 +41,20 @@ pub const COMPONENT_COUNT: u32 = 5;
 pub const MAX_LIGHTS: u32 = 8;
 /// BVH traversal stack depth in GLSL; the CPU builder guarantees the tree is no deeper.
 pub const BVH_STACK_SIZE: u32 = 48;
+
+// Shadow maps (src/passes/shadow.rs, glsl/common/shadow.glsl): every light
+// owns SHADOW_LAYERS_PER_LIGHT layers of one 2D-array image (light l: layers
+// 6l..6l+5); a point light uses all six (cube faces +x -x +y -y +z -z), a
+// spot or directional light layer 6l only.
+pub const SHADOW_LAYERS_PER_LIGHT: u32 = 6;
+// What a shadow texel stores: distance to the light's position (point, spot)
+// or depth along the light's direction from its ortho plane (directional).
+pub const SHADOW_RADIAL: u32 = 0;
+pub const SHADOW_PLANAR: u32 = 1;
+
+// Direct technique, descriptor set 1 (src/techniques/direct.rs, glsl/direct/lighting.comp).
+pub const DIRECT_BINDING_POSITION: u32 = 0;
+pub const DIRECT_BINDING_NORMAL: u32 = 1;
+pub const DIRECT_BINDING_RADIANCE: u32 = 2;
+pub const DIRECT_BINDING_SHADOW_MAP: u32 = 3;
+pub const DIRECT_BINDING_SHADOW_LIGHTS: u32 = 4;

@@ -1,4 +1,6 @@
 //! Passes shared by techniques: each owns its pipelines and records itself
 //! through `FrameRecorder::pass`.
 
+pub mod gbuffer;
+pub mod shadow;
 pub mod tonemap;

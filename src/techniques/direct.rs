@@ -1,28 +1,180 @@
-//! TEMPORARY: replaced by the direct technique (G-buffer, shadow maps, lighting).
+//! `direct`: direct light with shadow maps, the base frame every technique
+//! adds to. Radiometrically the ground truth's L D component for diffuse
+//! surfaces seen directly: L = albedo / pi * sum over lights of E * V, with
+//! E the light's irradiance (I cos / r^2 with spot falloff, or E cos for a
+//! directional light) and V the shadow-map visibility.
+//!
+//! Passes (each through `FrameRecorder::pass`):
+//! 1. "shadow maps" (`passes::shadow`): every light's views, linear distance;
+//! 2. "gbuffer" (`passes::gbuffer`): world position, normal, material;
+//! 3. "direct lighting" (glsl/direct/lighting.comp): per pixel, into the
+//!    frame's radiance image.
+//!
+//! Specular surfaces seen directly and the background read 0; no medium
+//! attenuation (the medium techniques add it).
+
 use super::{ParamSpec, Params, Technique};
+use crate::passes::gbuffer::GBuffer;
+use crate::passes::shadow::ShadowMaps;
 use crate::renderer::{FrameTargets, SceneGpu};
 use crate::scene::Scene;
-use crate::vk::{Context, FrameRecorder, VkResult};
+use crate::shader_bindings as b;
+use crate::vk::{
+    barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    FrameRecorder, ImageAccess, Sampler, VkResult,
+};
+use ash::vk;
+use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
-pub const PARAMS: &[ParamSpec] = &[];
-pub struct Direct;
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec {
+        name: "shadow_map_size",
+        description: "shadow map resolution per view (texels per side)",
+        min: 64.0,
+        max: 4096.0,
+        default: 1024.0,
+        integer: true,
+    },
+    ParamSpec {
+        name: "pcf_radius",
+        description: "percentage-closer filter half-width in shadow texels (0: one tap)",
+        min: 0.0,
+        max: 4.0,
+        default: 1.0,
+        integer: true,
+    },
+];
+
+/// Push constants of glsl/direct/lighting.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct LightingPush {
+    light_count: u32,
+    pcf_radius: i32,
+}
+
+pub struct Direct {
+    pub shadows: ShadowMaps,
+    pub gbuffer: GBuffer,
+    pcf_radius: i32,
+    light_count: u32,
+    lighting: ComputePipeline,
+    set: DescriptorSet,
+    /// The radiance image the set's output binding points at: the frame
+    /// targets are not known at construction, so the binding is written on
+    /// the first `record` (and again if the targets change).
+    bound_radiance: vk::ImageView,
+    _layout: DescriptorSetLayout,
+    _sampler: Sampler,
+}
+
 impl Direct {
     pub fn new(
-        _: &Arc<Context>,
-        _: &Params,
-        _: &Scene,
-        _: &SceneGpu,
-        _: u32,
-        _: u32,
+        ctx: &Arc<Context>,
+        params: &Params,
+        scene: &Scene,
+        scene_gpu: &SceneGpu,
+        width: u32,
+        height: u32,
     ) -> VkResult<Self> {
-        Ok(Direct)
+        let shadow_map_size = params.get("shadow_map_size") as u32;
+        let pcf_radius = params.get("pcf_radius") as i32;
+        let shadows = ShadowMaps::new(ctx, &scene_gpu.layout, &scene.lights, shadow_map_size)?;
+        let gbuffer = GBuffer::new(ctx, &scene_gpu.layout, width, height)?;
+        let layout = DescriptorSetLayout::new(
+            ctx,
+            &[
+                (b::DIRECT_BINDING_POSITION, BindingKind::StorageImage),
+                (b::DIRECT_BINDING_NORMAL, BindingKind::StorageImage),
+                (b::DIRECT_BINDING_RADIANCE, BindingKind::StorageImage),
+                (b::DIRECT_BINDING_SHADOW_MAP, BindingKind::Sampled),
+                (b::DIRECT_BINDING_SHADOW_LIGHTS, BindingKind::Uniform),
+            ],
+        )?;
+        // Nearest: the shader fetches single texels and compares them itself.
+        let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
+        let set = DescriptorSet::new(ctx, &layout)?;
+        // The shadow maps are read in compute, where `Access::ComputeRead`
+        // puts them in GENERAL layout.
+        set.write_storage_image(b::DIRECT_BINDING_POSITION, &gbuffer.position)
+            .write_storage_image(b::DIRECT_BINDING_NORMAL, &gbuffer.normal)
+            .write_sampled_image(
+                b::DIRECT_BINDING_SHADOW_MAP,
+                &shadows.map,
+                &sampler,
+                vk::ImageLayout::GENERAL,
+            )
+            .write_buffer(b::DIRECT_BINDING_SHADOW_LIGHTS, &shadows.lights);
+        let lighting = ComputePipeline::new(
+            ctx,
+            "direct/lighting.comp",
+            &[&scene_gpu.layout, &layout],
+            std::mem::size_of::<LightingPush>() as u32,
+        )?;
+        Ok(Self {
+            light_count: scene.lights.len().min(b::MAX_LIGHTS as usize) as u32,
+            shadows,
+            gbuffer,
+            pcf_radius,
+            lighting,
+            set,
+            bound_radiance: vk::ImageView::null(),
+            _layout: layout,
+            _sampler: sampler,
+        })
     }
 }
+
 impl Technique for Direct {
     fn name(&self) -> &'static str {
         "direct"
     }
-    fn record(&mut self, _: &mut FrameRecorder, _: &SceneGpu, _: &FrameTargets) -> VkResult<()> {
+
+    fn record(
+        &mut self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        targets: &FrameTargets,
+    ) -> VkResult<()> {
+        if self.bound_radiance != targets.radiance.view {
+            // Updating a set is only legal while no pending command buffer
+            // uses it: the renderer waits for every frame before the next.
+            self.set
+                .write_storage_image(b::DIRECT_BINDING_RADIANCE, &targets.radiance);
+            self.bound_radiance = targets.radiance.view;
+        }
+        self.shadows.record(rec, scene)?;
+        self.gbuffer.record(rec, scene);
+        let ctx = rec.ctx().clone();
+        let push = LightingPush {
+            light_count: self.light_count,
+            pcf_radius: self.pcf_radius,
+        };
+        rec.pass("direct lighting", |cmd| {
+            // The G-buffer's and shadow maps' attachment writes must be
+            // visible to the compute reads (and move to GENERAL); the
+            // radiance image is overwritten entirely, after waiting for last
+            // frame's readers (tonemap, readback).
+            barrier(
+                &ctx,
+                cmd,
+                &[
+                    ImageAccess::new(&self.gbuffer.position, Access::ComputeRead),
+                    ImageAccess::new(&self.gbuffer.normal, Access::ComputeRead),
+                    ImageAccess::new(&self.shadows.map, Access::ComputeRead),
+                    ImageAccess::discard(&targets.radiance, Access::ComputeWrite),
+                ],
+                &[],
+            );
+            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
+            self.lighting.dispatch(
+                cmd,
+                &[&scene.set, &self.set],
+                bytemuck::bytes_of(&push),
+                groups,
+            );
+        });
         Ok(())
     }
 }

@@ -1,0 +1,54 @@
+#version 460
+// Direct light with shadows (technique `direct`), per G-buffer pixel:
+// L = albedo / pi * sum_l E_l * V_l for diffuse surfaces, where E_l is the
+// light's irradiance (glsl/common/lights.glsl: I cos / r^2 with the spot
+// falloff, or E cos for directional light) and V_l the shadow-map visibility.
+// Specular surfaces seen directly and the background get 0: the ground
+// truth follows specular chains, which later techniques add.
+#include "scene.glsl"
+#include "lights.glsl"
+#include "optics.glsl"
+
+#define SHADOW_SET 1
+#define SHADOW_BINDING_LIGHTS DIRECT_BINDING_SHADOW_LIGHTS
+#define SHADOW_BINDING_MAP DIRECT_BINDING_SHADOW_MAP
+#include "shadow.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 1, binding = DIRECT_BINDING_POSITION, rgba32f) uniform readonly image2D g_position;
+layout(set = 1, binding = DIRECT_BINDING_NORMAL, rgba32f) uniform readonly image2D g_normal;
+layout(set = 1, binding = DIRECT_BINDING_RADIANCE, rgba32f) uniform writeonly image2D radiance;
+
+layout(push_constant) uniform Push {
+    uint light_count; // lights with shadow maps (<= MAX_LIGHTS)
+    int pcf_radius;   // PCF window half-width in texels
+} pc;
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(p, imageSize(radiance)))) return;
+    vec4 position = imageLoad(g_position, p);
+    if (position.w == 0.0) {
+        imageStore(radiance, p, vec4(0.0));
+        return;
+    }
+    vec4 nm = imageLoad(g_normal, p);
+    uint material = uint(nm.w + 0.5);
+    if (material_kind(material) != MATERIAL_DIFFUSE) {
+        imageStore(radiance, p, vec4(0.0, 0.0, 0.0, 1.0));
+        return;
+    }
+    vec3 x = position.xyz;
+    vec3 n = normalize(nm.xyz);
+    vec3 e_sum = vec3(0.0);
+    for (uint l = 0u; l < pc.light_count; ++l) {
+        vec3 to_light;
+        float dist;
+        vec3 e = light_irradiance(l, x, n, to_light, dist);
+        if (all(equal(e, vec3(0.0)))) continue;
+        e_sum += e * shadow_visibility(l, x, n, to_light, pc.pcf_radius);
+    }
+    vec3 albedo = materials[material].color.rgb;
+    imageStore(radiance, p, vec4(albedo / PI * e_sum, 1.0));
+}

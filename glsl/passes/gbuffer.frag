@@ -1,0 +1,19 @@
+#version 460
+// Camera G-buffer, fragment stage: world position (w = 1: covered) and the
+// smooth normal turned toward the camera (two-sided surfaces) with the
+// material index in w.
+#include "scene.glsl"
+
+layout(location = 0) in vec3 v_position;
+layout(location = 1) in vec3 v_normal;
+layout(location = 2) flat in uint v_material;
+
+layout(location = 0) out vec4 out_position;
+layout(location = 1) out vec4 out_normal;
+
+void main() {
+    vec3 n = normalize(v_normal);
+    if (dot(n, frame.eye.xyz - v_position) < 0.0) n = -n;
+    out_position = vec4(v_position, 1.0);
+    out_normal = vec4(n, float(v_material));
+}

@@ -1,0 +1,119 @@
+//! Camera G-buffer: every triangle rasterised from the camera (vertex pulling
+//! from the scene's triangle buffer, `frame.view_proj`) into world position
+//! and world normal + material index, with a D32 depth test. Techniques that
+//! shade per pixel (direct light, caustic receivers) read it in compute.
+//!
+//! Layout of the targets (both RGBA32F, storage + sampled):
+//! - `position`: xyz world position; w = 1 where a surface covers the pixel,
+//!   0 for background (cleared to zero).
+//! - `normal`: xyz unit smooth normal flipped to face the camera (surfaces are
+//!   two-sided); w = material index as a float (exact below 2^24).
+
+use crate::renderer::SceneGpu;
+use crate::vk::{
+    barrier, begin_rendering, end_rendering, Access, BufferAccess, Context, DescriptorSetLayout,
+    FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageAccess, ImageDesc, VkResult,
+};
+use ash::vk;
+use std::sync::Arc;
+
+pub const POSITION_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+pub const NORMAL_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+
+pub struct GBuffer {
+    pub position: Image,
+    pub normal: Image,
+    pub depth: Image,
+    pipeline: GraphicsPipeline,
+}
+
+impl GBuffer {
+    /// Targets of `width` x `height`; `scene_layout` is set 0 (`SceneGpu::layout`).
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene_layout: &DescriptorSetLayout,
+        width: u32,
+        height: u32,
+    ) -> VkResult<Self> {
+        let color_usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
+            | vk::ImageUsageFlags::STORAGE
+            | vk::ImageUsageFlags::SAMPLED;
+        let position = Image::new(
+            ctx,
+            "gbuffer position",
+            ImageDesc::new_2d(width, height, POSITION_FORMAT, color_usage),
+        )?;
+        let normal = Image::new(
+            ctx,
+            "gbuffer normal+material",
+            ImageDesc::new_2d(width, height, NORMAL_FORMAT, color_usage),
+        )?;
+        let depth = Image::new(
+            ctx,
+            "gbuffer depth",
+            ImageDesc::new_2d(
+                width,
+                height,
+                DEPTH_FORMAT,
+                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+            ),
+        )?;
+        let mut desc = GraphicsPipelineDesc::new("passes/gbuffer.vert", "passes/gbuffer.frag");
+        desc.color_formats = vec![POSITION_FORMAT, NORMAL_FORMAT];
+        desc.depth_format = Some(DEPTH_FORMAT);
+        desc.depth_test = true;
+        desc.depth_write = true;
+        // Two-sided surfaces: no culling; the fragment shader flips normals.
+        desc.cull = vk::CullModeFlags::NONE;
+        let pipeline = GraphicsPipeline::new(ctx, &desc, &[scene_layout])?;
+        Ok(Self {
+            position,
+            normal,
+            depth,
+            pipeline,
+        })
+    }
+
+    pub fn extent(&self) -> vk::Extent2D {
+        self.position.extent()
+    }
+
+    /// Records the pass "gbuffer". Afterwards the targets' last access is
+    /// `ColorAttachment`/`DepthAttachment`; readers declare theirs with `barrier`.
+    pub fn record(&self, rec: &mut FrameRecorder, scene: &SceneGpu) {
+        let ctx = rec.ctx().clone();
+        rec.pass("gbuffer", |cmd| {
+            // Every target is cleared and redrawn, so earlier contents are
+            // discarded; the barrier still waits for last frame's readers
+            // (write-after-read). The triangle buffer is read by the vertex
+            // shader: any earlier write to it (upload, refit) must be visible.
+            barrier(
+                &ctx,
+                cmd,
+                &[
+                    ImageAccess::discard(&self.position, Access::ColorAttachment),
+                    ImageAccess::discard(&self.normal, Access::ColorAttachment),
+                    ImageAccess::discard(&self.depth, Access::DepthAttachment),
+                ],
+                &[BufferAccess::new(&scene.triangles, Access::VertexRead)],
+            );
+            let extent = self.extent();
+            begin_rendering(
+                &ctx,
+                cmd,
+                extent,
+                &[
+                    (self.position.view, Some([0.0; 4])),
+                    (self.normal.view, Some([0.0; 4])),
+                ],
+                Some(self.depth.view),
+            );
+            if scene.triangle_count > 0 {
+                self.pipeline.bind(cmd, &[&scene.set], &[], extent);
+                unsafe { ctx.device.cmd_draw(cmd, 3 * scene.triangle_count, 1, 0, 0) };
+            }
+            end_rendering(&ctx, cmd);
+        });
+    }
+}
