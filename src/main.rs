@@ -13,7 +13,11 @@ use std::process::ExitCode;
 use std::sync::Arc;
 
 #[derive(Parser)]
-#[command(name = "caustics", version, about = "Real-time caustics techniques on Vulkan, side by side against a GPU ground truth")]
+#[command(
+    name = "caustics",
+    version,
+    about = "Real-time caustics techniques on Vulkan, side by side against a GPU ground truth"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -107,7 +111,9 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).format_timestamp(None).init();
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
+        .format_timestamp(None)
+        .init();
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
@@ -119,7 +125,10 @@ fn main() -> ExitCode {
 }
 
 fn context(args: &DeviceArgs) -> anyhow::Result<Arc<Context>> {
-    let options = ContextOptions { validation: args.validate || cfg!(debug_assertions), device: args.device.clone() };
+    let options = ContextOptions {
+        validation: args.validate || cfg!(debug_assertions),
+        device: args.device.clone(),
+    };
     let ctx = Context::new(&options)?;
     eprintln!("device: {} ({})", ctx.info.name, ctx.info.driver.trim());
     Ok(ctx)
@@ -129,7 +138,10 @@ fn context(args: &DeviceArgs) -> anyhow::Result<Arc<Context>> {
 fn check_validation(ctx: &Context) -> anyhow::Result<()> {
     let counts = ctx.validation_counts();
     if counts.errors > 0 {
-        anyhow::bail!("the Vulkan validation layer reported {} error(s) (see the log above)", counts.errors);
+        anyhow::bail!(
+            "the Vulkan validation layer reported {} error(s) (see the log above)",
+            counts.errors
+        );
     }
     Ok(())
 }
@@ -162,18 +174,31 @@ fn print_timings(title: &str, timings: &[PassTiming], source: &str) {
 
 /// Averages per-pass timings over frames (passes matched by position and name).
 fn average(frames: &[Vec<PassTiming>]) -> Vec<PassTiming> {
-    let Some(first) = frames.first() else { return Vec::new() };
+    let Some(first) = frames.first() else {
+        return Vec::new();
+    };
     first
         .iter()
         .enumerate()
         .map(|(i, p)| PassTiming {
             name: p.name.clone(),
-            ms: frames.iter().filter_map(|f| f.get(i)).map(|t| t.ms).sum::<f64>() / frames.len() as f64,
+            ms: frames
+                .iter()
+                .filter_map(|f| f.get(i))
+                .map(|t| t.ms)
+                .sum::<f64>()
+                / frames.len() as f64,
         })
         .collect()
 }
 
-fn write_outputs(out: &Path, width: u32, height: u32, radiance: &[f32], display: &[u8]) -> anyhow::Result<()> {
+fn write_outputs(
+    out: &Path,
+    width: u32,
+    height: u32,
+    radiance: &[f32],
+    display: &[u8],
+) -> anyhow::Result<()> {
     let format = output::format_of(out)?;
     let (exr, png) = match format {
         ImageFormat::Exr => (out.to_path_buf(), output::sibling(out, ImageFormat::Png)),
@@ -184,7 +209,11 @@ fn write_outputs(out: &Path, width: u32, height: u32, radiance: &[f32], display:
     }
     output::write_exr(&exr, width, height, radiance)?;
     output::write_png(&png, width, height, display)?;
-    println!("wrote {} (linear radiance) and {} (tonemapped)", exr.display(), png.display());
+    println!(
+        "wrote {} (linear radiance) and {} (tonemapped)",
+        exr.display(),
+        png.display()
+    );
     Ok(())
 }
 
@@ -199,7 +228,10 @@ fn list_techniques() {
             );
         }
     }
-    println!("  {:<14} ground-truth light tracer: run `caustics reference`", "reference");
+    println!(
+        "  {:<14} ground-truth light tracer: run `caustics reference`",
+        "reference"
+    );
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -212,7 +244,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             for d in devices {
                 println!(
                     "[{}] {} ({:?}), Vulkan {}.{}.{}, {}",
-                    d.index, d.name, d.kind, d.api_version.0, d.api_version.1, d.api_version.2, d.driver.trim()
+                    d.index,
+                    d.name,
+                    d.kind,
+                    d.api_version.0,
+                    d.api_version.1,
+                    d.api_version.2,
+                    d.driver.trim()
                 );
                 for (f, ok) in &d.features {
                     println!("    {} {}", if *ok { "yes" } else { "NO " }, f.name());
@@ -220,7 +258,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Render { scene, technique, params, frames, out, device } => {
+        Command::Render {
+            scene,
+            technique,
+            params,
+            frames,
+            out,
+            device,
+        } => {
             if technique == "list" {
                 list_techniques();
                 return Ok(());
@@ -234,24 +279,46 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             let loaded = load_scene(&scene.scene)?;
             let ctx = context(&device)?;
-            let mut renderer = Renderer::new(&ctx, loaded, &technique, &params, scene.width, scene.height, scene.time)?;
+            let mut renderer = Renderer::new(
+                &ctx,
+                loaded,
+                &technique,
+                &params,
+                scene.width,
+                scene.height,
+                scene.time,
+            )?;
             let mut all = Vec::new();
             for i in 0..frames {
                 all.push(renderer.render_frame(scene.time + i as f32 / 60.0)?);
             }
-            let title = format!("{} at {}x{}, {} frame(s), mean per pass", technique, scene.width, scene.height, frames);
+            let title = format!(
+                "{} at {}x{}, {} frame(s), mean per pass",
+                technique, scene.width, scene.height, frames
+            );
             print_timings(&title, &average(&all), renderer.profiler.source.describe());
             let stats = renderer.scene_gpu.stats;
             println!(
                 "geometry: {} triangles, BVH {} nodes ({} leaves, depth {}) built in {:.1} ms",
-                stats.triangles, stats.bvh_nodes, stats.bvh_leaves, stats.bvh_depth, stats.bvh_build_ms
+                stats.triangles,
+                stats.bvh_nodes,
+                stats.bvh_leaves,
+                stats.bvh_depth,
+                stats.bvh_build_ms
             );
             let radiance = renderer.radiance()?;
             let display = renderer.display()?;
             check_validation(&ctx)?;
             write_outputs(&out, scene.width, scene.height, &radiance, &display)
         }
-        Command::Reference { scene, photons, component, diffuse_bounces, out, device } => {
+        Command::Reference {
+            scene,
+            photons,
+            component,
+            diffuse_bounces,
+            out,
+            device,
+        } => {
             check_size(&scene)?;
             output::format_of(&out)?;
             let component = Component::parse(&component)?;
@@ -260,12 +327,24 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             let loaded = load_scene(&scene.scene)?;
             let ctx = context(&device)?;
-            let settings = ReferenceSettings { diffuse_bounces, ..Default::default() };
-            let mut reference = ReferenceRenderer::new(&ctx, loaded, scene.width, scene.height, scene.time, settings)?;
+            let settings = ReferenceSettings {
+                diffuse_bounces,
+                ..Default::default()
+            };
+            let mut reference = ReferenceRenderer::new(
+                &ctx,
+                loaded,
+                scene.width,
+                scene.height,
+                scene.time,
+                settings,
+            )?;
             let bar = indicatif::ProgressBar::new(photons);
             bar.set_style(
-                indicatif::ProgressStyle::with_template("{bar:40} {percent:>3}% {human_pos}/{human_len} photons, {per_sec}, eta {eta}")
-                    .context("progress style")?,
+                indicatif::ProgressStyle::with_template(
+                    "{bar:40} {percent:>3}% {human_pos}/{human_len} photons, {per_sec}, eta {eta}",
+                )
+                .context("progress style")?,
             );
             reference.trace(photons, |done, _| bar.set_position(done))?;
             bar.finish_and_clear();
@@ -281,7 +360,15 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             check_validation(&ctx)?;
             write_outputs(&out, scene.width, scene.height, &radiance, &display)
         }
-        Command::Bench { scene, technique, params, frames, warmup, json, device } => {
+        Command::Bench {
+            scene,
+            technique,
+            params,
+            frames,
+            warmup,
+            json,
+            device,
+        } => {
             let info = techniques::find(&technique)?;
             let params = Params::resolve(&technique, info.params, &params)?;
             check_size(&scene)?;
@@ -290,7 +377,15 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             let loaded = load_scene(&scene.scene)?;
             let ctx = context(&device)?;
-            let mut renderer = Renderer::new(&ctx, loaded, &technique, &params, scene.width, scene.height, scene.time)?;
+            let mut renderer = Renderer::new(
+                &ctx,
+                loaded,
+                &technique,
+                &params,
+                scene.width,
+                scene.height,
+                scene.time,
+            )?;
             for i in 0..warmup {
                 renderer.render_frame(scene.time + i as f32 / 60.0)?;
             }
@@ -314,7 +409,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 warmup
             );
             print_timings(&title, &passes, renderer.profiler.source.describe());
-            println!("  {:<28} {:>9.3} ms (host wall clock, submit to fence)", "frame", frame_mean);
+            println!(
+                "  {:<28} {:>9.3} ms (host wall clock, submit to fence)",
+                "frame", frame_mean
+            );
             if let Some(path) = json {
                 let report = serde_json::json!({
                     "device": ctx.info.name,

@@ -5,8 +5,8 @@
 use crate::renderer::{FrameTargets, SceneGpu};
 use crate::shader_bindings as b;
 use crate::vk::{
-    barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline, Context, DescriptorSet,
-    DescriptorSetLayout, FrameRecorder, ImageAccess, VkResult,
+    barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline, Context,
+    DescriptorSet, DescriptorSetLayout, FrameRecorder, ImageAccess, VkResult,
 };
 use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
@@ -39,14 +39,22 @@ impl Component {
     ];
 
     pub fn parse(name: &str) -> anyhow::Result<Component> {
-        Self::NAMED.iter().find(|(n, _)| *n == name).map(|(_, c)| *c).ok_or_else(|| {
-            let names: Vec<_> = Self::NAMED.iter().map(|(n, _)| *n).collect();
-            anyhow::anyhow!("unknown component `{name}`; one of: {}", names.join(", "))
-        })
+        Self::NAMED
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, c)| *c)
+            .ok_or_else(|| {
+                let names: Vec<_> = Self::NAMED.iter().map(|(n, _)| *n).collect();
+                anyhow::anyhow!("unknown component `{name}`; one of: {}", names.join(", "))
+            })
     }
 
     pub fn name(self) -> &'static str {
-        Self::NAMED.iter().find(|(_, c)| *c == self).map(|(n, _)| *n).unwrap_or("all")
+        Self::NAMED
+            .iter()
+            .find(|(_, c)| *c == self)
+            .map(|(n, _)| *n)
+            .unwrap_or("all")
     }
 
     fn index(self) -> u32 {
@@ -73,7 +81,11 @@ pub struct ReferenceSettings {
 
 impl Default for ReferenceSettings {
     fn default() -> Self {
-        Self { batch: 1 << 18, max_depth: 32, diffuse_bounces: 0 }
+        Self {
+            batch: 1 << 18,
+            max_depth: 32,
+            diffuse_bounces: 0,
+        }
     }
 }
 
@@ -110,10 +122,19 @@ pub struct Reference {
 }
 
 impl Reference {
-    pub fn new(ctx: &Arc<Context>, scene_gpu: &SceneGpu, targets: &FrameTargets, settings: ReferenceSettings) -> VkResult<Self> {
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene_gpu: &SceneGpu,
+        targets: &FrameTargets,
+        settings: ReferenceSettings,
+    ) -> VkResult<Self> {
         let layout = DescriptorSetLayout::new(
             ctx,
-            &[(0, BindingKind::Storage), (1, BindingKind::Storage), (2, BindingKind::StorageImage)],
+            &[
+                (0, BindingKind::Storage),
+                (1, BindingKind::Storage),
+                (2, BindingKind::StorageImage),
+            ],
         )?;
         let sets = [&scene_gpu.layout, &layout];
         let push = std::mem::size_of::<Push>() as u32;
@@ -121,11 +142,22 @@ impl Reference {
         let camera = ComputePipeline::new(ctx, "reference/camera.comp", &sets, push)?;
         let resolve = ComputePipeline::new(ctx, "reference/resolve.comp", &sets, push)?;
         let pixels = targets.width as u64 * targets.height as u64;
-        let photon_accum =
-            Buffer::new(ctx, "reference photon sums", pixels * 3 * 4 * b::COMPONENT_COUNT as u64, BufferUsage::Storage)?;
-        let camera_accum = Buffer::new(ctx, "reference camera sums", pixels * 3 * 4, BufferUsage::Storage)?;
+        let photon_accum = Buffer::new(
+            ctx,
+            "reference photon sums",
+            pixels * 3 * 4 * b::COMPONENT_COUNT as u64,
+            BufferUsage::Storage,
+        )?;
+        let camera_accum = Buffer::new(
+            ctx,
+            "reference camera sums",
+            pixels * 3 * 4,
+            BufferUsage::Storage,
+        )?;
         let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_buffer(0, &photon_accum).write_buffer(1, &camera_accum).write_storage_image(2, &targets.radiance);
+        set.write_buffer(0, &photon_accum)
+            .write_buffer(1, &camera_accum)
+            .write_storage_image(2, &targets.radiance);
         Ok(Self {
             trace,
             camera,
@@ -164,10 +196,15 @@ impl Reference {
                 &ctx,
                 cmd,
                 &[],
-                &[BufferAccess::new(&self.photon_accum, Access::TransferWrite), BufferAccess::new(&self.camera_accum, Access::TransferWrite)],
+                &[
+                    BufferAccess::new(&self.photon_accum, Access::TransferWrite),
+                    BufferAccess::new(&self.camera_accum, Access::TransferWrite),
+                ],
             );
-            ctx.device.cmd_fill_buffer(cmd, self.photon_accum.raw, 0, ash::vk::WHOLE_SIZE, 0);
-            ctx.device.cmd_fill_buffer(cmd, self.camera_accum.raw, 0, ash::vk::WHOLE_SIZE, 0);
+            ctx.device
+                .cmd_fill_buffer(cmd, self.photon_accum.raw, 0, ash::vk::WHOLE_SIZE, 0);
+            ctx.device
+                .cmd_fill_buffer(cmd, self.camera_accum.raw, 0, ash::vk::WHOLE_SIZE, 0);
         });
         self.photons = 0;
         self.camera_passes = 0;
@@ -181,19 +218,45 @@ impl Reference {
         let push = self.push(seed, Component::All);
         let sets = [&scene_gpu.set, &self.set];
         rec.pass("reference photons", |cmd| {
-            barrier(&ctx, cmd, &[], &[BufferAccess::new(&self.photon_accum, Access::ComputeWrite)]);
-            self.trace.dispatch(cmd, &sets, bytemuck::bytes_of(&push), [self.settings.batch.div_ceil(64), 1, 1]);
+            barrier(
+                &ctx,
+                cmd,
+                &[],
+                &[BufferAccess::new(&self.photon_accum, Access::ComputeWrite)],
+            );
+            self.trace.dispatch(
+                cmd,
+                &sets,
+                bytemuck::bytes_of(&push),
+                [self.settings.batch.div_ceil(64), 1, 1],
+            );
         });
         rec.pass("reference camera chains", |cmd| {
-            barrier(&ctx, cmd, &[], &[BufferAccess::new(&self.camera_accum, Access::ComputeWrite)]);
-            self.camera.dispatch(cmd, &sets, bytemuck::bytes_of(&push), [self.width.div_ceil(8), self.height.div_ceil(8), 1]);
+            barrier(
+                &ctx,
+                cmd,
+                &[],
+                &[BufferAccess::new(&self.camera_accum, Access::ComputeWrite)],
+            );
+            self.camera.dispatch(
+                cmd,
+                &sets,
+                bytemuck::bytes_of(&push),
+                [self.width.div_ceil(8), self.height.div_ceil(8), 1],
+            );
         });
         self.photons += self.settings.batch.div_ceil(64) as u64 * 64;
         self.camera_passes += 1;
     }
 
     /// Resolves `component` into the frame's radiance image.
-    pub fn record_resolve(&self, rec: &mut FrameRecorder, scene_gpu: &SceneGpu, targets: &FrameTargets, component: Component) {
+    pub fn record_resolve(
+        &self,
+        rec: &mut FrameRecorder,
+        scene_gpu: &SceneGpu,
+        targets: &FrameTargets,
+        component: Component,
+    ) {
         let ctx = rec.ctx().clone();
         let push = self.push(0, component);
         let sets = [&scene_gpu.set, &self.set];
@@ -201,10 +264,21 @@ impl Reference {
             barrier(
                 &ctx,
                 cmd,
-                &[ImageAccess::discard(&targets.radiance, Access::ComputeWrite)],
-                &[BufferAccess::new(&self.photon_accum, Access::ComputeRead), BufferAccess::new(&self.camera_accum, Access::ComputeRead)],
+                &[ImageAccess::discard(
+                    &targets.radiance,
+                    Access::ComputeWrite,
+                )],
+                &[
+                    BufferAccess::new(&self.photon_accum, Access::ComputeRead),
+                    BufferAccess::new(&self.camera_accum, Access::ComputeRead),
+                ],
             );
-            self.resolve.dispatch(cmd, &sets, bytemuck::bytes_of(&push), [self.width.div_ceil(8), self.height.div_ceil(8), 1]);
+            self.resolve.dispatch(
+                cmd,
+                &sets,
+                bytemuck::bytes_of(&push),
+                [self.width.div_ceil(8), self.height.div_ceil(8), 1],
+            );
         });
     }
 }
@@ -242,7 +316,16 @@ impl ReferenceRenderer {
             reference.record_clear(rec);
             Ok(())
         })?;
-        Ok(Self { ctx: ctx.clone(), scene, scene_gpu, targets, tonemap, profiler, reference, trace_seconds: 0.0 })
+        Ok(Self {
+            ctx: ctx.clone(),
+            scene,
+            scene_gpu,
+            targets,
+            tonemap,
+            profiler,
+            reference,
+            trace_seconds: 0.0,
+        })
     }
 
     /// Traces at least `photons` more photons in batches; `progress(done, total)`

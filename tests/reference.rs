@@ -16,7 +16,12 @@ fn point_light_on_plane_matches_inverse_square_law() {
     let light = Vec3::new(0.3, 2.0, 0.2);
     let intensity = 10.0;
     let albedo = 0.6;
-    let s = scene(cam, vec![point_light(light, intensity)], vec![diffuse("floor", albedo)], vec![object("floor", floor_mesh(20.0, 0.0, 0))]);
+    let s = scene(
+        cam,
+        vec![point_light(light, intensity)],
+        vec![diffuse("floor", albedo)],
+        vec![object("floor", floor_mesh(20.0, 0.0, 0))],
+    );
     let mut r = ReferenceRenderer::new(&ctx, s, w, h, 0.0, ReferenceSettings::default()).unwrap();
     let start = std::time::Instant::now();
     r.trace(8_000_000, |_, _| {}).unwrap();
@@ -142,7 +147,10 @@ fn glass_slab_transmits_one_minus_fresnel_squared() {
         vec![diffuse("floor", albedo), dielectric("glass", n)],
         vec![
             object("floor", floor_mesh(4.0, 0.0, 0)),
-            object("slab", box_mesh(Vec3::new(-3.0, 1.0, -3.0), Vec3::new(3.0, 1.2, 3.0), 1)),
+            object(
+                "slab",
+                box_mesh(Vec3::new(-3.0, 1.0, -3.0), Vec3::new(3.0, 1.2, 3.0), 1),
+            ),
         ],
     );
     let mut r = ReferenceRenderer::new(&ctx, s, w, h, 0.0, ReferenceSettings::default()).unwrap();
@@ -166,10 +174,15 @@ fn glass_slab_transmits_one_minus_fresnel_squared() {
     let expected = (albedo / std::f32::consts::PI * irradiance * (1.0 - f).powi(2)) as f64;
     let mean = measured / count as f64;
     let rel = ((mean - expected) / expected).abs();
-    eprintln!("slab: {count} pixels, mean {mean:.5}, expected {expected:.5}, relative error {rel:.4}");
+    eprintln!(
+        "slab: {count} pixels, mean {mean:.5}, expected {expected:.5}, relative error {rel:.4}"
+    );
     assert!(count > 500, "the test region must be visible");
     assert!(rel < 0.01, "transmitted radiance off by {rel}");
-    assert!(direct_sum == 0.0, "no direct light reaches the floor under the slab");
+    assert!(
+        direct_sum == 0.0,
+        "no direct light reaches the floor under the slab"
+    );
     assert_validation_clean(&ctx);
 }
 
@@ -197,17 +210,25 @@ fn ball_lens_focuses_at_paraxial_focal_length() {
     let mut samples = Vec::new();
     for k in [0.85f32, 0.925, 1.0, 1.075, 1.15] {
         let floor_y = centre_y - v * k;
-        let cam = camera(Vec3::new(0.0, floor_y + 0.25, 1.2), Vec3::new(0.0, floor_y, 0.0), 12.0);
+        let cam = camera(
+            Vec3::new(0.0, floor_y + 0.25, 1.2),
+            Vec3::new(0.0, floor_y, 0.0),
+            12.0,
+        );
         let s = scene(
             cam,
             vec![light],
             vec![diffuse("floor", 0.8), dielectric("glass", n)],
             vec![
                 object("floor", floor_mesh(3.0, floor_y, 0)),
-                object("ball", sphere_mesh(Vec3::new(0.0, centre_y, 0.0), radius, 1, 96)),
+                object(
+                    "ball",
+                    sphere_mesh(Vec3::new(0.0, centre_y, 0.0), radius, 1, 96),
+                ),
             ],
         );
-        let mut r = ReferenceRenderer::new(&ctx, s, w, h, 0.0, ReferenceSettings::default()).unwrap();
+        let mut r =
+            ReferenceRenderer::new(&ctx, s, w, h, 0.0, ReferenceSettings::default()).unwrap();
         r.trace(1_000_000, |_, _| {}).unwrap();
         let img = r.resolve(Component::SurfaceCaustics).unwrap();
         assert_finite(&img);
@@ -233,35 +254,29 @@ fn ball_lens_focuses_at_paraxial_focal_length() {
         eprintln!("floor at {k:.3} v: RMS spot radius {:.4} m", rms2.sqrt());
         samples.push((k as f64, rms2));
     }
-    // Least-squares parabola rms^2 = a k^2 + b k + c; minimum at -b / 2a.
-    let (mut s) = [[0.0f64; 4]; 3];
-    for &(k, y) in &samples {
-        let row = [k * k, k, 1.0];
-        for i in 0..3 {
-            for j in 0..3 {
-                s[i][j] += row[i] * row[j];
-            }
-            s[i][3] += row[i] * y;
-        }
-    }
-    for i in 0..3 {
-        let p = s[i][i];
-        for j in i..4 {
-            s[i][j] /= p;
-        }
-        for r in 0..3 {
-            if r != i {
-                let factor = s[r][i];
-                for j in i..4 {
-                    s[r][j] -= factor * s[i][j];
-                }
-            }
-        }
-    }
-    let (a, b) = (s[0][3], s[1][3]);
+    let (a, b) = fit_parabola(&samples);
     let best = -b / (2.0 * a);
     eprintln!("best focus at {best:.4} v (v = {v:.4} m from the centre, f = {f})");
     assert!(a > 0.0, "the spot must shrink then grow");
     assert!((best - 1.0).abs() < 0.05, "focus at {best} v");
     assert_validation_clean(&ctx);
+}
+
+/// Least-squares parabola y = a x^2 + b x + c through the samples; returns (a, b)
+/// (normal equations solved by Cramer's rule).
+fn fit_parabola(samples: &[(f64, f64)]) -> (f64, f64) {
+    let sum = |f: &dyn Fn(f64, f64) -> f64| samples.iter().map(|&(x, y)| f(x, y)).sum::<f64>();
+    let (s0, s1, s2) = (samples.len() as f64, sum(&|x, _| x), sum(&|x, _| x * x));
+    let (s3, s4) = (sum(&|x, _| x * x * x), sum(&|x, _| x * x * x * x));
+    let (t0, t1, t2) = (sum(&|_, y| y), sum(&|x, y| x * y), sum(&|x, y| x * x * y));
+    let det3 = |m: [[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let m = [[s4, s3, s2], [s3, s2, s1], [s2, s1, s0]];
+    let d = det3(m);
+    let a = det3([[t2, s3, s2], [t1, s2, s1], [t0, s1, s0]]) / d;
+    let b = det3([[s4, t2, s2], [s3, t1, s1], [s2, t0, s0]]) / d;
+    (a, b)
 }

@@ -403,7 +403,11 @@ impl Context {
         ];
         // Swapchains only when the instance has surface extensions (the demo):
         // VK_KHR_swapchain requires VK_KHR_surface on the instance.
-        let extensions = if instance_extensions.is_empty() { &extensions[..1] } else { &extensions[..] };
+        let extensions = if instance_extensions.is_empty() {
+            &extensions[..1]
+        } else {
+            &extensions[..]
+        };
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_info)
             .enabled_features(&features)
@@ -476,7 +480,11 @@ impl Context {
 
     /// The first validation error messages (at most 16).
     pub fn validation_errors(&self) -> Vec<String> {
-        self.counters.first_errors.lock().map(|v| v.clone()).unwrap_or_default()
+        self.counters
+            .first_errors
+            .lock()
+            .map(|v| v.clone())
+            .unwrap_or_default()
     }
 
     /// True when the device is a CPU implementation (lavapipe), whose timestamps

@@ -11,7 +11,11 @@ use std::sync::Arc;
 
 /// A context with the Khronos validation layer on; tests end with `assert_validation_clean`.
 pub fn validated_context() -> Arc<Context> {
-    Context::new(&ContextOptions { validation: true, device: None }).expect("Vulkan context with validation")
+    Context::new(&ContextOptions {
+        validation: true,
+        device: None,
+    })
+    .expect("Vulkan context with validation")
 }
 
 pub fn assert_validation_clean(ctx: &Context) {
@@ -26,11 +30,23 @@ pub fn assert_validation_clean(ctx: &Context) {
 }
 
 pub fn diffuse(name: &str, albedo: f32) -> Material {
-    Material { name: name.into(), kind: MaterialKind::Diffuse, color: Vec3::splat(albedo), ior: 1.0, absorption: Vec3::ZERO }
+    Material {
+        name: name.into(),
+        kind: MaterialKind::Diffuse,
+        color: Vec3::splat(albedo),
+        ior: 1.0,
+        absorption: Vec3::ZERO,
+    }
 }
 
 pub fn dielectric(name: &str, ior: f32) -> Material {
-    Material { name: name.into(), kind: MaterialKind::Dielectric, color: Vec3::ONE, ior, absorption: Vec3::ZERO }
+    Material {
+        name: name.into(),
+        kind: MaterialKind::Dielectric,
+        color: Vec3::ONE,
+        ior,
+        absorption: Vec3::ZERO,
+    }
 }
 
 /// An axis-aligned rectangle at height `y`, normal +y, centred on the origin.
@@ -52,12 +68,60 @@ pub fn floor_mesh(half: f32, y: f32, material: u32) -> Mesh {
 pub fn box_mesh(min: Vec3, max: Vec3, material: u32) -> Mesh {
     let mut m = Mesh::default();
     let faces: [(Vec3, [Vec3; 4]); 6] = [
-        (Vec3::X, [Vec3::new(max.x, min.y, min.z), Vec3::new(max.x, max.y, min.z), Vec3::new(max.x, max.y, max.z), Vec3::new(max.x, min.y, max.z)]),
-        (Vec3::NEG_X, [Vec3::new(min.x, min.y, max.z), Vec3::new(min.x, max.y, max.z), Vec3::new(min.x, max.y, min.z), Vec3::new(min.x, min.y, min.z)]),
-        (Vec3::Y, [Vec3::new(min.x, max.y, min.z), Vec3::new(min.x, max.y, max.z), Vec3::new(max.x, max.y, max.z), Vec3::new(max.x, max.y, min.z)]),
-        (Vec3::NEG_Y, [Vec3::new(min.x, min.y, max.z), Vec3::new(min.x, min.y, min.z), Vec3::new(max.x, min.y, min.z), Vec3::new(max.x, min.y, max.z)]),
-        (Vec3::Z, [Vec3::new(max.x, min.y, max.z), Vec3::new(max.x, max.y, max.z), Vec3::new(min.x, max.y, max.z), Vec3::new(min.x, min.y, max.z)]),
-        (Vec3::NEG_Z, [Vec3::new(min.x, min.y, min.z), Vec3::new(min.x, max.y, min.z), Vec3::new(max.x, max.y, min.z), Vec3::new(max.x, min.y, min.z)]),
+        (
+            Vec3::X,
+            [
+                Vec3::new(max.x, min.y, min.z),
+                Vec3::new(max.x, max.y, min.z),
+                Vec3::new(max.x, max.y, max.z),
+                Vec3::new(max.x, min.y, max.z),
+            ],
+        ),
+        (
+            Vec3::NEG_X,
+            [
+                Vec3::new(min.x, min.y, max.z),
+                Vec3::new(min.x, max.y, max.z),
+                Vec3::new(min.x, max.y, min.z),
+                Vec3::new(min.x, min.y, min.z),
+            ],
+        ),
+        (
+            Vec3::Y,
+            [
+                Vec3::new(min.x, max.y, min.z),
+                Vec3::new(min.x, max.y, max.z),
+                Vec3::new(max.x, max.y, max.z),
+                Vec3::new(max.x, max.y, min.z),
+            ],
+        ),
+        (
+            Vec3::NEG_Y,
+            [
+                Vec3::new(min.x, min.y, max.z),
+                Vec3::new(min.x, min.y, min.z),
+                Vec3::new(max.x, min.y, min.z),
+                Vec3::new(max.x, min.y, max.z),
+            ],
+        ),
+        (
+            Vec3::Z,
+            [
+                Vec3::new(max.x, min.y, max.z),
+                Vec3::new(max.x, max.y, max.z),
+                Vec3::new(min.x, max.y, max.z),
+                Vec3::new(min.x, min.y, max.z),
+            ],
+        ),
+        (
+            Vec3::NEG_Z,
+            [
+                Vec3::new(min.x, min.y, min.z),
+                Vec3::new(min.x, max.y, min.z),
+                Vec3::new(max.x, max.y, min.z),
+                Vec3::new(max.x, min.y, min.z),
+            ],
+        ),
     ];
     for (n, corners) in faces {
         let base = m.positions.len() as u32;
@@ -88,7 +152,11 @@ pub fn sphere_mesh(center: Vec3, radius: f32, material: u32, segments: u32) -> M
         let theta = std::f32::consts::PI * j as f32 / nv as f32;
         for i in 0..=nu {
             let phi = 2.0 * std::f32::consts::PI * i as f32 / nu as f32;
-            let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            let n = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            );
             m.positions.push(center + n * radius);
             m.normals.push(n);
         }
@@ -112,7 +180,12 @@ pub fn sphere_mesh(center: Vec3, radius: f32, material: u32, segments: u32) -> M
 }
 
 pub fn object(name: &str, mesh: Mesh) -> Object {
-    Object { name: name.into(), mesh, transform: Mat4::IDENTITY, animation: None }
+    Object {
+        name: name.into(),
+        mesh,
+        transform: Mat4::IDENTITY,
+        animation: None,
+    }
 }
 
 pub fn point_light(position: Vec3, intensity: f32) -> Light {
@@ -137,7 +210,12 @@ pub fn directional_light(direction: Vec3, irradiance: f32) -> Light {
     }
 }
 
-pub fn scene(camera: Camera, lights: Vec<Light>, materials: Vec<Material>, objects: Vec<Object>) -> Scene {
+pub fn scene(
+    camera: Camera,
+    lights: Vec<Light>,
+    materials: Vec<Material>,
+    objects: Vec<Object>,
+) -> Scene {
     Scene {
         source: PathBuf::from("<test>"),
         camera,
@@ -150,7 +228,12 @@ pub fn scene(camera: Camera, lights: Vec<Light>, materials: Vec<Material>, objec
 }
 
 pub fn camera(eye: Vec3, target: Vec3, fov_y_deg: f32) -> Camera {
-    Camera { eye, target, up: Vec3::Y, fov_y_deg }
+    Camera {
+        eye,
+        target,
+        up: Vec3::Y,
+        fov_y_deg,
+    }
 }
 
 /// The world-space ray through the centre of pixel (px, py) (row 0 at the top).
