@@ -118,10 +118,28 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", describe(&e));
             ExitCode::FAILURE
         }
     }
+}
+
+/// The error and its causes on one line, like `{e:#}`, but without repeating a
+/// cause that a message already quotes (`SceneError::Read` and `VkError`
+/// variants put their source in their own message and also report it as the
+/// source, which `{e:#}` printed twice).
+fn describe(e: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in e.chain() {
+        let m = cause.to_string();
+        if line.is_empty() {
+            line = m;
+        } else if !line.contains(&m) {
+            line.push_str(": ");
+            line.push_str(&m);
+        }
+    }
+    line
 }
 
 fn context(args: &DeviceArgs) -> anyhow::Result<Arc<Context>> {
