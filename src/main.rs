@@ -1,7 +1,7 @@
 //! The `caustics` command line: render, reference, bench, info.
 
 use anyhow::Context as _;
-use caustics::output::{self, ImageFormat};
+use caustics::output;
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use caustics::renderer::Renderer;
 use caustics::scene::{Scene, DEFAULT_SCENE};
@@ -118,10 +118,28 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", describe(&e));
             ExitCode::FAILURE
         }
     }
+}
+
+/// The error and its causes on one line, like `{e:#}`, but without repeating a
+/// cause that a message already quotes (`SceneError::Read` and `VkError`
+/// variants put their source in their own message and also report it as the
+/// source, which `{e:#}` printed twice).
+fn describe(e: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in e.chain() {
+        let m = cause.to_string();
+        if line.is_empty() {
+            line = m;
+        } else if !line.contains(&m) {
+            line.push_str(": ");
+            line.push_str(&m);
+        }
+    }
+    line
 }
 
 fn context(args: &DeviceArgs) -> anyhow::Result<Arc<Context>> {
@@ -192,23 +210,22 @@ fn average(frames: &[Vec<PassTiming>]) -> Vec<PassTiming> {
         .collect()
 }
 
+/// Writes both images, or neither: when the PNG fails the EXR just written is removed.
 fn write_outputs(
-    out: &Path,
+    (exr, png): &(PathBuf, PathBuf),
     width: u32,
     height: u32,
     radiance: &[f32],
     display: &[u8],
 ) -> anyhow::Result<()> {
-    let format = output::format_of(out)?;
-    let (exr, png) = match format {
-        ImageFormat::Exr => (out.to_path_buf(), output::sibling(out, ImageFormat::Png)),
-        ImageFormat::Png => (output::sibling(out, ImageFormat::Exr), out.to_path_buf()),
-    };
     if radiance.iter().any(|v| !v.is_finite()) {
         anyhow::bail!("the rendered radiance contains NaN or Inf; no image written");
     }
-    output::write_exr(&exr, width, height, radiance)?;
-    output::write_png(&png, width, height, display)?;
+    output::write_exr(exr, width, height, radiance)?;
+    if let Err(e) = output::write_png(png, width, height, display) {
+        let _ = std::fs::remove_file(exr);
+        return Err(e);
+    }
     println!(
         "wrote {} (linear radiance) and {} (tonemapped)",
         exr.display(),
@@ -278,6 +295,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 anyhow::bail!("--frames must be at least 1");
             }
             let loaded = load_scene(&scene.scene)?;
+            let outputs = output::prepare(&out)?;
             let ctx = context(&device)?;
             let mut renderer = Renderer::new(
                 &ctx,
@@ -309,7 +327,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let radiance = renderer.radiance()?;
             let display = renderer.display()?;
             check_validation(&ctx)?;
-            write_outputs(&out, scene.width, scene.height, &radiance, &display)
+            write_outputs(&outputs, scene.width, scene.height, &radiance, &display)
         }
         Command::Reference {
             scene,
@@ -326,6 +344,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 anyhow::bail!("--photons must be at least 1");
             }
             let loaded = load_scene(&scene.scene)?;
+            let outputs = output::prepare(&out)?;
             let ctx = context(&device)?;
             let settings = ReferenceSettings {
                 diffuse_bounces,
@@ -358,7 +377,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let radiance = reference.resolve(component)?;
             let display = reference.display()?;
             check_validation(&ctx)?;
-            write_outputs(&out, scene.width, scene.height, &radiance, &display)
+            write_outputs(&outputs, scene.width, scene.height, &radiance, &display)
         }
         Command::Bench {
             scene,

@@ -36,6 +36,31 @@ pub fn sibling(path: &Path, format: ImageFormat) -> PathBuf {
     })
 }
 
+/// Checks, before any rendering, that `out` can be written: its format is
+/// known, its folder exists (created if needed) and neither `out` nor its
+/// sibling in the other format is a folder. Returns the (EXR, PNG) paths.
+pub fn prepare(out: &Path) -> anyhow::Result<(PathBuf, PathBuf)> {
+    let (exr, png) = match format_of(out)? {
+        ImageFormat::Exr => (out.to_path_buf(), sibling(out, ImageFormat::Png)),
+        ImageFormat::Png => (sibling(out, ImageFormat::Exr), out.to_path_buf()),
+    };
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| {
+            format!(
+                "--out {}: cannot create folder {}",
+                out.display(),
+                dir.display()
+            )
+        })?;
+    }
+    for p in [&exr, &png] {
+        if p.is_dir() {
+            anyhow::bail!("--out {}: {} is a folder", out.display(), p.display());
+        }
+    }
+    Ok((exr, png))
+}
+
 fn write_atomically(
     path: &Path,
     write: impl FnOnce(&Path) -> anyhow::Result<()>,
@@ -47,9 +72,10 @@ fn write_atomically(
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("img");
     let tmp = path.with_extension(format!("partial.{ext}"));
     match write(&tmp) {
-        Ok(()) => {
-            std::fs::rename(&tmp, path).with_context(|| format!("cannot write {}", path.display()))
-        }
+        Ok(()) => std::fs::rename(&tmp, path).or_else(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            Err(e).with_context(|| format!("cannot write {}", path.display()))
+        }),
         Err(e) => {
             let _ = std::fs::remove_file(&tmp);
             Err(e)
@@ -85,4 +111,24 @@ pub fn read_exr(path: &Path) -> anyhow::Result<(u32, u32, Vec<f32>)> {
         .with_context(|| format!("cannot read {}", path.display()))?
         .into_rgba32f();
     Ok((img.width(), img.height(), img.into_raw()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn failed_rename_leaves_no_partial_file() {
+        let dir = std::env::temp_dir().join(format!("caustics-output-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        // The target is a folder: the temporary file is written, the rename fails.
+        let target = dir.join("x.png");
+        std::fs::create_dir_all(&target).unwrap();
+        let e = write_png(&target, 1, 1, &[0, 0, 0, 255]).expect_err("a folder is in the way");
+        assert!(e.to_string().contains("cannot write"), "{e:#}");
+        assert!(!dir.join("x.partial.png").exists());
+        assert!(prepare(&dir.join("x.exr")).is_err());
+        assert!(prepare(&dir.join("sub/y.exr")).is_ok());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
