@@ -152,9 +152,10 @@ fn context(args: &DeviceArgs) -> anyhow::Result<Arc<Context>> {
     Ok(ctx)
 }
 
-/// Fails the command if the validation layer reported errors.
-fn check_validation(ctx: &Context) -> anyhow::Result<()> {
-    let counts = ctx.validation_counts();
+/// Fails the command if the validation layer reported errors, leaked objects
+/// included: everything that used the device must be dropped before this.
+fn check_validation(ctx: Arc<Context>) -> anyhow::Result<()> {
+    let counts = Context::shutdown(ctx)?;
     if counts.errors > 0 {
         anyhow::bail!(
             "the Vulkan validation layer reported {} error(s) (see the log above)",
@@ -326,7 +327,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             );
             let radiance = renderer.radiance()?;
             let display = renderer.display()?;
-            check_validation(&ctx)?;
+            drop(renderer);
+            check_validation(ctx)?;
             write_outputs(&outputs, scene.width, scene.height, &radiance, &display)
         }
         Command::Reference {
@@ -376,7 +378,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             );
             let radiance = reference.resolve(component)?;
             let display = reference.display()?;
-            check_validation(&ctx)?;
+            drop(reference);
+            check_validation(ctx)?;
             write_outputs(&outputs, scene.width, scene.height, &radiance, &display)
         }
         Command::Bench {
@@ -415,7 +418,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 all.push(renderer.render_frame(scene.time + (warmup + i) as f32 / 60.0)?);
                 frame_ms.push(start.elapsed().as_secs_f64() * 1e3);
             }
-            check_validation(&ctx)?;
+            let (device_name, driver) = (ctx.info.name.clone(), ctx.info.driver.trim().to_string());
+            let (source, stats) = (renderer.profiler.source, renderer.scene_gpu.stats);
+            drop(renderer);
+            check_validation(ctx)?;
             let passes = average(&all);
             let frame_mean = frame_ms.iter().sum::<f64>() / frame_ms.len() as f64;
             let title = format!(
@@ -427,16 +433,16 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 frames,
                 warmup
             );
-            print_timings(&title, &passes, renderer.profiler.source.describe());
+            print_timings(&title, &passes, source.describe());
             println!(
                 "  {:<28} {:>9.3} ms (host wall clock, submit to fence)",
                 "frame", frame_mean
             );
             if let Some(path) = json {
                 let report = serde_json::json!({
-                    "device": ctx.info.name,
-                    "driver": ctx.info.driver.trim(),
-                    "timing_source": renderer.profiler.source.describe(),
+                    "device": device_name,
+                    "driver": driver,
+                    "timing_source": source.describe(),
                     "scene": scene.scene.display().to_string(),
                     "technique": technique,
                     "params": params.iter().map(|(k, v)| (k.clone(), *v)).collect::<std::collections::BTreeMap<_, _>>(),
@@ -446,7 +452,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     "warmup": warmup,
                     "passes_ms": passes,
                     "frame_ms": frame_mean,
-                    "geometry": renderer.scene_gpu.stats,
+                    "geometry": stats,
                 });
                 std::fs::write(&path, serde_json::to_string_pretty(&report)?)
                     .with_context(|| format!("cannot write {}", path.display()))?;

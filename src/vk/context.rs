@@ -118,6 +118,7 @@ pub struct Context {
     messenger: vk::DebugUtilsMessengerEXT,
     counters: Box<Counters>,
     command_pool: vk::CommandPool,
+    destroyed: bool,
 }
 
 unsafe extern "system" fn debug_callback(
@@ -462,6 +463,7 @@ impl Context {
             messenger,
             counters,
             command_pool,
+            destroyed: false,
         }))
     }
 
@@ -608,8 +610,24 @@ fn pick_device(infos: &[DeviceInfo], wanted: Option<&str>) -> VkResult<usize> {
         .unwrap_or(0))
 }
 
-impl Drop for Context {
-    fn drop(&mut self) {
+impl Context {
+    /// Ends the context explicitly: fails if anything still holds it (a
+    /// leaked resource keeps its `Arc<Context>`, which would otherwise keep
+    /// the device alive silently), then destroys the device while the
+    /// messenger still listens, so the validation layer's report of leaked
+    /// objects is counted. Returns the final validation counts.
+    pub fn shutdown(ctx: Arc<Context>) -> VkResult<ValidationCounts> {
+        let mut ctx =
+            Arc::try_unwrap(ctx).map_err(|still| VkError::Leaked(Arc::strong_count(&still) - 1))?;
+        ctx.destroy();
+        Ok(ctx.validation_counts())
+    }
+
+    fn destroy(&mut self) {
+        if self.destroyed {
+            return;
+        }
+        self.destroyed = true;
         unsafe {
             let _ = self.device.device_wait_idle();
             self.device.destroy_command_pool(self.command_pool, None);
@@ -621,5 +639,11 @@ impl Drop for Context {
             }
             self.instance.destroy_instance(None);
         }
+    }
+}
+
+impl Drop for Context {
+    fn drop(&mut self) {
+        self.destroy();
     }
 }

@@ -45,6 +45,8 @@ pub enum VkError {
     DeviceLost,
     #[error("memory allocation failed: {0}")]
     Allocation(#[from] gpu_allocator::AllocationError),
+    #[error("{0} object(s) still held the Vulkan device at shutdown (leaked resources)")]
+    Leaked(usize),
     #[error("Vulkan call failed: {0}")]
     Vulkan(vk::Result),
 }
