@@ -58,3 +58,9 @@ pub const DIRECT_BINDING_NORMAL: u32 = 1;
 pub const DIRECT_BINDING_RADIANCE: u32 = 2;
 pub const DIRECT_BINDING_SHADOW_MAP: u32 = 3;
 pub const DIRECT_BINDING_SHADOW_LIGHTS: u32 = 4;
+
+// BVH probe (glsl/tests/bvh_probe.comp, tests/bvh_gpu.rs), descriptor set 1
+// (set 0 is the scene). Numbers kept from the probe's first version.
+pub const PROBE_BINDING_RAYS: u32 = 10;
+pub const PROBE_BINDING_RESULTS: u32 = 11;
+pub const PROBE_BINDING_ANY: u32 = 12;

@@ -135,6 +135,12 @@ impl SceneGpu {
         })
     }
 
+    /// The BVH the GPU traverses (its `nodes` are the uploaded `bvh_nodes`;
+    /// `triangle_order` maps the uploaded leaf-order triangles to the scene's).
+    pub fn bvh(&self) -> &Bvh {
+        &self.bvh
+    }
+
     /// Re-uploads moved triangles and refits the BVH (animated scenes). The
     /// caller has waited for every frame that read the old geometry.
     pub fn update_geometry(&mut self, scene: &Scene, time: f32) -> VkResult<()> {
