@@ -433,11 +433,34 @@ impl Context {
             debug_settings,
             buffer_device_address: false,
             allocation_sizes: Default::default(),
-        })?;
+        });
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
-        let command_pool = unsafe { device.create_command_pool(&pool_info, None) }?;
+        let pool = unsafe { device.create_command_pool(&pool_info, None) };
+        let (allocator, command_pool) = match (allocator, pool) {
+            (Ok(a), Ok(p)) => (a, p),
+            (allocator, pool) => {
+                // Undo in reverse order so a failed start leaves nothing behind.
+                unsafe {
+                    if let Ok(p) = pool {
+                        device.destroy_command_pool(p, None);
+                    }
+                    let error: VkError = match allocator {
+                        Err(e) => e.into(),
+                        Ok(a) => {
+                            drop(a);
+                            pool.err()
+                                .map(VkError::from)
+                                .unwrap_or(VkError::OutOfMemory)
+                        }
+                    };
+                    device.destroy_device(None);
+                    cleanup(&instance);
+                    return Err(error);
+                }
+            }
+        };
         let debug_device =
             has_debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device));
         log::info!(
