@@ -447,3 +447,87 @@ fn fit_parabola(samples: &[(f64, f64)]) -> (f64, f64) {
     let b = det3([[s4, t2, s2], [s3, t1, s1], [s2, t0, s0]]) / d;
     (a, b)
 }
+
+/// Camera-side specular chains: a pixel that sees a mirror shows the
+/// directly lit floor it reflects, times the mirror's reflectance
+/// (L D S E, counted in the direct component).
+#[test]
+fn mirror_shows_the_reflected_floor_times_its_reflectance() {
+    let ctx = validated_context();
+    let (w, h) = (64, 64);
+    let cam = camera(Vec3::new(0.0, 1.5, 3.0), Vec3::new(0.0, 1.0, -2.0), 50.0);
+    let (light, intensity, albedo, reflectance) =
+        (Vec3::new(0.0, 2.0, 1.0), 10.0f32, 0.6f32, 0.9f32);
+    // A vertical mirror at z = -2 facing +z, wider and taller than the view.
+    let mirror = caustics::scene::Mesh {
+        positions: vec![
+            Vec3::new(-6.0, 0.0, -2.0),
+            Vec3::new(6.0, 0.0, -2.0),
+            Vec3::new(6.0, 6.0, -2.0),
+            Vec3::new(-6.0, 6.0, -2.0),
+        ],
+        normals: vec![Vec3::Z; 4],
+        indices: vec![[0, 1, 2], [0, 2, 3]],
+        materials: vec![1, 1],
+    };
+    let mirror_material = caustics::scene::Material {
+        name: "mirror".into(),
+        kind: caustics::scene::MaterialKind::Mirror,
+        color: Vec3::splat(reflectance),
+        ior: 1.0,
+        absorption: Vec3::ZERO,
+    };
+    let s = scene(
+        cam,
+        vec![point_light(light, intensity)],
+        vec![diffuse("floor", albedo), mirror_material],
+        vec![
+            object("floor", floor_mesh(20.0, 0.0, 0)),
+            object("mirror", mirror),
+        ],
+    );
+    let mut r = ReferenceRenderer::new(
+        &ctx,
+        s,
+        w,
+        h,
+        0.0,
+        ReferenceSettings {
+            batch: 1 << 16,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    r.trace(1 << 20, |_, _| {}).unwrap();
+    let img = r.resolve(Component::Direct).unwrap();
+    assert_finite(&img);
+    let (mut measured, mut expected, mut pixels) = (0.0f64, 0.0f64, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let (o, d) = pixel_ray(&cam, w, h, x, y);
+            // Pixels whose ray meets the mirror (not the floor) first.
+            let t_mirror = (-2.0 - o.z) / d.z;
+            let t_floor = if d.y < 0.0 { -o.y / d.y } else { f32::INFINITY };
+            if !(t_mirror > 0.0 && t_mirror < t_floor) {
+                continue;
+            }
+            let m = o + d * t_mirror;
+            let reflected = Vec3::new(d.x, d.y, -d.z);
+            if reflected.y >= 0.0 {
+                continue; // sees the sky in the mirror
+            }
+            let p = m + reflected * (-m.y / reflected.y);
+            let to_light = light - p;
+            let lit = albedo / std::f32::consts::PI * intensity * to_light.normalize().y
+                / to_light.length_squared();
+            expected += (reflectance * lit) as f64;
+            measured += red(&img, w, x, y) as f64;
+            pixels += 1;
+        }
+    }
+    let rel = ((measured - expected) / expected).abs();
+    eprintln!("mirror: {pixels} pixels, relative error {rel:.4}");
+    assert!(pixels > 500, "the mirror must fill much of the view");
+    assert!(rel < 0.01, "reflected radiance off by {rel}");
+    assert_validation_clean(&ctx);
+}
