@@ -454,6 +454,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     "frame_ms": frame_mean,
                     "geometry": stats,
                 });
+                if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                    std::fs::create_dir_all(dir)
+                        .with_context(|| format!("cannot create folder {}", dir.display()))?;
+                }
                 std::fs::write(&path, serde_json::to_string_pretty(&report)?)
                     .with_context(|| format!("cannot write {}", path.display()))?;
                 println!("wrote {}", path.display());

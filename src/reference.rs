@@ -127,7 +127,8 @@ impl Reference {
         scene_gpu: &SceneGpu,
         targets: &FrameTargets,
         settings: ReferenceSettings,
-    ) -> VkResult<Self> {
+    ) -> anyhow::Result<Self> {
+        let accum_bytes = check_image_size(ctx, targets.width, targets.height)?;
         let layout = DescriptorSetLayout::new(
             ctx,
             &[
@@ -141,17 +142,16 @@ impl Reference {
         let trace = ComputePipeline::new(ctx, "reference/trace.comp", &sets, push)?;
         let camera = ComputePipeline::new(ctx, "reference/camera.comp", &sets, push)?;
         let resolve = ComputePipeline::new(ctx, "reference/resolve.comp", &sets, push)?;
-        let pixels = targets.width as u64 * targets.height as u64;
         let photon_accum = Buffer::new(
             ctx,
             "reference photon sums",
-            pixels * 3 * 4 * b::COMPONENT_COUNT as u64,
+            accum_bytes,
             BufferUsage::Storage,
         )?;
         let camera_accum = Buffer::new(
             ctx,
             "reference camera sums",
-            pixels * 3 * 4,
+            targets.width as u64 * targets.height as u64 * 3 * 4,
             BufferUsage::Storage,
         )?;
         let set = DescriptorSet::new(ctx, &layout)?;
@@ -283,6 +283,23 @@ impl Reference {
     }
 }
 
+/// Bytes of the photon sums for a `width` x `height` image: one rgb float sum
+/// per pixel and path type, addressed by a 32-bit index. An error when the
+/// device cannot hold them in one storage buffer.
+pub fn check_image_size(ctx: &Context, width: u32, height: u32) -> anyhow::Result<u64> {
+    let bytes = width as u64 * height as u64 * 3 * 4 * b::COMPONENT_COUNT as u64;
+    let limit = (ctx.limits.max_storage_buffer_range as u64).min(u32::MAX as u64);
+    if bytes > limit {
+        anyhow::bail!(
+            "{width}x{height} is too large for the reference on {}: its sums need {} MiB, the device allows {} MiB per buffer",
+            ctx.info.name,
+            bytes >> 20,
+            limit >> 20
+        );
+    }
+    Ok(bytes)
+}
+
 /// Everything `caustics reference` needs: the scene on the GPU, the output
 /// images and the tracer, run batch by batch.
 pub struct ReferenceRenderer {
@@ -306,6 +323,7 @@ impl ReferenceRenderer {
         time: f32,
         settings: ReferenceSettings,
     ) -> anyhow::Result<Self> {
+        check_image_size(ctx, width, height)?;
         let scene_gpu = SceneGpu::new(ctx, &scene, time)?;
         scene_gpu.update_frame(&scene, width, height, time, 0)?;
         let targets = FrameTargets::new(ctx, width, height)?;

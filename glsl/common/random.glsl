@@ -9,7 +9,9 @@ uint pcg_hash(uint v) {
     return (word >> 22u) ^ word;
 }
 
-uint rng_seed(uint a, uint b) { return pcg_hash(a ^ pcg_hash(b + 0x9e3779b9u)); }
+// Hashes both inputs before combining, so that two (a, b) pairs collide only
+// by chance (probability 2^-32), never for whole batches of a.
+uint rng_seed(uint a, uint b) { return pcg_hash(pcg_hash(a) ^ pcg_hash(b * 0x9e3779b9u + 0x632be5abu)); }
 
 // Uniform in [0, 1).
 float rng_next(inout uint state) {

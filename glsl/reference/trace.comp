@@ -37,7 +37,8 @@ bool camera_connection(vec3 x, out ivec2 pixel, out vec3 to_eye, out float dist,
     vec2 ndc = clip.xy / clip.w;
     if (any(lessThan(ndc, vec2(-1.0))) || any(greaterThanEqual(ndc, vec2(1.0)))) return false;
     vec2 p = (ndc * 0.5 + 0.5) * frame.viewport.xy;
-    pixel = ivec2(floor(p));
+    // Rounding can put ndc just below 1 exactly on the far edge: clamp.
+    pixel = min(ivec2(floor(p)), ivec2(frame.viewport.xy) - 1);
     vec3 v = frame.eye.xyz - x;
     dist = length(v);
     to_eye = v / dist;
@@ -61,6 +62,10 @@ uint pick_light(float u, out float probability) {
     uint count = frame.counts.x;
     float total = 0.0;
     for (uint l = 0u; l < count; ++l) total += lights[l].power.x;
+    if (total <= 0.0) {
+        probability = 0.0;
+        return 0u;
+    }
     float target = u * total;
     float running = 0.0;
     for (uint l = 0u; l < count; ++l) {
@@ -133,52 +138,56 @@ void main() {
     if (frame.counts.x == 0u) return;
     float light_probability;
     uint l = pick_light(rng_next(rng), light_probability);
-    vec3 o, d, weight;
-    emit(l, rng, o, d, weight);
-    weight /= light_probability;
+    if (light_probability <= 0.0) return; // every light is black
+    SpecularState s;
+    emit(l, rng, s.origin, s.dir, s.weight);
+    s.weight /= light_probability;
+    s.inside = false; // lights are outside objects
+    s.inside_absorption = vec3(0.0);
 
     uint specular = 0u;
     bool scattered_or_bounced = false;
     uint diffuse_left = pc.diffuse_bounces;
-    bool inside = false;          // inside a dielectric (no medium there)
-    vec3 inside_absorption = vec3(0.0);
     bool has_medium = medium_present();
     float g = medium.sigma_s.w;
 
     for (uint depth = 0u; depth < pc.max_depth; ++depth) {
         Hit hit;
-        bool found = trace_closest(o, d, 0.0, 1e30, hit);
+        bool found = trace_closest(s.origin, s.dir, 0.0, 1e30, hit);
         float t_hit = found ? hit.t : 1e30;
 
-        if (has_medium && !inside) {
+        if (has_medium && !s.inside) {
             // Tentative collisions at rate `majorant` (delta tracking with
             // null collisions; weighted so that rgb coefficients may differ).
             float t0 = 0.0, t1 = t_hit;
             float majorant = medium_majorant();
             bool event = false;
-            if (majorant > 0.0 && clip_to_medium(o, d, t0, t1)) {
+            if (majorant > 0.0 && clip_to_medium(s.origin, s.dir, t0, t1)) {
                 float t = t0;
                 for (int i = 0; i < 100000; ++i) {
                     t -= log(1.0 - rng_next(rng)) / majorant;
                     if (t >= t1) break;
-                    vec3 x = o + t * d;
+                    vec3 x = s.origin + t * s.dir;
                     float density = medium_density(x);
                     vec3 sigma_s = medium.sigma_s.rgb * density;
                     vec3 sigma_n = vec3(majorant) - (medium.sigma_s.rgb + medium.sigma_a.rgb) * density;
                     // Every tentative collision connects: E[sum] = integral of T sigma_s along the ray.
-                    connect_medium(x, d, weight * sigma_s / majorant, g, tag_for(specular, scattered_or_bounced, true), rng);
+                    if (any(greaterThan(sigma_s, vec3(0.0)))) {
+                        connect_medium(x, s.dir, s.weight * sigma_s / majorant, g,
+                                       tag_for(specular, scattered_or_bounced, true), rng);
+                    }
                     float p_scatter = (sigma_s.r + sigma_s.g + sigma_s.b) / (3.0 * majorant);
                     float p_null = max(sigma_n.r + sigma_n.g + sigma_n.b, 0.0) / (3.0 * majorant);
                     float u = rng_next(rng);
                     if (u < p_scatter) {
-                        weight *= sigma_s / (majorant * p_scatter);
-                        o = x;
-                        d = sample_hg(d, g, vec2(rng_next(rng), rng_next(rng)));
+                        s.weight *= sigma_s / (majorant * p_scatter);
+                        s.origin = x;
+                        s.dir = sample_hg(s.dir, g, vec2(rng_next(rng), rng_next(rng)));
                         scattered_or_bounced = true;
                         event = true;
                         break;
                     } else if (u < p_scatter + p_null) {
-                        weight *= sigma_n / (majorant * p_null);
+                        s.weight *= sigma_n / (majorant * p_null);
                     } else {
                         return; // absorbed
                     }
@@ -188,50 +197,27 @@ void main() {
         }
         if (!found) return;
 
-        vec3 x = o + hit.t * d;
+        vec3 x = s.origin + hit.t * s.dir;
         vec3 ng = hit_geometric_normal(hit);
-        vec3 ns = hit_normal(hit);
-        bool front = dot(d, ng) < 0.0;
-        // Normals facing the side the photon arrives from.
-        vec3 ng_in = front ? ng : -ng;
-        vec3 ns_in = dot(ns, ng_in) > 0.0 ? ns : -ns;
-        if (inside) weight *= exp(-inside_absorption * hit.t);
+        bool front = dot(s.dir, ng) < 0.0;
+        if (s.inside) s.weight *= exp(-s.inside_absorption * hit.t);
 
         Material m = materials[hit_material(hit)];
-        uint kind = floatBitsToUint(m.color.w);
-        if (kind == MATERIAL_DIFFUSE) {
-            connect_surface(x, ng_in, weight, m.color.rgb, tag_for(specular, scattered_or_bounced, false), rng);
+        if (floatBitsToUint(m.color.w) == MATERIAL_DIFFUSE) {
+            vec3 ng_in = front ? ng : -ng; // the side the photon arrives on
+            connect_surface(x, ng_in, s.weight, m.color.rgb, tag_for(specular, scattered_or_bounced, false), rng);
             if (diffuse_left == 0u) return;
             diffuse_left -= 1u;
             float survive = clamp(luminance(m.color.rgb), 0.05, 1.0);
             if (rng_next(rng) >= survive) return;
-            weight *= m.color.rgb / survive;
-            d = cosine_hemisphere(vec2(rng_next(rng), rng_next(rng)), ng_in);
-            o = offset_origin(x, ng_in);
+            s.weight *= m.color.rgb / survive;
+            s.dir = cosine_hemisphere(vec2(rng_next(rng), rng_next(rng)), ng_in);
+            s.origin = offset_origin(x, ng_in);
             scattered_or_bounced = true;
-        } else if (kind == MATERIAL_MIRROR) {
-            weight *= m.color.rgb;
-            d = reflect(d, ns_in);
-            o = offset_origin(x, ng_in);
-            specular += 1u;
         } else {
-            float ior = m.absorption_ior.w;
-            float eta = front ? 1.0 / ior : ior;
-            float cos_i = -dot(d, ns_in);
-            float f = fresnel_dielectric(cos_i, eta);
-            vec3 refracted;
-            // Choosing reflection with probability F keeps the weight unchanged.
-            if (rng_next(rng) < f || !refract_dir(d, ns_in, eta, refracted)) {
-                d = reflect(d, ns_in);
-                o = offset_origin(x, ng_in);
-            } else {
-                d = refracted;
-                o = offset_origin(x, -ng_in);
-                inside = front;
-                inside_absorption = m.absorption_ior.rgb;
-            }
+            specular_bounce(s, x, ng, hit_normal(hit), front, m, rng_next(rng));
             specular += 1u;
         }
-        if (luminance(weight) <= 0.0) return;
+        if (luminance(s.weight) <= 0.0) return;
     }
 }

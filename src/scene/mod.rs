@@ -105,7 +105,15 @@ impl Scene {
                 .map(|&v| (n * v).normalize_or_zero())
                 .collect();
             for (t, &material) in o.mesh.indices.iter().zip(&o.mesh.materials) {
-                let t = if flip { [t[0], t[2], t[1]] } else { *t };
+                let mut t = if flip { [t[0], t[2], t[1]] } else { *t };
+                // Renderers tell inside from outside by the winding (the
+                // geometric normal); where a file's normals disagree with its
+                // winding, the normals win.
+                let [a, b, c] = t.map(|i| positions[i as usize]);
+                let shading = t.iter().map(|&i| normals[i as usize]).sum::<Vec3>();
+                if (b - a).cross(c - a).dot(shading) < 0.0 {
+                    t.swap(1, 2);
+                }
                 out.push(Triangle {
                     positions: t.map(|i| positions[i as usize]),
                     normals: t.map(|i| normals[i as usize]),
@@ -137,9 +145,19 @@ impl Scene {
         }
     }
 
-    /// Sphere around [`Scene::bounds`]: its centre, radius half the diagonal.
+    /// Sphere around [`Scene::bounds`] and the medium's box: its centre, radius
+    /// half the diagonal. Directional lights emit from a disk of this radius,
+    /// so it must hold everything light can interact with.
     pub fn bounding_sphere(&self, time: f32) -> (Vec3, f32) {
-        let (lo, hi) = self.bounds(time);
+        let (mut lo, mut hi) = self.bounds(time);
+        if let Some(m) = &self.medium {
+            if self.objects.is_empty() {
+                (lo, hi) = (m.bounds_min, m.bounds_max);
+            } else {
+                lo = lo.min(m.bounds_min);
+                hi = hi.max(m.bounds_max);
+            }
+        }
         ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
     }
 }

@@ -533,7 +533,7 @@ pub fn begin_rendering(
     let depth_attachment = depth.map(|view| {
         vk::RenderingAttachmentInfo::default()
             .image_view(view)
-            .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+            .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
             .load_op(vk::AttachmentLoadOp::CLEAR)
             .store_op(vk::AttachmentStoreOp::STORE)
             .clear_value(vk::ClearValue {

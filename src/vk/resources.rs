@@ -133,6 +133,18 @@ impl Buffer {
             self.ctx
                 .device
                 .cmd_copy_buffer(cmd, staging.raw, self.raw, &[region]);
+            // A fence makes device writes visible to the host only; later
+            // submissions read this buffer in shaders, indirect arguments or
+            // copies, so make the copy available and visible to them all.
+            let visible = vk::MemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::COPY)
+                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                .dst_access_mask(vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE);
+            self.ctx.device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().memory_barriers(&[visible]),
+            );
         })?;
         Ok(())
     }

@@ -118,6 +118,7 @@ impl Access {
             Access::Undefined => L::UNDEFINED,
             Access::ComputeRead | Access::ComputeWrite | Access::FragmentWrite => L::GENERAL,
             Access::FragmentRead | Access::VertexRead => {
+                // The DEPTH_STENCIL_* layouts need no separateDepthStencilLayouts.
                 if format_is_depth {
                     L::DEPTH_STENCIL_READ_ONLY_OPTIMAL
                 } else {
@@ -125,7 +126,7 @@ impl Access {
                 }
             }
             Access::ColorAttachment => L::COLOR_ATTACHMENT_OPTIMAL,
-            Access::DepthAttachment => L::DEPTH_ATTACHMENT_OPTIMAL,
+            Access::DepthAttachment => L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
             Access::IndirectRead | Access::HostRead => L::GENERAL,
             Access::TransferRead => L::TRANSFER_SRC_OPTIMAL,
             Access::TransferWrite => L::TRANSFER_DST_OPTIMAL,
