@@ -11,7 +11,10 @@ use crate::vk::{
 use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
 
-/// A path-type component of the ground truth (Heckbert's notation).
+/// A path-type component of the ground truth (Heckbert's notation). Paths
+/// whose last segment to the eye passes through a specular surface are
+/// covered only as L D S+ E (see docs/ARCHITECTURE.md, "What the ground
+/// truth does not cover").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Component {
     /// L D (and L D S+ E through the camera-side chains).
