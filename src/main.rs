@@ -181,6 +181,23 @@ fn check_size(args: &SceneArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// What `render` and `bench` check before they touch the device: the
+/// technique and its parameters, the image size, the frame count, the scene.
+fn checked_technique_run(
+    scene: &SceneArgs,
+    technique: &str,
+    overrides: &[String],
+    frames: u32,
+) -> anyhow::Result<(Scene, Params)> {
+    let info = techniques::find(technique)?;
+    let params = Params::resolve(technique, info.params, overrides)?;
+    check_size(scene)?;
+    if frames == 0 {
+        anyhow::bail!("--frames must be at least 1");
+    }
+    Ok((load_scene(&scene.scene)?, params))
+}
+
 fn print_timings(title: &str, timings: &[PassTiming], source: &str) {
     println!("{title} ({source}):");
     let mut total = 0.0;
@@ -288,14 +305,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 list_techniques();
                 return Ok(());
             }
-            let info = techniques::find(&technique)?;
-            let params = Params::resolve(&technique, info.params, &params)?;
-            check_size(&scene)?;
             output::format_of(&out)?;
-            if frames == 0 {
-                anyhow::bail!("--frames must be at least 1");
-            }
-            let loaded = load_scene(&scene.scene)?;
+            let (loaded, params) = checked_technique_run(&scene, &technique, &params, frames)?;
             let outputs = output::prepare(&out)?;
             let ctx = context(&device)?;
             let mut renderer = Renderer::new(
@@ -391,13 +402,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             json,
             device,
         } => {
-            let info = techniques::find(&technique)?;
-            let params = Params::resolve(&technique, info.params, &params)?;
-            check_size(&scene)?;
-            if frames == 0 {
-                anyhow::bail!("--frames must be at least 1");
-            }
-            let loaded = load_scene(&scene.scene)?;
+            let (loaded, params) = checked_technique_run(&scene, &technique, &params, frames)?;
             let ctx = context(&device)?;
             let mut renderer = Renderer::new(
                 &ctx,
