@@ -345,6 +345,14 @@ impl State {
         self.swapchain = None;
         self.finished = ImageSemaphores::new(&ctx, new.images.len())?;
         let extent = new.extent;
+        println!(
+            "swapchain: {}x{}, {} images, {:?}, {:?}",
+            extent.width,
+            extent.height,
+            new.images.len(),
+            new.format,
+            new.present_mode
+        );
         self.swapchain = Some(new);
         if extent.width > 0
             && extent.height > 0
@@ -506,9 +514,8 @@ impl State {
 
     fn apply_fly(&mut self, dt: f32) {
         let k = &self.input.keys;
-        let axis = |pos: KeyCode, neg: KeyCode| {
-            (k.contains(&pos) as i32 - k.contains(&neg) as i32) as f32
-        };
+        let axis =
+            |pos: KeyCode, neg: KeyCode| (k.contains(&pos) as i32 - k.contains(&neg) as i32) as f32;
         let forward = axis(KeyCode::KeyW, KeyCode::KeyS);
         let strafe = axis(KeyCode::KeyD, KeyCode::KeyA);
         if forward != 0.0 || strafe != 0.0 {
@@ -635,6 +642,9 @@ impl ApplicationHandler for App {
                     let done = self.options.exit
                         && self.options.frames.is_some_and(|n| state.presented >= n);
                     if done {
+                        if !state.frame_ms.is_empty() {
+                            state.report();
+                        }
                         println!("demo: presented {} frames", state.presented);
                         self.close(event_loop);
                         return;
@@ -681,7 +691,10 @@ impl ApplicationHandler for App {
                     }
                     KeyCode::Space => {
                         state.paused = !state.paused;
-                        println!("animation {}", if state.paused { "paused" } else { "running" });
+                        println!(
+                            "animation {}",
+                            if state.paused { "paused" } else { "running" }
+                        );
                         Ok(())
                     }
                     KeyCode::KeyR => {
@@ -695,7 +708,9 @@ impl ApplicationHandler for App {
                     },
                 }
             }
-            WindowEvent::MouseInput { state: s, button, .. } => {
+            WindowEvent::MouseInput {
+                state: s, button, ..
+            } => {
                 let down = s == ElementState::Pressed;
                 match button {
                     MouseButton::Left => state.input.left = down,

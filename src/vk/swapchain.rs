@@ -34,8 +34,9 @@ impl Surface {
     ) -> VkResult<Surface> {
         // SAFETY: the handles come from a live window, which the caller keeps
         // alive for as long as this surface (the app drops the surface first).
-        let raw =
-            unsafe { ash_window::create_surface(&ctx.entry, &ctx.instance, display, window, None) }?;
+        let raw = unsafe {
+            ash_window::create_surface(&ctx.entry, &ctx.instance, display, window, None)
+        }?;
         let loader = ash::khr::surface::Instance::new(&ctx.entry, &ctx.instance);
         let supported = unsafe {
             loader.get_physical_device_surface_support(ctx.physical_device, ctx.queue_family, raw)
