@@ -233,6 +233,8 @@ struct State {
     timings: Vec<Vec<PassTiming>>,
     frame_ms: Vec<f64>,
     report_at: Instant,
+    /// When the frames being averaged for the next report began.
+    report_from: Instant,
     screenshots: u32,
 }
 
@@ -302,6 +304,7 @@ impl App {
             timings: Vec::new(),
             frame_ms: Vec::new(),
             report_at: now + Duration::from_secs(1),
+            report_from: now,
             screenshots: 0,
         };
         state.recreate(o.present_mode)?;
@@ -474,9 +477,13 @@ impl State {
     /// Once a second: per-pass means on stdout (the same scope names as
     /// `caustics render`), frame time in the window title.
     fn report(&mut self) {
-        self.report_at = Instant::now() + Duration::from_secs(1);
+        let now = Instant::now();
+        self.report_at = now + Duration::from_secs(1);
         let n = self.frame_ms.len().max(1) as f64;
         let frame_ms = self.frame_ms.iter().sum::<f64>() / n;
+        // Frame interval: everything, fence waits and event handling included.
+        let interval_ms = (now - self.report_from).as_secs_f64() * 1e3 / n;
+        self.report_from = now;
         let mut passes: Vec<(String, f64, usize)> = Vec::new();
         for t in self.timings.iter().flatten() {
             match passes.iter_mut().find(|p| p.0 == t.name) {
@@ -489,11 +496,12 @@ impl State {
         }
         let r = &self.renderer;
         println!(
-            "{} {}x{}: {:.2} ms/frame over {} frame(s) ({})",
+            "{} {}x{}: {:.2} ms/frame render+present, {:.2} ms frame interval, over {} frame(s) ({})",
             r.technique_name(),
             r.targets.width,
             r.targets.height,
             frame_ms,
+            interval_ms,
             self.frame_ms.len(),
             r.profiler.source.describe()
         );
