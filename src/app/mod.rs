@@ -14,20 +14,22 @@
 //! 4. present, waiting on that semaphore.
 
 mod camera;
+mod overlay;
 
 pub use camera::OrbitCamera;
+use overlay::{Action, Overlay, UiData};
 
 use crate::output;
 use crate::renderer::Renderer;
 use crate::scene::Scene;
 use crate::techniques::{self, Params};
 use crate::vk::{
-    barrier, Access, Acquired, Context, ContextOptions, ImageAccess, PassTiming, Surface,
-    Swapchain, VkResult,
+    barrier, begin_rendering, end_rendering, Access, Acquired, Context, ContextOptions,
+    ImageAccess, PassTiming, Surface, Swapchain, VkResult,
 };
 use anyhow::Context as _;
 use ash::vk;
-use std::collections::HashSet;
+use std::collections::{HashSet, VecDeque};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -215,6 +217,8 @@ struct Input {
 struct State {
     frames: Vec<Frame>,
     finished: ImageSemaphores,
+    /// Made with the first swapchain (it needs the swapchain's format).
+    overlay: Option<Overlay>,
     swapchain: Option<Swapchain>,
     renderer: Renderer,
     surface: Surface,
@@ -232,6 +236,9 @@ struct State {
     light_moved: bool,
     timings: Vec<Vec<PassTiming>>,
     frame_ms: Vec<f64>,
+    /// The last frame's per-pass timings and recent frame intervals (overlay).
+    last_timings: Vec<PassTiming>,
+    history_ms: VecDeque<f32>,
     report_at: Instant,
     /// When the frames being averaged for the next report began.
     report_from: Instant,
@@ -303,6 +310,9 @@ impl App {
             light_moved: false,
             timings: Vec::new(),
             frame_ms: Vec::new(),
+            last_timings: Vec::new(),
+            history_ms: VecDeque::new(),
+            overlay: None,
             report_at: now + Duration::from_secs(1),
             report_from: now,
             screenshots: 0,
@@ -387,6 +397,10 @@ impl State {
         let now = Instant::now();
         let dt = (now - self.last).as_secs_f32().min(0.25);
         self.last = now;
+        if self.history_ms.len() >= 240 {
+            self.history_ms.pop_front();
+        }
+        self.history_ms.push_back(dt * 1e3);
         if !self.paused {
             self.time += dt;
         }
@@ -411,6 +425,33 @@ impl State {
         // image, never those buffers. Were `render_frame` made asynchronous,
         // those buffers would have to become per frame slot.
         unsafe { d.wait_for_fences(&[frame.fence], true, u64::MAX) }?;
+
+        if self.overlay.is_none() {
+            let format = self.swapchain.as_ref().expect("swapchain").format;
+            self.overlay = Some(Overlay::new(&ctx, &self.window, format, FRAMES_IN_FLIGHT)?);
+        }
+        let overlay = self.overlay.as_mut().expect("overlay");
+        let history: Vec<f32> = self.history_ms.iter().copied().collect();
+        let actions = overlay.prepare(
+            &self.window,
+            &UiData {
+                technique: self.renderer.technique_name(),
+                params: self.renderer.params(),
+                timings: &self.last_timings,
+                history_ms: &history,
+            },
+        )?;
+        for action in actions {
+            match action {
+                Action::Technique(name) => self.switch_technique_named(name)?,
+                Action::Params(params) => {
+                    ctx.wait_idle();
+                    let name = self.renderer.technique_name();
+                    self.renderer.set_technique(name, &params)?;
+                }
+            }
+        }
+        let frame = &self.frames[self.current];
 
         let start = Instant::now();
         let timings = self.renderer.render_frame(self.time)?;
@@ -447,7 +488,23 @@ impl State {
             &[ImageAccess::new(display, Access::TransferRead)],
             &[],
         );
-        swapchain.blit_to_image(frame.cmd, index, display.raw, display.extent());
+        let overlay = self.overlay.as_mut().expect("overlay");
+        let draw_overlay = overlay.visible();
+        swapchain.blit_to_image(
+            frame.cmd,
+            index,
+            display.raw,
+            display.extent(),
+            draw_overlay,
+        );
+        if draw_overlay {
+            let view = swapchain.views[index as usize];
+            begin_rendering(&ctx, frame.cmd, swapchain.extent, &[(view, None)], None);
+            let drawn = overlay.record(frame.cmd, swapchain.extent);
+            end_rendering(&ctx, frame.cmd);
+            swapchain.attachment_to_present(frame.cmd, index);
+            drawn?;
+        }
         unsafe { d.end_command_buffer(frame.cmd) }?;
         let finished = self.finished.raw[index as usize];
         let waits = [vk::SemaphoreSubmitInfo::default()
@@ -467,6 +524,7 @@ impl State {
         self.presented += 1;
 
         self.frame_ms.push(start.elapsed().as_secs_f64() * 1e3);
+        self.last_timings.clone_from(&timings);
         self.timings.push(timings);
         if Instant::now() >= self.report_at {
             self.report();
@@ -603,6 +661,11 @@ impl State {
             );
             return Ok(());
         };
+        self.switch_technique_named(info.name)
+    }
+
+    fn switch_technique_named(&mut self, name: &str) -> anyhow::Result<()> {
+        let info = techniques::find(name)?;
         if info.name == self.renderer.technique_name() {
             return Ok(());
         }
@@ -636,6 +699,46 @@ impl ApplicationHandler for App {
         let Some(state) = self.state.as_mut() else {
             return;
         };
+        if let WindowEvent::KeyboardInput { event: key, .. } = &event {
+            if key.physical_key == PhysicalKey::Code(KeyCode::F1)
+                && key.state == ElementState::Pressed
+                && !key.repeat
+            {
+                if let Some(o) = state.overlay.as_mut() {
+                    o.toggle();
+                }
+                return;
+            }
+        }
+        if let Some(o) = state.overlay.as_mut() {
+            if o.on_event(&state.window, &event) {
+                // egui uses this input; still track the cursor and releases
+                // so the demo's drags and held keys do not go stale.
+                match &event {
+                    WindowEvent::CursorMoved { position, .. } => {
+                        state.input.cursor = Some((position.x, position.y));
+                    }
+                    WindowEvent::KeyboardInput { event: k, .. }
+                        if k.state == ElementState::Released =>
+                    {
+                        if let PhysicalKey::Code(code) = k.physical_key {
+                            state.input.keys.remove(&code);
+                        }
+                    }
+                    WindowEvent::MouseInput {
+                        state: ElementState::Released,
+                        button,
+                        ..
+                    } => match button {
+                        MouseButton::Left => state.input.left = false,
+                        MouseButton::Right => state.input.right = false,
+                        _ => {}
+                    },
+                    _ => {}
+                }
+                return;
+            }
+        }
         let result: anyhow::Result<()> = match event {
             WindowEvent::CloseRequested => {
                 self.close(event_loop);

@@ -74,6 +74,8 @@ pub struct Swapchain {
     pub loader: ash::khr::swapchain::Device,
     pub raw: vk::SwapchainKHR,
     pub images: Vec<vk::Image>,
+    /// One colour view per image, for drawing on top of a blit (an overlay).
+    pub views: Vec<vk::ImageView>,
     pub format: vk::Format,
     pub extent: vk::Extent2D,
     pub present_mode: vk::PresentModeKHR,
@@ -148,7 +150,7 @@ impl Swapchain {
             .image_color_space(format.color_space)
             .image_extent(extent)
             .image_array_layers(1)
-            .image_usage(vk::ImageUsageFlags::TRANSFER_DST)
+            .image_usage(vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::COLOR_ATTACHMENT)
             .image_sharing_mode(vk::SharingMode::EXCLUSIVE)
             .pre_transform(caps.current_transform)
             .composite_alpha(vk::CompositeAlphaFlagsKHR::OPAQUE)
@@ -164,15 +166,29 @@ impl Swapchain {
                 return Err(e.into());
             }
         };
-        Ok(Swapchain {
+        let mut swapchain = Swapchain {
             ctx: ctx.clone(),
             loader,
             raw,
-            images,
+            images: Vec::new(),
+            views: Vec::new(),
             format: format.format,
             extent,
             present_mode,
-        })
+        };
+        // From here `swapchain` owns what was made: an error drops it whole.
+        for &image in &images {
+            let info = vk::ImageViewCreateInfo::default()
+                .image(image)
+                .view_type(vk::ImageViewType::TYPE_2D)
+                .format(format.format)
+                .subresource_range(COLOR_RANGE);
+            swapchain
+                .views
+                .push(unsafe { ctx.device.create_image_view(&info, None) }?);
+        }
+        swapchain.images = images;
+        Ok(swapchain)
     }
 
     /// Acquires the next image; `signal` is signalled when it may be written.
@@ -205,7 +221,9 @@ impl Swapchain {
     }
 
     /// Records a blit of `src` (in TRANSFER_SRC_OPTIMAL, `src_extent`) into
-    /// swapchain image `index`, leaving it in PRESENT_SRC. The image's old
+    /// swapchain image `index`, leaving it in PRESENT_SRC, or, with
+    /// `then_draw`, in COLOR_ATTACHMENT_OPTIMAL for drawing on top (then
+    /// `attachment_to_present`). The image's old
     /// contents are discarded (UNDEFINED), and the first barrier waits on the
     /// transfer stage, the stage the acquire semaphore is waited at.
     /// A blit, not a copy, so RGBA sources reach BGRA swapchains with their
@@ -216,15 +234,10 @@ impl Swapchain {
         index: u32,
         src: vk::Image,
         src_extent: vk::Extent2D,
+        then_draw: bool,
     ) {
         let image = self.images[index as usize];
-        let range = vk::ImageSubresourceRange {
-            aspect_mask: vk::ImageAspectFlags::COLOR,
-            base_mip_level: 0,
-            level_count: 1,
-            base_array_layer: 0,
-            layer_count: 1,
-        };
+        let range = COLOR_RANGE;
         let to_dst = [vk::ImageMemoryBarrier2::default()
             .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
             .src_access_mask(vk::AccessFlags2::NONE)
@@ -272,13 +285,26 @@ impl Swapchain {
         };
         // Presentation needs no access mask: the render-finished semaphore
         // signalled at the end of the submission makes the writes visible.
+        let (dst_stage, dst_access, new_layout) = if then_draw {
+            (
+                vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+                vk::AccessFlags2::COLOR_ATTACHMENT_READ | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            )
+        } else {
+            (
+                vk::PipelineStageFlags2::NONE,
+                vk::AccessFlags2::NONE,
+                vk::ImageLayout::PRESENT_SRC_KHR,
+            )
+        };
         let to_present = [vk::ImageMemoryBarrier2::default()
             .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
             .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-            .dst_stage_mask(vk::PipelineStageFlags2::NONE)
-            .dst_access_mask(vk::AccessFlags2::NONE)
+            .dst_stage_mask(dst_stage)
+            .dst_access_mask(dst_access)
             .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-            .new_layout(vk::ImageLayout::PRESENT_SRC_KHR)
+            .new_layout(new_layout)
             .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .image(image)
@@ -290,10 +316,43 @@ impl Swapchain {
             )
         };
     }
+
+    /// After drawing on image `index` (see `blit_to_image`'s `then_draw`):
+    /// COLOR_ATTACHMENT_OPTIMAL -> PRESENT_SRC.
+    pub fn attachment_to_present(&self, cmd: vk::CommandBuffer, index: u32) {
+        let barrier = [vk::ImageMemoryBarrier2::default()
+            .src_stage_mask(vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)
+            .src_access_mask(vk::AccessFlags2::COLOR_ATTACHMENT_WRITE)
+            .dst_stage_mask(vk::PipelineStageFlags2::NONE)
+            .dst_access_mask(vk::AccessFlags2::NONE)
+            .old_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+            .new_layout(vk::ImageLayout::PRESENT_SRC_KHR)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(self.images[index as usize])
+            .subresource_range(COLOR_RANGE)];
+        unsafe {
+            self.ctx.device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().image_memory_barriers(&barrier),
+            )
+        };
+    }
 }
+
+const COLOR_RANGE: vk::ImageSubresourceRange = vk::ImageSubresourceRange {
+    aspect_mask: vk::ImageAspectFlags::COLOR,
+    base_mip_level: 0,
+    level_count: 1,
+    base_array_layer: 0,
+    layer_count: 1,
+};
 
 impl Drop for Swapchain {
     fn drop(&mut self) {
+        for v in &self.views {
+            unsafe { self.ctx.device.destroy_image_view(*v, None) };
+        }
         unsafe { self.loader.destroy_swapchain(self.raw, None) };
     }
 }
