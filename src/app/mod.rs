@@ -347,6 +347,15 @@ impl State {
         if size.width == 0 || size.height == 0 {
             return Ok(());
         }
+        if self
+            .surface
+            .current_extent()?
+            .is_some_and(|e| e.width == 0 || e.height == 0)
+        {
+            // The window reports a size but the surface is already (or
+            // still) zero-sized: stay stale and try again next frame.
+            return Ok(());
+        }
         self.ctx().wait_idle();
         let ctx = self.ctx().clone();
         let wanted = vk::Extent2D {
@@ -390,7 +399,7 @@ impl State {
         }
         if self.stale || self.swapchain.is_none() {
             self.recreate(mode)?;
-            if self.swapchain.is_none() {
+            if self.stale || self.swapchain.is_none() {
                 return Ok(false);
             }
         }

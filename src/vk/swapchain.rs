@@ -55,6 +55,17 @@ impl Surface {
         })
     }
 
+    /// The size the surface has now, when it fixes one (X11, Wayland do
+    /// not always); `Some(0x0)` while the window is minimised, when no
+    /// swapchain may be made.
+    pub fn current_extent(&self) -> VkResult<Option<vk::Extent2D>> {
+        let caps = unsafe {
+            self.loader
+                .get_physical_device_surface_capabilities(self.ctx.physical_device, self.raw)
+        }?;
+        Ok((caps.current_extent.width != u32::MAX).then_some(caps.current_extent))
+    }
+
     pub fn present_modes(&self) -> VkResult<Vec<vk::PresentModeKHR>> {
         Ok(unsafe {
             self.loader
