@@ -418,8 +418,7 @@ impl State {
             self.light_moved = false;
             // The scene (lights) is re-uploaded: nothing may still read it.
             self.ctx().wait_idle();
-            let scene = self.renderer.scene.clone();
-            self.renderer.set_scene(scene, self.time)?;
+            self.renderer.lights_changed(self.time)?;
         }
         self.renderer.scene.camera = self.camera.camera();
 

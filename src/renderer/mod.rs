@@ -134,6 +134,19 @@ impl Renderer {
         Ok(())
     }
 
+    /// `scene.lights` were edited in place (the demo moves a light): updates
+    /// the GPU copy and the technique, rebuilding the technique only if it
+    /// cannot take the change. The caller has waited for every frame in flight.
+    pub fn lights_changed(&mut self, time: f32) -> anyhow::Result<()> {
+        if self.technique.set_lights(&self.scene.lights) {
+            self.scene_gpu.update_lights(&self.scene)?;
+            Ok(())
+        } else {
+            let scene = self.scene.clone();
+            self.set_scene(scene, time)
+        }
+    }
+
     pub fn params(&self) -> &Params {
         &self.params
     }
