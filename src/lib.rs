@@ -1,6 +1,7 @@
 //! caustics: real-time caustics techniques on raw Vulkan, side by side against
 //! a GPU ground-truth light tracer. See docs/ARCHITECTURE.md for the map.
 
+pub mod app;
 pub mod bvh;
 pub mod gpu;
 pub mod output;

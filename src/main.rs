@@ -1,4 +1,4 @@
-//! The `caustics` command line: render, reference, bench, info.
+//! The `caustics` command line: render, reference, bench, demo, info.
 
 use anyhow::Context as _;
 use caustics::output;
@@ -103,6 +103,36 @@ enum Command {
         /// Also write the results as JSON.
         #[arg(long)]
         json: Option<PathBuf>,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    /// Open a window and render interactively (keys and mouse: README.md).
+    Demo {
+        /// Scene file (TOML, docs/SCENES.md); R reloads it.
+        #[arg(long, default_value = DEFAULT_SCENE)]
+        scene: PathBuf,
+        #[arg(long, default_value = "direct")]
+        technique: String,
+        #[arg(long = "param")]
+        params: Vec<String>,
+        /// Initial window width.
+        #[arg(long, default_value_t = 512)]
+        width: u32,
+        /// Initial window height.
+        #[arg(long, default_value_t = 512)]
+        height: u32,
+        /// fifo (default, vsync), mailbox or immediate; falls back to fifo when not offered.
+        #[arg(long, default_value = "fifo")]
+        present_mode: String,
+        /// With --exit: frames to present before exiting.
+        #[arg(long)]
+        frames: Option<u32>,
+        /// Exit after --frames N frames (tests, screenshots).
+        #[arg(long, requires = "frames")]
+        exit: bool,
+        /// Resize the window every few frames while running (tests).
+        #[arg(long)]
+        resize_test: bool,
         #[command(flatten)]
         device: DeviceArgs,
     },
@@ -271,6 +301,43 @@ fn list_techniques() {
 
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
+        Command::Demo {
+            scene,
+            technique,
+            params,
+            width,
+            height,
+            present_mode,
+            frames,
+            exit,
+            resize_test,
+            device,
+        } => {
+            let info = techniques::find(&technique)?;
+            let params = Params::resolve(&technique, info.params, &params)?;
+            check_size(&SceneArgs {
+                scene: scene.clone(),
+                width,
+                height,
+                time: 0.0,
+            })?;
+            if frames == Some(0) {
+                anyhow::bail!("--frames must be at least 1");
+            }
+            caustics::app::run(caustics::app::DemoOptions {
+                scene,
+                technique,
+                params,
+                width,
+                height,
+                present_mode: caustics::app::parse_present_mode(&present_mode)?,
+                frames,
+                exit,
+                resize_test,
+                validate: device.validate,
+                device: device.device,
+            })
+        }
         Command::Info => {
             let devices = Context::list_devices()?;
             if devices.is_empty() {

@@ -236,6 +236,24 @@ impl ShadowMaps {
         })
     }
 
+    /// Moves the lights (same count and kinds as at creation: the maps keep
+    /// their layers); the views are recomputed when the pass is recorded.
+    /// Returns false, changing nothing, when the light list differs otherwise.
+    pub fn set_lights(&mut self, lights: &[Light]) -> bool {
+        let n = lights.len().min(b::MAX_LIGHTS as usize);
+        if n != self.scene_lights.len()
+            || lights.len() > b::MAX_LIGHTS as usize
+            || lights
+                .iter()
+                .zip(&self.scene_lights)
+                .any(|(a, b)| a.kind != b.kind)
+        {
+            return false;
+        }
+        self.scene_lights.copy_from_slice(&lights[..n]);
+        true
+    }
+
     /// The views of every light for the scene's current bounding sphere.
     pub fn views(&self, sphere: (Vec3, f32)) -> Vec<GpuShadowLight> {
         self.scene_lights

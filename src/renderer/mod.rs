@@ -50,6 +50,7 @@ pub struct Renderer {
     pub targets: FrameTargets,
     pub tonemap: Tonemap,
     technique: Box<dyn Technique>,
+    params: Params,
     frame_index: u32,
 }
 
@@ -76,8 +77,78 @@ impl Renderer {
             targets,
             tonemap,
             technique,
+            params: params.clone(),
             frame_index: 0,
         })
+    }
+
+    /// Rebuilds the frame targets, the tonemap and the technique at a new
+    /// size (the demo's window resize). The caller has waited for every frame
+    /// that used the old ones.
+    pub fn resize(&mut self, width: u32, height: u32) -> anyhow::Result<()> {
+        let name = self.technique.name();
+        // Drop the old technique and targets before making the new ones, so
+        // peak memory holds one set.
+        self.technique = Box::new(NoTechnique);
+        let targets = FrameTargets::new(&self.ctx, width, height)?;
+        let tonemap = Tonemap::new(&self.ctx, &targets.radiance)?;
+        self.tonemap = tonemap;
+        self.targets = targets;
+        self.set_technique(name, &self.params.clone())
+    }
+
+    /// Switches to technique `name` with `params` (keeps the current one on error).
+    pub fn set_technique(&mut self, name: &str, params: &Params) -> anyhow::Result<()> {
+        let technique = techniques::create(
+            &self.ctx,
+            name,
+            params,
+            &self.scene,
+            &self.scene_gpu,
+            self.targets.width,
+            self.targets.height,
+        )?;
+        self.technique = technique;
+        self.params = params.clone();
+        Ok(())
+    }
+
+    /// Replaces the scene (reload from disk, or a light moved): re-uploads it
+    /// and rebuilds the technique, whose resources (shadow maps) depend on
+    /// the lights. On error the old scene stays. The caller has waited for
+    /// every frame that used the old scene.
+    pub fn set_scene(&mut self, scene: Scene, time: f32) -> anyhow::Result<()> {
+        let scene_gpu = SceneGpu::new(&self.ctx, &scene, time)?;
+        let technique = techniques::create(
+            &self.ctx,
+            self.technique.name(),
+            &self.params,
+            &scene,
+            &scene_gpu,
+            self.targets.width,
+            self.targets.height,
+        )?;
+        self.technique = technique;
+        self.scene_gpu = scene_gpu;
+        self.scene = scene;
+        Ok(())
+    }
+
+    /// `scene.lights` were edited in place (the demo moves a light): updates
+    /// the GPU copy and the technique, rebuilding the technique only if it
+    /// cannot take the change. The caller has waited for every frame in flight.
+    pub fn lights_changed(&mut self, time: f32) -> anyhow::Result<()> {
+        if self.technique.set_lights(&self.scene.lights) {
+            self.scene_gpu.update_lights(&self.scene)?;
+            Ok(())
+        } else {
+            let scene = self.scene.clone();
+            self.set_scene(scene, time)
+        }
+    }
+
+    pub fn params(&self) -> &Params {
+        &self.params
     }
 
     pub fn technique_name(&self) -> &'static str {
@@ -118,5 +189,22 @@ impl Renderer {
     /// The last frame tonemapped to 8-bit sRGB RGBA.
     pub fn display(&self) -> VkResult<Vec<u8>> {
         self.tonemap.display.download_bytes(4)
+    }
+}
+
+/// Stands in for a technique while `resize` rebuilds the real one.
+struct NoTechnique;
+
+impl Technique for NoTechnique {
+    fn name(&self) -> &'static str {
+        "none"
+    }
+    fn record(
+        &mut self,
+        _rec: &mut crate::vk::FrameRecorder,
+        _scene: &SceneGpu,
+        _targets: &FrameTargets,
+    ) -> VkResult<()> {
+        Ok(())
     }
 }

@@ -155,6 +155,17 @@ impl SceneGpu {
         Ok(())
     }
 
+    /// Re-uploads moved lights (same count). The caller has waited for every
+    /// frame that read the old ones.
+    pub fn update_lights(&self, scene: &Scene) -> VkResult<()> {
+        let lights: Vec<GpuLight> = scene
+            .lights
+            .iter()
+            .map(|l| GpuLight::new(l, self.sphere.1))
+            .collect();
+        self.lights.upload(bytemuck::cast_slice(&lights))
+    }
+
     /// Writes the per-frame constants for an image of `width` x `height`.
     pub fn update_frame(
         &self,

@@ -177,4 +177,8 @@ impl Technique for Direct {
         });
         Ok(())
     }
+
+    fn set_lights(&mut self, lights: &[crate::scene::Light]) -> bool {
+        self.shadows.set_lights(lights)
+    }
 }

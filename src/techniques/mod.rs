@@ -99,6 +99,13 @@ pub trait Technique {
         scene: &SceneGpu,
         targets: &FrameTargets,
     ) -> VkResult<()>;
+
+    /// The scene's lights moved (same count and kinds). Returns true when the
+    /// technique updated itself; false (the default) makes the renderer
+    /// rebuild it. Called with no frame in flight.
+    fn set_lights(&mut self, _lights: &[crate::scene::Light]) -> bool {
+        false
+    }
 }
 
 /// Every real-time technique: name, one-line description, parameters.

@@ -12,6 +12,7 @@ mod context;
 mod pipeline;
 mod profiler;
 mod resources;
+mod swapchain;
 mod sync;
 
 pub use context::{Context, ContextOptions, DeviceInfo, RequiredFeature, ValidationCounts};
@@ -21,6 +22,7 @@ pub use pipeline::{
 };
 pub use profiler::{FrameRecorder, PassTiming, Profiler, TimingSource};
 pub use resources::{Buffer, BufferUsage, Image, ImageDesc};
+pub use swapchain::{Acquired, Surface, Swapchain};
 pub use sync::{barrier, Access, BufferAccess, ImageAccess};
 
 pub use ash::vk;

@@ -1,0 +1,336 @@
+//! The demo's egui overlay (feature `overlay`; F1 toggles it): technique
+//! picker, parameter sliders from each technique's `ParamSpec`s, the per-pass
+//! timing table and a rolling frame-time graph. Without the feature the same
+//! API is a no-op, so the frame loop has no `cfg`s.
+//!
+//! It draws straight onto the swapchain image after the blit (so screenshots,
+//! which read the display image, never contain it), in the frame slot's
+//! command buffer. egui-ash-renderer keeps one vertex/index buffer pair per
+//! frame in flight and rotates them per `cmd_draw`, which the demo calls
+//! once per submitted frame, so a buffer is rewritten only after the fence
+//! of the frame that last read it has been waited for.
+
+use crate::techniques::Params;
+use crate::vk::{Context, PassTiming};
+use ash::vk;
+use std::sync::Arc;
+use winit::event::WindowEvent;
+use winit::window::Window;
+
+/// What the overlay shows, gathered by the frame loop.
+#[cfg_attr(not(feature = "overlay"), allow(dead_code))]
+pub struct UiData<'a> {
+    pub technique: &'static str,
+    pub params: &'a Params,
+    pub timings: &'a [PassTiming],
+    /// Recent frame intervals, oldest first.
+    pub history_ms: &'a [f32],
+}
+
+/// What the user asked for in the overlay.
+#[cfg_attr(not(feature = "overlay"), allow(dead_code))]
+pub enum Action {
+    Technique(&'static str),
+    Params(Params),
+}
+
+#[cfg(not(feature = "overlay"))]
+pub struct Overlay;
+
+#[cfg(not(feature = "overlay"))]
+impl Overlay {
+    pub fn new(
+        _ctx: &Arc<Context>,
+        _window: &Window,
+        _format: vk::Format,
+        _frames_in_flight: usize,
+    ) -> anyhow::Result<Self> {
+        Ok(Overlay)
+    }
+    pub fn toggle(&mut self) {
+        println!("overlay: not built in (cargo build --features overlay)");
+    }
+    pub fn visible(&self) -> bool {
+        false
+    }
+    pub fn on_event(&mut self, _window: &Window, _event: &WindowEvent) -> bool {
+        false
+    }
+    pub fn prepare(&mut self, _window: &Window, _data: &UiData) -> anyhow::Result<Vec<Action>> {
+        Ok(Vec::new())
+    }
+    pub fn record(&mut self, _cmd: vk::CommandBuffer, _extent: vk::Extent2D) -> anyhow::Result<()> {
+        Ok(())
+    }
+}
+
+#[cfg(feature = "overlay")]
+pub use enabled::Overlay;
+
+#[cfg(feature = "overlay")]
+mod enabled {
+    use super::*;
+    use crate::techniques::TECHNIQUES;
+    use egui_ash_renderer::{DynamicRendering, Options, RenderMode, Renderer};
+
+    pub struct Overlay {
+        ctx: Arc<Context>,
+        egui: egui::Context,
+        winit: egui_winit::State,
+        renderer: Renderer<egui_ash_renderer::allocator::DefaultAllocator>,
+        /// For egui-ash-renderer's blocking texture uploads.
+        pool: vk::CommandPool,
+        visible: bool,
+        primitives: Vec<egui::ClippedPrimitive>,
+        pixels_per_point: f32,
+        /// Textures egui released; freed once no queued frame can use them.
+        to_free: Vec<egui::TextureId>,
+        /// Slider edits not yet applied (applied when the mouse is released,
+        /// since a technique rebuild compiles pipelines).
+        pending: Option<Params>,
+    }
+
+    impl Overlay {
+        pub fn new(
+            ctx: &Arc<Context>,
+            window: &Window,
+            format: vk::Format,
+            frames_in_flight: usize,
+        ) -> anyhow::Result<Self> {
+            let pool = unsafe {
+                ctx.device.create_command_pool(
+                    &vk::CommandPoolCreateInfo::default()
+                        .queue_family_index(ctx.queue_family)
+                        .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER),
+                    None,
+                )
+            }?;
+            let renderer = Renderer::with_default_allocator(
+                &ctx.instance,
+                ctx.physical_device,
+                ctx.device.clone(),
+                RenderMode::DynamicRendering(DynamicRendering {
+                    color_attachment_format: format,
+                    depth_attachment_format: None,
+                    stencil_attachment_format: None,
+                }),
+                Options {
+                    in_flight_frames: frames_in_flight,
+                    // The swapchain is UNORM holding sRGB-encoded values.
+                    srgb_framebuffer: false,
+                    ..Default::default()
+                },
+            );
+            let renderer = match renderer {
+                Ok(r) => r,
+                Err(e) => {
+                    unsafe { ctx.device.destroy_command_pool(pool, None) };
+                    anyhow::bail!("egui renderer: {e}");
+                }
+            };
+            let egui = egui::Context::default();
+            let winit = egui_winit::State::new(
+                egui.clone(),
+                egui::ViewportId::ROOT,
+                window,
+                Some(window.scale_factor() as f32),
+                None,
+                None,
+            );
+            Ok(Overlay {
+                ctx: ctx.clone(),
+                egui,
+                winit,
+                renderer,
+                pool,
+                visible: true,
+                primitives: Vec::new(),
+                pixels_per_point: 1.0,
+                to_free: Vec::new(),
+                pending: None,
+            })
+        }
+
+        pub fn toggle(&mut self) {
+            self.visible = !self.visible;
+        }
+
+        pub fn visible(&self) -> bool {
+            self.visible
+        }
+
+        /// Feeds a window event to egui; true when egui used it (the demo
+        /// then leaves it alone: dragging a slider must not orbit).
+        pub fn on_event(&mut self, window: &Window, event: &WindowEvent) -> bool {
+            if !self.visible {
+                return false;
+            }
+            let r = self.winit.on_window_event(window, event);
+            let wants = match event {
+                WindowEvent::KeyboardInput { .. } => self.egui.egui_wants_keyboard_input(),
+                WindowEvent::MouseInput { .. } | WindowEvent::MouseWheel { .. } => {
+                    self.egui.egui_wants_pointer_input()
+                }
+                _ => false,
+            };
+            r.consumed || wants
+        }
+
+        /// Runs the UI for this frame and uploads changed textures. Called
+        /// after the frame slot's fence wait, before recording.
+        pub fn prepare(&mut self, window: &Window, data: &UiData) -> anyhow::Result<Vec<Action>> {
+            self.primitives.clear();
+            if !self.to_free.is_empty() {
+                // Rare (egui frees textures seldom): wait rather than track
+                // which queued frame last drew with them.
+                self.ctx.wait_idle();
+                for id in &self.to_free {
+                    self.renderer.free_texture(*id)?;
+                }
+                self.to_free.clear();
+            }
+            if !self.visible {
+                return Ok(Vec::new());
+            }
+            let mut actions = Vec::new();
+            let raw = self.winit.take_egui_input(window);
+            let pending = &mut self.pending;
+            let mut output = self.egui.run_ui(raw, |ui| {
+                panel(ui.ctx(), data, &mut actions, pending);
+            });
+            if let Some(p) = self.pending.take() {
+                if self.egui.input(|i| i.pointer.any_down()) {
+                    self.pending = Some(p);
+                } else {
+                    actions.push(Action::Params(p));
+                }
+            }
+            self.winit
+                .handle_platform_output(window, output.platform_output);
+            self.pixels_per_point = output.pixels_per_point;
+            for (id, deltas) in &output.textures_delta.set {
+                for delta in deltas {
+                    self.renderer
+                        .set_texture(self.ctx.queue, self.pool, *id, delta)?;
+                }
+            }
+            self.to_free
+                .extend(output.textures_delta.free.iter().copied());
+            // Applied above; egui 0.36 panics on dropping unapplied deltas.
+            output.textures_delta.clear();
+            self.primitives = self.egui.tessellate(output.shapes, output.pixels_per_point);
+            Ok(actions)
+        }
+
+        /// Draws the prepared UI; the caller has the target image in
+        /// COLOR_ATTACHMENT_OPTIMAL inside `begin_rendering`.
+        pub fn record(
+            &mut self,
+            cmd: vk::CommandBuffer,
+            extent: vk::Extent2D,
+        ) -> anyhow::Result<()> {
+            self.renderer
+                .cmd_draw(cmd, extent, self.pixels_per_point, &self.primitives)?;
+            Ok(())
+        }
+    }
+
+    fn panel(
+        ctx: &egui::Context,
+        data: &UiData,
+        actions: &mut Vec<Action>,
+        pending: &mut Option<Params>,
+    ) {
+        egui::Window::new("caustics")
+            .default_pos([8.0, 8.0])
+            .default_width(260.0)
+            .show(ctx, |ui| {
+                let mut chosen = data.technique;
+                egui::ComboBox::from_label("technique")
+                    .selected_text(chosen)
+                    .show_ui(ui, |ui| {
+                        for t in TECHNIQUES {
+                            ui.selectable_value(&mut chosen, t.name, t.name)
+                                .on_hover_text(t.description);
+                        }
+                    });
+                if chosen != data.technique {
+                    actions.push(Action::Technique(chosen));
+                }
+                if let Some(info) = TECHNIQUES.iter().find(|t| t.name == data.technique) {
+                    let current = pending.clone().unwrap_or_else(|| data.params.clone());
+                    let mut edited = false;
+                    let mut values = Vec::new();
+                    for spec in info.params {
+                        let mut v = current.get(spec.name);
+                        let mut slider =
+                            egui::Slider::new(&mut v, spec.min..=spec.max).text(spec.name);
+                        if spec.integer {
+                            slider = slider.integer();
+                        }
+                        edited |= ui.add(slider).on_hover_text(spec.description).changed();
+                        values.push(format!("{}={}", spec.name, v));
+                    }
+                    if edited {
+                        if let Ok(p) = Params::resolve(info.name, info.params, &values) {
+                            *pending = Some(p);
+                        }
+                    }
+                }
+                ui.separator();
+                egui::Grid::new("timings").striped(true).show(ui, |ui| {
+                    let mut total = 0.0;
+                    for t in data.timings {
+                        ui.label(&t.name);
+                        ui.label(format!("{:8.3} ms", t.ms));
+                        ui.end_row();
+                        total += t.ms;
+                    }
+                    ui.strong("total");
+                    ui.strong(format!("{total:8.3} ms"));
+                    ui.end_row();
+                });
+                ui.separator();
+                frame_graph(ui, data.history_ms);
+            });
+    }
+
+    /// Frame intervals as a polyline, scaled to the largest recent one.
+    fn frame_graph(ui: &mut egui::Ui, history: &[f32]) {
+        let max = history.iter().copied().fold(1.0f32, f32::max);
+        ui.label(format!(
+            "frame time, last {} frames (max {:.1} ms)",
+            history.len(),
+            max
+        ));
+        let (rect, _) =
+            ui.allocate_exact_size(egui::vec2(ui.available_width(), 60.0), egui::Sense::hover());
+        let painter = ui.painter_at(rect);
+        painter.rect_filled(rect, 2.0, egui::Color32::from_black_alpha(96));
+        if history.len() < 2 {
+            return;
+        }
+        let n = (history.len() - 1) as f32;
+        let points: Vec<egui::Pos2> = history
+            .iter()
+            .enumerate()
+            .map(|(i, ms)| {
+                egui::pos2(
+                    rect.left() + rect.width() * i as f32 / n,
+                    rect.bottom() - rect.height() * (ms / max),
+                )
+            })
+            .collect();
+        painter.add(egui::Shape::line(
+            points,
+            egui::Stroke::new(1.5, egui::Color32::LIGHT_GREEN),
+        ));
+    }
+
+    impl Drop for Overlay {
+        fn drop(&mut self) {
+            // The demo waited for the device before dropping the state.
+            unsafe { self.ctx.device.destroy_command_pool(self.pool, None) };
+        }
+    }
+}
