@@ -64,3 +64,14 @@ pub const DIRECT_BINDING_SHADOW_LIGHTS: u32 = 4;
 pub const PROBE_BINDING_RAYS: u32 = 10;
 pub const PROBE_BINDING_RESULTS: u32 = 11;
 pub const PROBE_BINDING_ANY: u32 = 12;
+
+// Caustic maps (src/passes/caustic_map.rs, glsl/caustic_map/), descriptor set 1.
+pub const CAUSTIC_BINDING_PHOTONS: u32 = 0;
+pub const CAUSTIC_BINDING_VIEWS: u32 = 1;
+pub const CAUSTIC_BINDING_MAP: u32 = 2;
+pub const CAUSTIC_BINDING_POSITION: u32 = 3;
+pub const CAUSTIC_BINDING_NORMAL: u32 = 4;
+pub const CAUSTIC_BINDING_RADIANCE: u32 = 5;
+/// Photon buffer halves: refracted photons first, then reflected ones.
+pub const PHOTON_REFRACTED: u32 = 0;
+pub const PHOTON_REFLECTED: u32 = 1;

@@ -1,0 +1,197 @@
+#version 460
+// Caustic maps, step 1: the photon buffer (Wyman & Davis 2006, "Approximate,
+// Image-Space Caustics": render the specular objects from the light and
+// store where each texel's photon lands).
+//
+// One invocation per texel of the light-space photon view: a perspective
+// frustum fitted to the specular objects' bounding sphere (point and spot
+// lights) or an orthographic box (directional). The photon leaves the light
+// through the texel centre carrying
+//   point/spot:  Phi = I * falloff * Omega_texel, Omega_texel the texel's
+//                exact solid angle (2x2 Gauss-Legendre quadrature of
+//                dOmega = du dv / (1 + u^2 + v^2)^(3/2) over the texel in
+//                the tan plane: error O(h^4), below float rounding);
+//   directional: Phi = E * A_texel (texel area perpendicular to the light).
+// This implementation finds the interfaces and the landing point p3 exactly
+// by tracing the BVH instead of Wyman's light-space depth/normal textures
+// and Eq. 6.3.1 distance interpolation (which approximate the second
+// interface); the optics (Snell, Fresnel, absorption) are the same.
+// At the first dielectric interface the photon splits: the reflected part
+// (Fresnel F) goes to the second half of the buffer, the transmitted part
+// (1 - F) to the first. Further interfaces keep only transmission (weight
+// 1 - F); total internal reflection reflects and continues (up to
+// MAX_BOUNCES). Mirrors reflect with their reflectance. A photon that
+// leaves the scene or runs out of bounces is dropped (w = 0).
+#include "scene.glsl"
+#include "optics.glsl"
+#include "lights.glsl"
+#include "bvh.glsl"
+#include "photon.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 1, binding = CAUSTIC_BINDING_PHOTONS, std430) writeonly buffer PhotonBlock { Photon photons[]; };
+
+layout(push_constant) uniform Push {
+    vec4 origin;  // xyz: light position (perspective) or ortho plane centre; w: half-width (tan or metres)
+    vec4 right;   // xyz; w: light index (uint bits)
+    vec4 up;      // xyz; w: photon view size N (uint bits)
+    vec4 forward; // xyz; w: SHADOW_RADIAL (perspective) or SHADOW_PLANAR (ortho) (uint bits)
+} pc;
+
+const int MAX_BOUNCES = 8;
+
+vec3 offset_origin(vec3 x, vec3 n) {
+    return x + n * (1e-4 * max(1.0, bvh_max_abs(x)));
+}
+
+// Solid angle of the tan-plane rectangle [u0,u1] x [v0,v1] at unit distance.
+float texel_solid_angle(float u0, float u1, float v0, float v1) {
+    const float g = 0.5773502691896258; // 1/sqrt(3)
+    float hu = 0.5 * (u1 - u0), hv = 0.5 * (v1 - v0);
+    float cu = 0.5 * (u1 + u0), cv = 0.5 * (v1 + v0);
+    float sum = 0.0;
+    for (int i = 0; i < 2; ++i) {
+        for (int j = 0; j < 2; ++j) {
+            float u = cu + (i == 0 ? -g : g) * hu;
+            float v = cv + (j == 0 ? -g : g) * hv;
+            float r2 = 1.0 + u * u + v * v;
+            sum += inversesqrt(r2 * r2 * r2);
+        }
+    }
+    return sum * hu * hv; // 4 points of weight 1 on [-1,1]^2, Jacobian hu hv
+}
+
+// Follows a specular chain from (o, d) with weight w; true if it lands on a
+// diffuse surface (p3, arrival direction in `d`).
+bool follow(vec3 o, inout vec3 d, inout vec3 w, bool inside, vec3 absorption, out vec3 p3) {
+    p3 = vec3(0.0);
+    for (int bounce = 0; bounce < MAX_BOUNCES; ++bounce) {
+        Hit h;
+        if (!trace_closest(o, d, 0.0, 1e30, h)) return false;
+        vec3 x = hit_position(h, o, d);
+        if (inside) w *= exp(-absorption * h.t);
+        uint m = hit_material(h);
+        uint kind = material_kind(m);
+        if (kind == MATERIAL_DIFFUSE) {
+            p3 = x;
+            return true;
+        }
+        vec3 ng = hit_geometric_normal(h);
+        bool front = dot(d, ng) < 0.0;
+        vec3 ng_in = front ? ng : -ng;
+        vec3 ns = hit_normal(h);
+        vec3 n = dot(ns, ng_in) > 0.0 ? ns : -ns;
+        if (kind == MATERIAL_MIRROR) {
+            w *= materials[m].color.rgb;
+            vec3 r = reflect(d, n);
+            d = dot(r, ng_in) > 0.0 ? r : reflect(d, ng_in);
+            o = offset_origin(x, ng_in);
+            continue;
+        }
+        float eta = front ? 1.0 / materials[m].absorption_ior.w : materials[m].absorption_ior.w;
+        vec3 t;
+        bool ok = refract_dir(d, n, eta, t);
+        if (ok && dot(t, ng_in) >= 0.0) {
+            n = ng_in;
+            ok = refract_dir(d, n, eta, t);
+        }
+        if (ok) {
+            w *= 1.0 - fresnel_dielectric(-dot(d, n), eta);
+            d = t;
+            o = offset_origin(x, -ng_in);
+            inside = front;
+            absorption = materials[m].absorption_ior.rgb;
+        } else {
+            // Total internal reflection: all of the flux reflects.
+            vec3 r = reflect(d, n);
+            d = dot(r, ng_in) > 0.0 ? r : reflect(d, ng_in);
+            o = offset_origin(x, ng_in);
+        }
+    }
+    return false;
+}
+
+void main() {
+    uint n_size = floatBitsToUint(pc.up.w);
+    uvec2 id = gl_GlobalInvocationID.xy;
+    if (id.x >= n_size || id.y >= n_size) return;
+    uint index = id.y * n_size + id.x;
+    uint count = n_size * n_size;
+    uint l = floatBitsToUint(pc.right.w);
+    bool planar = floatBitsToUint(pc.forward.w) == SHADOW_PLANAR;
+    float h = pc.origin.w;
+    float s0 = (2.0 * float(id.x) / float(n_size) - 1.0) * h;
+    float s1 = (2.0 * float(id.x + 1u) / float(n_size) - 1.0) * h;
+    float t0 = (2.0 * float(id.y) / float(n_size) - 1.0) * h;
+    float t1 = (2.0 * float(id.y + 1u) / float(n_size) - 1.0) * h;
+    float s = 0.5 * (s0 + s1), t = 0.5 * (t0 + t1);
+
+    vec3 o, d, w;
+    float measure;
+    Light light = lights[l];
+    if (planar) {
+        o = pc.origin.xyz + s * pc.right.xyz + t * pc.up.xyz;
+        d = pc.forward.xyz;
+        measure = (s1 - s0) * (t1 - t0);
+        w = light.intensity.rgb * measure;
+    } else {
+        o = pc.origin.xyz;
+        d = normalize(pc.forward.xyz + s * pc.right.xyz + t * pc.up.xyz);
+        measure = texel_solid_angle(s0, s1, t0, t1);
+        vec3 intensity = light.intensity.rgb;
+        if (light_kind(l) == LIGHT_SPOT) {
+            intensity *= spot_falloff(dot(d, light.direction.xyz), light.direction.w, light.intensity.w);
+        }
+        w = intensity * measure;
+    }
+    Photon none = Photon(vec4(0.0), vec4(0.0, 0.0, 0.0, measure), vec4(0.0));
+    photons[index] = none;
+    photons[count + index] = none;
+    if (all(equal(w, vec3(0.0)))) return;
+
+    // The first surface: only photons meeting a specular object first make caustics.
+    Hit hit;
+    if (!trace_closest(o, d, 0.0, 1e30, hit)) return;
+    uint m = hit_material(hit);
+    uint kind = material_kind(m);
+    if (kind == MATERIAL_DIFFUSE) return;
+    vec3 x = hit_position(hit, o, d);
+    vec3 ng = hit_geometric_normal(hit);
+    bool front = dot(d, ng) < 0.0;
+    vec3 ng_in = front ? ng : -ng;
+    vec3 ns = hit_normal(hit);
+    vec3 n = dot(ns, ng_in) > 0.0 ? ns : -ns;
+
+    // Reflected photon (mirror: reflectance; dielectric: Fresnel F).
+    vec3 r = reflect(d, n);
+    r = dot(r, ng_in) > 0.0 ? r : reflect(d, ng_in);
+    float eta = 1.0;
+    float f = 1.0;
+    vec3 wr = w * materials[m].color.rgb;
+    if (kind == MATERIAL_DIELECTRIC) {
+        eta = front ? 1.0 / materials[m].absorption_ior.w : materials[m].absorption_ior.w;
+        f = fresnel_dielectric(-dot(d, n), eta);
+        wr = w * f;
+    }
+    vec3 p3;
+    vec3 dr = r;
+    if (any(greaterThan(wr, vec3(0.0))) && follow(offset_origin(x, ng_in), dr, wr, false, vec3(0.0), p3)) {
+        photons[count + index] = Photon(vec4(p3, 1.0), vec4(wr, measure), vec4(dr, 0.0));
+    }
+    if (kind != MATERIAL_DIELECTRIC) return;
+
+    // Refracted photon: Snell at the front interface, weight 1 - F, then the chain.
+    vec3 tdir;
+    bool ok = refract_dir(d, n, eta, tdir);
+    vec3 nt = n;
+    if (ok && dot(tdir, ng_in) >= 0.0) {
+        nt = ng_in;
+        ok = refract_dir(d, nt, eta, tdir);
+    }
+    if (!ok) return;
+    vec3 wt = w * (1.0 - fresnel_dielectric(-dot(d, nt), eta));
+    if (follow(offset_origin(x, -ng_in), tdir, wt, front, materials[m].absorption_ior.rgb, p3)) {
+        photons[index] = Photon(vec4(p3, 1.0), vec4(wt, measure), vec4(tdir, 0.0));
+    }
+}
