@@ -161,3 +161,73 @@ fn floor_flux_matches_fresnel_transmission() {
     assert!(rel < 0.05, "relative error {rel}");
     assert_validation_clean(&ctx);
 }
+
+/// Floor pixels of the test camera: (index, angle from the light's axis at
+/// the light), skipping pixels whose ray meets the sphere (with a margin).
+fn floor_pixels(s: &Scene) -> Vec<(usize, f32)> {
+    let mut out = Vec::new();
+    for py in 0..SIZE {
+        for px in 0..SIZE {
+            let (o, d) = pixel_ray(&s.camera, SIZE, SIZE, px, py);
+            let oc = o - CENTRE;
+            let bq = oc.dot(d);
+            let disc = bq * bq - (oc.length_squared() - (RADIUS * 1.03).powi(2));
+            if disc > 0.0 && -bq + disc.sqrt() > 0.0 {
+                continue;
+            }
+            if d.y >= 0.0 {
+                continue;
+            }
+            let x = o + d * (-o.y / d.y);
+            if x.x.abs() > 4.9 || x.z.abs() > 4.9 {
+                continue;
+            }
+            let rho = (x.x * x.x + x.z * x.z).sqrt();
+            out.push(((py * SIZE + px) as usize, (rho / LIGHT.y).atan()));
+        }
+    }
+    out
+}
+
+#[test]
+fn ior_one_gives_back_the_shadowed_light() {
+    let ctx = validated_context();
+    let with = ball_scene(Some(1.0), 0.0);
+    let without = ball_scene(None, 0.0);
+    let a = render(&ctx, &with, &[]);
+    let b_ = render(&ctx, &without, &[]);
+    let ra = a.targets.radiance.download_rgba32f().unwrap();
+    let rb = b_.targets.radiance.download_rgba32f().unwrap();
+    assert_finite(&ra);
+    // The shadow's rim: cone half-angle asin(R / D); the caustic splat blurs
+    // it by (splat/2 + 1) caustic texels of 2 / 512 rad on the -y cube face,
+    // the shadow's PCF by about a shadow texel: skip 0.02 rad either side.
+    let alpha = (RADIUS / (LIGHT - CENTRE).length()).asin();
+    let band = 0.02;
+    let (mut worst_in, mut worst_out) = (0.0f32, 0.0f32);
+    let (mut sum_a, mut sum_b, mut n_in) = (0.0f64, 0.0f64, 0);
+    for (i, gamma) in floor_pixels(&with) {
+        let (va, vb) = (ra[4 * i], rb[4 * i]);
+        let rel = (va - vb).abs() / vb;
+        if gamma < alpha - band {
+            worst_in = worst_in.max(rel);
+            sum_a += va as f64;
+            sum_b += vb as f64;
+            n_in += 1;
+        } else if gamma > alpha + band {
+            worst_out = worst_out.max(rel);
+        }
+    }
+    let mean_rel = (sum_a - sum_b).abs() / sum_b;
+    println!(
+        "IOR 1: {n_in} pixels inside the shadow cone: worst relative error {worst_in:.4}, mean {mean_rel:.2e}; outside: worst {worst_out:.2e}"
+    );
+    assert!(n_in > 100);
+    assert!(worst_out < 1e-4, "outside the shadow: {worst_out}");
+    assert!(mean_rel < 0.02, "inside the shadow, mean: {mean_rel}");
+    assert!(
+        worst_in < 0.02,
+        "inside the shadow, worst pixel: {worst_in}"
+    );
+    assert_validation_clean(&ctx);
+}

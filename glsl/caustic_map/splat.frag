@@ -1,9 +1,12 @@
 #version 460
-// Caustic maps, step 2 (fragment): a discrete Gaussian over the S x S
-// sprite texels, sigma = S / 6, normalised so that its weights sum to 1:
-// each photon adds exactly its flux to the map (additive blending). The
-// map stores flux per texel (W); readers divide by the texel's receiver
-// area (glsl/caustic_map/apply.comp) to get irradiance.
+// Caustic maps, step 2 (fragment): a Gaussian of sigma = S / 6 texels
+// around the photon's exact position p, evaluated at the S x S texel
+// centres nearest p (per axis the S centres in [p - S/2, p + S/2]) and
+// normalised by its sum over exactly those centres: each photon adds
+// exactly its flux to the map (additive blending). The sprite is S + 1
+// texels wide, so fragments outside that set are discarded. The map stores
+// flux per texel (W); glsl/caustic_map/apply.comp divides by the texel's
+// receiver area to get irradiance.
 layout(push_constant) uniform Push {
     uint light;
     uint view;
@@ -12,16 +15,25 @@ layout(push_constant) uniform Push {
 } pc;
 
 layout(location = 0) flat in vec3 v_flux;
-layout(location = 1) flat in vec2 v_centre;
+layout(location = 1) flat in vec2 v_centre; // photon position in texel units
+
 layout(location = 0) out vec4 out_flux;
 
 void main() {
-    int half_size = int(pc.splat_size) / 2;
-    float sigma = max(float(pc.splat_size) / 6.0, 0.3);
+    float s = float(pc.splat_size);
+    float sigma = max(s / 6.0, 0.3);
     float k = 1.0 / (2.0 * sigma * sigma);
-    float norm1 = 0.0;
-    for (int i = -half_size; i <= half_size; ++i) norm1 += exp(-float(i * i) * k);
-    vec2 o = round(gl_FragCoord.xy - v_centre);
-    float w = exp(-dot(o, o) * k) / (norm1 * norm1);
+    // First of the S centres, per axis.
+    vec2 c0 = ceil(v_centre - 0.5 * s - 0.5) + 0.5;
+    vec2 idx = floor(gl_FragCoord.xy - c0 + 0.5);
+    if (any(lessThan(idx, vec2(0.0))) || any(greaterThanEqual(idx, vec2(s)))) discard;
+    vec2 norm = vec2(0.0);
+    for (uint i = 0u; i < pc.splat_size; ++i) {
+        vec2 dd = c0 + float(i) - v_centre;
+        norm += exp(-dd * dd * k);
+    }
+    vec2 o = gl_FragCoord.xy - v_centre;
+    vec2 w2 = exp(-o * o * k) / norm;
+    float w = w2.x * w2.y;
     out_flux = vec4(v_flux * w, w);
 }
