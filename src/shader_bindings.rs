@@ -75,3 +75,15 @@ pub const CAUSTIC_BINDING_RADIANCE: u32 = 5;
 /// Photon buffer halves: refracted photons first, then reflected ones.
 pub const PHOTON_REFRACTED: u32 = 0;
 pub const PHOTON_REFLECTED: u32 = 1;
+// Light-space G-buffers of the specular objects (image-space photon mode).
+pub const CAUSTIC_BINDING_FRONT_POSITION: u32 = 6;
+pub const CAUSTIC_BINDING_FRONT_NORMAL: u32 = 7;
+pub const CAUSTIC_BINDING_BACK_POSITION: u32 = 8;
+pub const CAUSTIC_BINDING_BACK_NORMAL: u32 = 9;
+/// Photon modes (`photon_mode` parameter of image_space).
+pub const PHOTON_MODE_TRACED: u32 = 0;
+pub const PHOTON_MODE_IMAGE_SPACE: u32 = 1;
+pub const PHOTON_MODE_BACK_MARCH: u32 = 2;
+/// Light-view G-buffer passes: nearest front faces, nearest back faces.
+pub const LIGHT_VIEW_FRONT: u32 = 0;
+pub const LIGHT_VIEW_BACK: u32 = 1;

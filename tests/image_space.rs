@@ -158,12 +158,22 @@ fn transmitted_flux(ior: f64) -> (f64, f64) {
 
 #[test]
 fn floor_flux_matches_fresnel_transmission() {
+    floor_flux(0);
+}
+
+#[test]
+fn floor_flux_matches_fresnel_transmission_back_march() {
+    floor_flux(2);
+}
+
+fn floor_flux(mode: u32) {
     let ctx = validated_context();
     let s = ball_scene(Some(1.5), 0.0);
+    let mode = format!("photon_mode={mode}");
     let f = render(
         &ctx,
         &s,
-        &["photon_buffer_size=256", "caustic_map_size=256"],
+        &["photon_buffer_size=256", "caustic_map_size=256", &mode],
     );
     let ph = photons(&f);
     let n2 = ph.len() / 2;
@@ -219,11 +229,26 @@ fn floor_pixels(s: &Scene) -> Vec<(usize, f32)> {
 
 #[test]
 fn ior_one_gives_back_the_shadowed_light() {
+    ior_one(0);
+}
+
+#[test]
+fn ior_one_gives_back_the_shadowed_light_image_space() {
+    ior_one(1);
+}
+
+#[test]
+fn ior_one_gives_back_the_shadowed_light_back_march() {
+    ior_one(2);
+}
+
+fn ior_one(mode: u32) {
     let ctx = validated_context();
     let with = ball_scene(Some(1.0), 0.0);
     let without = ball_scene(None, 0.0);
-    let a = render(&ctx, &with, &[]);
-    let b_ = render(&ctx, &without, &[]);
+    let mode = format!("photon_mode={mode}");
+    let a = render(&ctx, &with, &[&mode]);
+    let b_ = render(&ctx, &without, &[&mode]);
     let ra = a.targets.radiance.download_rgba32f().unwrap();
     let rb = b_.targets.radiance.download_rgba32f().unwrap();
     assert_finite(&ra);

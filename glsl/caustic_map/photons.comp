@@ -37,7 +37,16 @@ layout(push_constant) uniform Push {
     vec4 right;   // xyz; w: light index (uint bits)
     vec4 up;      // xyz; w: photon view size N (uint bits)
     vec4 forward; // xyz; w: SHADOW_RADIAL (perspective) or SHADOW_PLANAR (ortho) (uint bits)
+    uvec4 mode;   // x: PHOTON_MODE_TRACED or PHOTON_MODE_IMAGE_SPACE
 } pc;
+
+// Light-space G-buffers of the specular objects (image-space mode only):
+// nearest front faces and nearest back faces, position (w: covered) and
+// outward smooth normal (w: material).
+layout(set = 1, binding = CAUSTIC_BINDING_FRONT_POSITION, rgba32f) uniform readonly image2D front_position;
+layout(set = 1, binding = CAUSTIC_BINDING_FRONT_NORMAL, rgba32f) uniform readonly image2D front_normal;
+layout(set = 1, binding = CAUSTIC_BINDING_BACK_POSITION, rgba32f) uniform readonly image2D back_position;
+layout(set = 1, binding = CAUSTIC_BINDING_BACK_NORMAL, rgba32f) uniform readonly image2D back_normal;
 
 const int MAX_BOUNCES = 8;
 
@@ -112,6 +121,124 @@ bool follow(vec3 o, inout vec3 d, inout vec3 w, bool inside, vec3 absorption, ou
     return false;
 }
 
+// Lands a photon leaving the specular objects at o along d on the first
+// diffuse surface, passing through specular ones unrefracted (image-space
+// mode: the caustic map models one refractor's two interfaces).
+bool land(vec3 o, vec3 d, out vec3 p3) {
+    p3 = vec3(0.0);
+    for (int i = 0; i < 16; ++i) {
+        Hit h;
+        if (!trace_closest(o, d, 0.0, 1e30, h)) return false;
+        vec3 x = hit_position(h, o, d);
+        if (material_kind(hit_material(h)) == MATERIAL_DIFFUSE) {
+            p3 = x;
+            return true;
+        }
+        o = x + d * (1e-4 * max(1.0, bvh_max_abs(x)));
+    }
+    return false;
+}
+
+// The photon-view texel x projects to, or (-1, -1) outside the view.
+ivec2 light_texel(vec3 x) {
+    uint n_size = floatBitsToUint(pc.up.w);
+    vec3 v = x - pc.origin.xyz;
+    vec2 st;
+    if (floatBitsToUint(pc.forward.w) == SHADOW_PLANAR) {
+        st = vec2(dot(v, pc.right.xyz), dot(v, pc.up.xyz));
+    } else {
+        float z = dot(v, pc.forward.xyz);
+        if (z <= 0.0) return ivec2(-1);
+        st = vec2(dot(v, pc.right.xyz), dot(v, pc.up.xyz)) / z;
+    }
+    ivec2 q = ivec2(floor((st / pc.origin.w * 0.5 + 0.5) * float(n_size)));
+    if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(n_size)))) return ivec2(-1);
+    return q;
+}
+
+// Depth of x along the light's rays (distance, or depth along the axis).
+float light_depth(vec3 x) {
+    vec3 v = x - pc.origin.xyz;
+    return floatBitsToUint(pc.forward.w) == SHADOW_PLANAR ? dot(v, pc.forward.xyz) : length(v);
+}
+
+// True if x lies at or behind the back surface stored at its texel (or
+// outside the back faces' coverage: the ray has left the object).
+bool behind_back(vec3 x) {
+    ivec2 q = light_texel(x);
+    if (q.x < 0) return true;
+    vec4 b = imageLoad(back_position, q);
+    if (b.w == 0.0) return true;
+    return light_depth(x) >= light_depth(b.xyz);
+}
+
+// Wyman 2005 two-sided refraction from the light (image-space mode), for the
+// refracted photon of texel `id` entering at p1 (normal n1 facing the light,
+// incident direction d, eta = 1 / ior, weight w already times 1 - F1):
+// - d_V: distance from p1 to the nearest back face along the light's ray
+//   at this texel (the two light-space depth maps);
+// - d_N: distance from p1 to the back surface along -n1. Wyman precomputes
+//   it per vertex by ray casting; here it is cast per texel against the BVH;
+// - Eq. 6.3.1: d~ = (theta_t / theta_i) d_V + (1 - theta_t / theta_i) d_N,
+//   p2 = p1 + d~ T1;
+// - N2: the back-face normal texture at p2's projection; refract out of the
+//   glass about -N2 (Snell), weight 1 - F2, Beer-Lambert over d~. Total
+//   internal reflection there, or p2 projecting outside the back faces:
+//   the photon is dropped (Wyman's approximation has no second bounce).
+bool image_space_refraction(uvec2 id, vec3 p1, vec3 n1, vec3 d, uint m, inout vec3 w, out vec3 p3, out vec3 dir) {
+    p3 = vec3(0.0);
+    dir = vec3(0.0);
+    float ior = materials[m].absorption_ior.w;
+    vec3 t1;
+    if (!refract_dir(d, n1, 1.0 / ior, t1)) return false;
+    vec4 bp = imageLoad(back_position, ivec2(id));
+    if (bp.w == 0.0) return false;
+    float d_v = length(bp.xyz - p1);
+    float d_n = d_v;
+    Hit h;
+    vec3 o = p1 - n1 * (1e-4 * max(1.0, bvh_max_abs(p1)));
+    if (trace_closest(o, -n1, 0.0, 1e30, h)) d_n = h.t;
+    float dist;
+    ivec2 q;
+    if (pc.mode.x == PHOTON_MODE_IMAGE_SPACE) {
+        float theta_i = acos(clamp(-dot(d, n1), -1.0, 1.0));
+        float theta_t = acos(clamp(-dot(t1, n1), -1.0, 1.0));
+        float ratio = theta_i > 1e-4 ? theta_t / theta_i : 1.0 / ior;
+        dist = ratio * d_v + (1.0 - ratio) * d_n;
+        q = light_texel(p1 + dist * t1);
+        if (q.x < 0 || imageLoad(back_position, q).w == 0.0) return false;
+    } else {
+        // PHOTON_MODE_BACK_MARCH: march the refracted ray against the
+        // back-face map until it passes behind the stored back surface
+        // (steps of max(d_V, d_N) / 32, then 16 bisections). Exact for
+        // convex objects up to the map's resolution.
+        float t_max = 1.05 * max(max(d_v, d_n), 1e-4);
+        float lo = 0.0, hi = -1.0;
+        for (int i = 1; i <= 32; ++i) {
+            float t = t_max * float(i) / 32.0;
+            if (behind_back(p1 + t * t1)) { hi = t; break; }
+            lo = t;
+        }
+        if (hi < 0.0) return false;
+        for (int i = 0; i < 16; ++i) {
+            float mid = 0.5 * (lo + hi);
+            if (behind_back(p1 + mid * t1)) hi = mid; else lo = mid;
+        }
+        dist = hi;
+        q = light_texel(p1 + dist * t1);
+        if (q.x < 0 || imageLoad(back_position, q).w == 0.0) return false;
+    }
+    vec3 p2 = p1 + dist * t1;
+    vec4 bn = imageLoad(back_normal, q);
+    vec3 n2 = -normalize(bn.xyz); // facing the ray inside the glass
+    if (dot(n2, t1) > 0.0) n2 = -n2;
+    vec3 t2;
+    if (!refract_dir(t1, n2, ior, t2)) return false;
+    w *= (1.0 - fresnel_dielectric(-dot(t1, n2), ior)) * exp(-materials[m].absorption_ior.rgb * dist);
+    dir = t2;
+    return land(p2, t2, p3);
+}
+
 void main() {
     uint n_size = floatBitsToUint(pc.up.w);
     uvec2 id = gl_GlobalInvocationID.xy;
@@ -150,17 +277,33 @@ void main() {
     photons[count + index] = none;
     if (all(equal(w, vec3(0.0)))) return;
 
-    // The first surface: only photons meeting a specular object first make caustics.
-    Hit hit;
-    if (!trace_closest(o, d, 0.0, 1e30, hit)) return;
-    uint m = hit_material(hit);
+    // The first surface: only photons meeting a specular object first make
+    // caustics. Traced: the BVH; image space: the front-face G-buffer (its
+    // position lies on this texel's centre ray).
+    bool image_space = pc.mode.x != PHOTON_MODE_TRACED;
+    uint m;
+    vec3 x, ng, ns;
+    bool front = true;
+    if (image_space) {
+        vec4 fp = imageLoad(front_position, ivec2(id));
+        if (fp.w == 0.0) return;
+        vec4 fn = imageLoad(front_normal, ivec2(id));
+        m = uint(fn.w + 0.5);
+        x = fp.xyz;
+        ns = normalize(fn.xyz);
+        ng = dot(ns, d) < 0.0 ? ns : -ns;
+    } else {
+        Hit hit;
+        if (!trace_closest(o, d, 0.0, 1e30, hit)) return;
+        m = hit_material(hit);
+        x = hit_position(hit, o, d);
+        ng = hit_geometric_normal(hit);
+        front = dot(d, ng) < 0.0;
+        ns = hit_normal(hit);
+    }
     uint kind = material_kind(m);
     if (kind == MATERIAL_DIFFUSE) return;
-    vec3 x = hit_position(hit, o, d);
-    vec3 ng = hit_geometric_normal(hit);
-    bool front = dot(d, ng) < 0.0;
     vec3 ng_in = front ? ng : -ng;
-    vec3 ns = hit_normal(hit);
     vec3 n = dot(ns, ng_in) > 0.0 ? ns : -ns;
 
     // Reflected photon (mirror: reflectance; dielectric: Fresnel F).
@@ -191,6 +334,13 @@ void main() {
     }
     if (!ok) return;
     vec3 wt = w * (1.0 - fresnel_dielectric(-dot(d, nt), eta));
+    if (image_space) {
+        vec3 dt;
+        if (image_space_refraction(id, x, n, d, m, wt, p3, dt)) {
+            photons[index] = Photon(vec4(p3, 1.0), vec4(wt, measure), vec4(dt, 0.0));
+        }
+        return;
+    }
     if (follow(offset_origin(x, -ng_in), tdir, wt, front, materials[m].absorption_ior.rgb, p3)) {
         photons[index] = Photon(vec4(p3, 1.0), vec4(wt, measure), vec4(tdir, 0.0));
     }

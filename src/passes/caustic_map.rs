@@ -35,11 +35,12 @@ use crate::vk::{
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use std::mem::size_of;
 use std::sync::Arc;
 
 pub const CAUSTIC_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+pub const LIGHT_GBUFFER_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 
 /// One photon, mirrored by `Photon` in glsl/caustic_map/photon.glsl.
 #[repr(C)]
@@ -62,6 +63,17 @@ pub struct PhotonViewPush {
     pub right: [f32; 4],
     pub up: [f32; 4],
     pub forward: [f32; 4],
+    /// x: `PHOTON_MODE_TRACED` or `PHOTON_MODE_IMAGE_SPACE`.
+    pub mode: [u32; 4],
+}
+
+/// Push constants of glsl/caustic_map/lightview.*.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct LightViewPush {
+    view_proj: [[f32; 4]; 4],
+    origin: [f32; 4],
+    forward: [f32; 4],
 }
 
 #[repr(C)]
@@ -111,7 +123,30 @@ pub fn photon_view(
         right: right.extend(f32::from_bits(light_index)).to_array(),
         up: up.extend(f32::from_bits(size)).to_array(),
         forward: forward.extend(f32::from_bits(mode)).to_array(),
+        mode: [b::PHOTON_MODE_TRACED, 0, 0, 0],
     })
+}
+
+/// World -> clip of a photon view (rasteriser's view of the same texel grid:
+/// texel (i, j) of the raster is photon (i, j)), for specular objects in
+/// the sphere `specular`.
+pub fn photon_view_proj(v: &PhotonViewPush, specular: (Vec3, f32)) -> Mat4 {
+    let origin = Vec3::from_slice(&v.origin[..3]);
+    let forward = Vec3::from_slice(&v.forward[..3]);
+    let up = Vec3::from_slice(&v.up[..3]);
+    let h = v.origin[3];
+    let (centre, radius) = specular;
+    let view = Mat4::look_at_rh(origin, origin + forward, up);
+    let proj = if v.forward[3].to_bits() == b::SHADOW_PLANAR {
+        let far = (centre - origin).dot(forward) + 2.0 * radius;
+        Mat4::orthographic_rh(-h, h, -h, h, 0.0, far)
+    } else {
+        let d = (centre - origin).length();
+        let far = d + 1.05 * radius;
+        let near = (d - 1.05 * radius).max(far * 1e-4);
+        Mat4::perspective_rh(2.0 * h.atan(), 1.0, near, far)
+    };
+    proj * view
 }
 
 /// Bounding sphere of every non-diffuse triangle of `scene` at time 0.
@@ -143,6 +178,16 @@ pub struct CausticMap {
     pub photon_size: u32,
     pub map_size: u32,
     pub splat_size: u32,
+    /// `PHOTON_MODE_TRACED` or `PHOTON_MODE_IMAGE_SPACE`.
+    pub mode: u32,
+    /// Light-space G-buffers of the specular objects (image-space mode):
+    /// nearest front and back faces, position and normal (RGBA32F, N x N).
+    pub front_position: Image,
+    pub front_normal: Image,
+    pub back_position: Image,
+    pub back_normal: Image,
+    light_depth: Image,
+    lightview_pipeline: GraphicsPipeline,
     lights: Vec<Light>,
     specular: Option<(Vec3, f32)>,
     photon_pipeline: ComputePipeline,
@@ -161,6 +206,7 @@ impl CausticMap {
         photon_size: u32,
         map_size: u32,
         splat_size: u32,
+        mode: u32,
     ) -> VkResult<Self> {
         let lights: Vec<Light> = scene
             .lights
@@ -200,11 +246,53 @@ impl CausticMap {
             &[
                 (b::CAUSTIC_BINDING_PHOTONS, BindingKind::Storage),
                 (b::CAUSTIC_BINDING_VIEWS, BindingKind::Uniform),
+                (b::CAUSTIC_BINDING_FRONT_POSITION, BindingKind::StorageImage),
+                (b::CAUSTIC_BINDING_FRONT_NORMAL, BindingKind::StorageImage),
+                (b::CAUSTIC_BINDING_BACK_POSITION, BindingKind::StorageImage),
+                (b::CAUSTIC_BINDING_BACK_NORMAL, BindingKind::StorageImage),
             ],
+        )?;
+        let gbuffer_image = |name: &str| {
+            Image::new(
+                ctx,
+                name,
+                ImageDesc::new_2d(
+                    photon_size,
+                    photon_size,
+                    LIGHT_GBUFFER_FORMAT,
+                    vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::STORAGE,
+                ),
+            )
+        };
+        let front_position = gbuffer_image("light view front position")?;
+        let front_normal = gbuffer_image("light view front normal")?;
+        let back_position = gbuffer_image("light view back position")?;
+        let back_normal = gbuffer_image("light view back normal")?;
+        let light_depth = Image::new(
+            ctx,
+            "light view depth",
+            ImageDesc::new_2d(
+                photon_size,
+                photon_size,
+                vk::Format::D32_SFLOAT,
+                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+            ),
         )?;
         let set = DescriptorSet::new(ctx, &layout)?;
         set.write_buffer(b::CAUSTIC_BINDING_PHOTONS, &photons)
-            .write_buffer(b::CAUSTIC_BINDING_VIEWS, &views);
+            .write_buffer(b::CAUSTIC_BINDING_VIEWS, &views)
+            .write_storage_image(b::CAUSTIC_BINDING_FRONT_POSITION, &front_position)
+            .write_storage_image(b::CAUSTIC_BINDING_FRONT_NORMAL, &front_normal)
+            .write_storage_image(b::CAUSTIC_BINDING_BACK_POSITION, &back_position)
+            .write_storage_image(b::CAUSTIC_BINDING_BACK_NORMAL, &back_normal);
+        let mut lv =
+            GraphicsPipelineDesc::new("caustic_map/lightview.vert", "caustic_map/lightview.frag");
+        lv.color_formats = vec![LIGHT_GBUFFER_FORMAT, LIGHT_GBUFFER_FORMAT];
+        lv.depth_format = Some(vk::Format::D32_SFLOAT);
+        lv.depth_test = true;
+        lv.depth_write = true;
+        lv.push_size = size_of::<LightViewPush>() as u32;
+        let lightview_pipeline = GraphicsPipeline::new(ctx, &lv, &[&scene_gpu.layout])?;
         let photon_pipeline = ComputePipeline::new(
             ctx,
             "caustic_map/photons.comp",
@@ -226,6 +314,13 @@ impl CausticMap {
             photon_size,
             map_size,
             splat_size: splat_size | 1,
+            mode,
+            front_position,
+            front_normal,
+            back_position,
+            back_normal,
+            light_depth,
+            lightview_pipeline,
             lights,
             specular,
             photon_pipeline,
@@ -257,7 +352,9 @@ impl CausticMap {
 
     /// Photon view of light `l`, if it has one.
     pub fn photon_view(&self, l: usize) -> Option<PhotonViewPush> {
-        photon_view(&self.lights[l], l as u32, self.specular?, self.photon_size)
+        let mut v = photon_view(&self.lights[l], l as u32, self.specular?, self.photon_size)?;
+        v.mode[0] = self.mode;
+        Some(v)
     }
 
     /// Records "caustic photons" and "caustic splat" for every light; the
@@ -289,6 +386,66 @@ impl CausticMap {
                 }
                 continue;
             };
+            if self.mode != b::PHOTON_MODE_TRACED {
+                let view_proj = photon_view_proj(&push, self.specular.unwrap_or_default());
+                rec.pass("caustic light view", |cmd| {
+                    let extent = self.front_position.extent();
+                    for (pass, pos, nrm) in [
+                        (
+                            b::LIGHT_VIEW_FRONT,
+                            &self.front_position,
+                            &self.front_normal,
+                        ),
+                        (b::LIGHT_VIEW_BACK, &self.back_position, &self.back_normal),
+                    ] {
+                        // Overwritten entirely; waits for the previous reader
+                        // (last light's photons); the depth image is reused
+                        // by both passes (write-after-write).
+                        barrier(
+                            &ctx,
+                            cmd,
+                            &[
+                                ImageAccess::discard(pos, Access::ColorAttachment),
+                                ImageAccess::discard(nrm, Access::ColorAttachment),
+                                ImageAccess::discard(&self.light_depth, Access::DepthAttachment),
+                            ],
+                            &[BufferAccess::new(&scene.triangles, Access::VertexRead)],
+                        );
+                        begin_rendering(
+                            &ctx,
+                            cmd,
+                            extent,
+                            &[(pos.view, Some([0.0; 4])), (nrm.view, Some([0.0; 4]))],
+                            Some(self.light_depth.view),
+                        );
+                        if scene.triangle_count > 0 {
+                            let lv = LightViewPush {
+                                view_proj: view_proj.to_cols_array_2d(),
+                                origin: [
+                                    push.origin[0],
+                                    push.origin[1],
+                                    push.origin[2],
+                                    push.forward[3],
+                                ],
+                                forward: [
+                                    push.forward[0],
+                                    push.forward[1],
+                                    push.forward[2],
+                                    f32::from_bits(pass),
+                                ],
+                            };
+                            self.lightview_pipeline.bind(
+                                cmd,
+                                &[&scene.set],
+                                bytemuck::bytes_of(&lv),
+                                extent,
+                            );
+                            unsafe { ctx.device.cmd_draw(cmd, 3 * scene.triangle_count, 1, 0, 0) };
+                        }
+                        end_rendering(&ctx, cmd);
+                    }
+                });
+            }
             rec.pass("caustic photons", |cmd| {
                 // Write-after-read against the previous light's splat (or last frame's readers).
                 barrier(
@@ -300,6 +457,22 @@ impl CausticMap {
                         BufferAccess::new(&scene.triangles, Access::ComputeRead),
                     ],
                 );
+                {
+                    // The light-view attachments, read as storage images
+                    // (in GENERAL layout even in traced mode: the shader
+                    // declares them, so they must be in the bound layout).
+                    barrier(
+                        &ctx,
+                        cmd,
+                        &[
+                            ImageAccess::new(&self.front_position, Access::ComputeRead),
+                            ImageAccess::new(&self.front_normal, Access::ComputeRead),
+                            ImageAccess::new(&self.back_position, Access::ComputeRead),
+                            ImageAccess::new(&self.back_normal, Access::ComputeRead),
+                        ],
+                        &[],
+                    );
+                }
                 let groups = [
                     self.photon_size.div_ceil(8),
                     self.photon_size.div_ceil(8),

@@ -64,6 +64,14 @@ pub const PARAMS: &[ParamSpec] = &[
         default: 7.0,
         integer: true,
     },
+    ParamSpec {
+        name: "photon_mode",
+        description: "0: photon paths traced exactly through the BVH; 1: Wyman's two-sided image-space refraction from light-space front/back G-buffers (Eq. 6.3.1 distance); 2: the same G-buffers, the refracted ray marched against the back-face map (exact for convex objects)",
+        min: 0.0,
+        max: 2.0,
+        default: 0.0,
+        integer: true,
+    },
 ];
 
 pub struct ImageSpace {
@@ -93,6 +101,7 @@ impl ImageSpace {
             params.get("photon_buffer_size") as u32,
             params.get("caustic_map_size") as u32,
             params.get("splat_size") as u32,
+            params.get("photon_mode") as u32,
         )?;
         let layout = DescriptorSetLayout::new(
             ctx,
