@@ -12,10 +12,22 @@
 //                dOmega = du dv / (1 + u^2 + v^2)^(3/2) over the texel in
 //                the tan plane: error O(h^4), below float rounding);
 //   directional: Phi = E * A_texel (texel area perpendicular to the light).
-// This implementation finds the interfaces and the landing point p3 exactly
-// by tracing the BVH instead of Wyman's light-space depth/normal textures
-// and Eq. 6.3.1 distance interpolation (which approximate the second
-// interface); the optics (Snell, Fresnel, absorption) are the same.
+// Three ways to find the refracted path (push constant `mode`):
+// - PHOTON_MODE_TRACED (default): interfaces and landing point by tracing
+//   the BVH; exact, any number of interfaces.
+// - PHOTON_MODE_IMAGE_SPACE: Wyman 2005's two-sided refraction from the
+//   light: front interface p1, N1 from the light-space front G-buffer; Snell;
+//   distance to the back interface by Eq. 6.3.1 between d_V (front/back
+//   light-space depth maps) and d_N (cast along -N1 through the BVH, where
+//   Wyman precomputes it per vertex); N2 from the back-face normal texture
+//   at p2's projection; Snell again.
+// - PHOTON_MODE_BACK_MARCH: the same G-buffers, but p2 where the refracted
+//   ray passes behind the back-face map (exact for convex objects).
+// In both light-space modes the exit ray is landed on the first diffuse
+// surface through the BVH (Wyman intersects the light-space depth map of
+// the receivers; the BVH is exact), passing through further specular
+// surfaces unrefracted; total internal reflection at the approximated exit
+// drops the photon.
 // At the first dielectric interface the photon splits: the reflected part
 // (Fresnel F) goes to the second half of the buffer, the transmitted part
 // (1 - F) to the first. Further interfaces keep only transmission (weight

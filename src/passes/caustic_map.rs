@@ -7,10 +7,13 @@
 //!    of an N x N light view fitted to the specular objects' bounding sphere
 //!    (perspective for point and spot lights, orthographic for directional
 //!    ones). Flux I * Omega_texel (exact per-texel solid angle) or
-//!    E * A_texel, times Fresnel and Beer-Lambert. The interfaces and the
-//!    landing point p3 are found by tracing the BVH (exact), not by Wyman's
-//!    light-space depth/normal textures. Buffer: `2 N^2` `GpuPhoton`s,
-//!    refracted photons first, reflected ones second.
+//!    E * A_texel, times Fresnel and Beer-Lambert. `mode` picks how the
+//!    refracted path is found: traced through the BVH (exact, default), or
+//!    from light-space front/back G-buffers of the specular objects
+//!    ("caustic light view", Wyman's two-sided refraction) with the back
+//!    interface by Eq. 6.3.1 or by marching the back-face map; the exit ray
+//!    lands through the BVH. Buffer: `2 N^2` `GpuPhoton`s, refracted photons
+//!    first, reflected ones second (reflected photons are always traced).
 //! 2. "caustic splat" (glsl/caustic_map/splat.*): one point sprite per photon,
 //!    S x S discrete Gaussian weights summing to 1, additive, into the
 //!    caustic map: a 2D array with the same views (layers) as the light's
