@@ -26,8 +26,11 @@
 // In both light-space modes the exit ray is landed on the first diffuse
 // surface through the BVH (Wyman intersects the light-space depth map of
 // the receivers; the BVH is exact), passing through further specular
-// surfaces unrefracted; total internal reflection at the approximated exit
-// drops the photon.
+// surfaces unrefracted. Mode 1 handles Wyman's failure cases as he suggests:
+// total internal reflection at the approximated exit clamps to the critical
+// angle (his second fix; the photon keeps its flux); a p2 projecting
+// outside the back faces gets N2 from Eq. 6.3.2. Mode 2 drops those (rare)
+// photons.
 // At the first dielectric interface the photon splits: the reflected part
 // (Fresnel F) goes to the second half of the buffer, the transmitted part
 // (1 - F) to the first. Further interfaces keep only transmission (weight
@@ -195,8 +198,9 @@ bool behind_back(vec3 x) {
 //   p2 = p1 + d~ T1;
 // - N2: the back-face normal texture at p2's projection; refract out of the
 //   glass about -N2 (Snell), weight 1 - F2, Beer-Lambert over d~. Total
-//   internal reflection there, or p2 projecting outside the back faces:
-//   the photon is dropped (Wyman's approximation has no second bounce).
+//   internal reflection there: leave tangent (mode 1) or drop (mode 2);
+//   p2 outside the back faces: Eq. 6.3.2 (mode 1) or drop (mode 2).
+// Mode 2 replaces Eq. 6.3.1 by marching T1 against the back-face map.
 bool image_space_refraction(uvec2 id, vec3 p1, vec3 n1, vec3 d, uint m, inout vec3 w, out vec3 p3, out vec3 dir) {
     p3 = vec3(0.0);
     dir = vec3(0.0);
@@ -212,13 +216,20 @@ bool image_space_refraction(uvec2 id, vec3 p1, vec3 n1, vec3 d, uint m, inout ve
     if (trace_closest(o, -n1, 0.0, 1e30, h)) d_n = h.t;
     float dist;
     ivec2 q;
+    vec3 n2_fallback = vec3(0.0);
+    bool use_fallback = false;
     if (pc.mode.x == PHOTON_MODE_IMAGE_SPACE) {
         float theta_i = acos(clamp(-dot(d, n1), -1.0, 1.0));
         float theta_t = acos(clamp(-dot(t1, n1), -1.0, 1.0));
         float ratio = theta_i > 1e-4 ? theta_t / theta_i : 1.0 / ior;
         dist = ratio * d_v + (1.0 - ratio) * d_n;
         q = light_texel(p1 + dist * t1);
-        if (q.x < 0 || imageLoad(back_position, q).w == 0.0) return false;
+        if (q.x < 0 || imageLoad(back_position, q).w == 0.0) {
+            // d~ overshot past the back faces' coverage: Wyman's Eq. 6.3.2,
+            // N2 = T1 - (V . T1) V, perpendicular to the light's ray V.
+            n2_fallback = normalize(t1 - dot(d, t1) * d);
+            use_fallback = true;
+        }
     } else {
         // PHOTON_MODE_BACK_MARCH: march the refracted ray against the
         // back-face map until it passes behind the stored back surface
@@ -241,12 +252,23 @@ bool image_space_refraction(uvec2 id, vec3 p1, vec3 n1, vec3 d, uint m, inout ve
         if (q.x < 0 || imageLoad(back_position, q).w == 0.0) return false;
     }
     vec3 p2 = p1 + dist * t1;
-    vec4 bn = imageLoad(back_normal, q);
-    vec3 n2 = -normalize(bn.xyz); // facing the ray inside the glass
+    vec3 n2 = use_fallback ? n2_fallback : imageLoad(back_normal, q).xyz;
+    n2 = -normalize(n2); // facing the ray inside the glass
     if (dot(n2, t1) > 0.0) n2 = -n2;
+    w *= exp(-materials[m].absorption_ior.rgb * dist);
     vec3 t2;
-    if (!refract_dir(t1, n2, ior, t2)) return false;
-    w *= (1.0 - fresnel_dielectric(-dot(t1, n2), ior)) * exp(-materials[m].absorption_ior.rgb * dist);
+    if (!refract_dir(t1, n2, ior, t2)) {
+        if (pc.mode.x != PHOTON_MODE_IMAGE_SPACE) return false;
+        // Total internal reflection at the approximated exit (for a convex
+        // refractor mostly an artefact of d~): Wyman's second ad hoc fix,
+        // clamp to the critical angle, i.e. leave tangent to the surface.
+        // The photon keeps its flux (the transmission it would have had is
+        // unknown; dropping it loses ~21% of a ball lens's caustic, and his
+        // third fix, reflecting, sends it back up past the light).
+        dir = normalize(t1 - dot(t1, n2) * n2);
+        return land(p2, dir, p3);
+    }
+    w *= 1.0 - fresnel_dielectric(-dot(t1, n2), ior);
     dir = t2;
     return land(p2, t2, p3);
 }
