@@ -25,7 +25,10 @@
 //! - ior_one_gives_back_the_shadowed_light (512²/512², defaults): inside the
 //!   shadow cone (0.02 rad from its rim left out) worst pixel 0.15%, mean
 //!   1.7e-4 (photon_mode 1 and 2: worst 0.15%, mean 1.7e-5); outside
-//!   exactly equal; bound 2%. (Snapping splats to texel
+//!   exactly equal; bound 2%. Same test with a spot light (30° cone, one
+//!   perspective view): worst 0.34%, mean 1.5e-4; with a directional light
+//!   along (0.3, -1, 0.2) (orthographic views, 0.2 m rim band): worst
+//!   0.15%, mean 2.1e-4. (Snapping splats to texel
 //!   centres gave 8.8% worst pixel from aliasing: hence sub-texel splats.)
 //! - ball_lens_focus (512²/512²): paraxial photons (impact 0.03-0.1 R) cross
 //!   the axis 4.9 mm from the thick-lens paraxial focus (tolerance 18.1 mm =
@@ -48,7 +51,7 @@ mod common;
 use caustics::passes::caustic_map::GpuPhoton;
 use caustics::radiometry::fresnel_dielectric;
 use caustics::renderer::{FrameTargets, SceneGpu};
-use caustics::scene::Scene;
+use caustics::scene::{Light, LightKind, Scene};
 use caustics::shader_bindings as b;
 use caustics::techniques::image_space::{ImageSpace, PARAMS};
 use caustics::techniques::{Params, Technique};
@@ -68,13 +71,17 @@ const PHOTONS_REFERENCE: u64 = 8_000_000;
 const MAX_REFERENCE_ENERGY: f64 = 0.05;
 
 fn ball_scene(ior: Option<f32>, floor_y: f32) -> Scene {
+    ball_scene_lit(ior, floor_y, point_light(LIGHT, INTENSITY))
+}
+
+fn ball_scene_lit(ior: Option<f32>, floor_y: f32, light: Light) -> Scene {
     let mut objects = vec![object("floor", floor_mesh(5.0, floor_y, 0))];
     if ior.is_some() {
         objects.push(object("lens", sphere_mesh(CENTRE, RADIUS, 1, 64)));
     }
     scene(
         camera(Vec3::new(0.0, 5.0, 7.0), Vec3::new(0.0, 0.8, 0.0), 40.0),
-        vec![point_light(LIGHT, INTENSITY)],
+        vec![light],
         vec![
             diffuse("floor", ALBEDO),
             dielectric("glass", ior.unwrap_or(1.5)),
@@ -217,9 +224,9 @@ fn floor_flux(mode: u32) {
     assert_validation_clean(&ctx);
 }
 
-/// Floor pixels of the test camera: (index, angle from the light's axis at
-/// the light), skipping pixels whose ray meets the sphere (with a margin).
-fn floor_pixels(s: &Scene) -> Vec<(usize, f32)> {
+/// Floor pixels of the test camera: (index, floor point), skipping pixels
+/// whose ray meets the sphere (with a margin).
+fn floor_pixels(s: &Scene) -> Vec<(usize, Vec3)> {
     let mut out = Vec::new();
     for py in 0..SIZE {
         for px in 0..SIZE {
@@ -237,8 +244,7 @@ fn floor_pixels(s: &Scene) -> Vec<(usize, f32)> {
             if x.x.abs() > 4.9 || x.z.abs() > 4.9 {
                 continue;
             }
-            let rho = (x.x * x.x + x.z * x.z).sqrt();
-            out.push(((py * SIZE + px) as usize, (rho / LIGHT.y).atan()));
+            out.push(((py * SIZE + px) as usize, x));
         }
     }
     out
@@ -260,37 +266,73 @@ fn ior_one_gives_back_the_shadowed_light_back_march() {
 }
 
 fn ior_one(mode: u32) {
+    // The shadow's rim blurs by (splat/2 + 1) caustic texels of 2 / 512 rad
+    // on the -y cube face and by about a shadow texel of PCF: skip 0.02 rad
+    // either side, 0.128 m at the sphere's distance (6.4 m).
+    ior_one_with(mode, point_light(LIGHT, INTENSITY), 0.128);
+}
+
+#[test]
+fn ior_one_gives_back_the_shadowed_light_spot() {
+    let light = Light {
+        kind: LightKind::Spot,
+        cone_angle_deg: 30.0,
+        cone_falloff_deg: 5.0,
+        ..point_light(LIGHT, INTENSITY)
+    };
+    // One 60° view at 512²: texels of 2 tan 30° / 512 rad, smaller than the
+    // cube face's: the point light's band is ample.
+    ior_one_with(0, light, 0.128);
+}
+
+#[test]
+fn ior_one_gives_back_the_shadowed_light_directional() {
+    // Orthographic caustic map over the scene sphere (radius ~7.2 m): texels
+    // of 2.8 cm at 512², splat half-width 3.5 texels + PCF: skip 0.2 m.
+    let light = directional_light(Vec3::new(0.3, -1.0, 0.2), 3.0);
+    ior_one_with(0, light, 0.2);
+}
+
+/// IOR 1: the floor's radiance with the sphere equals the radiance without
+/// it, away from the shadow's rim: `band` metres either side of the sphere's
+/// silhouette, measured as the distance from the sphere's centre to the
+/// light's ray through the floor point.
+fn ior_one_with(mode: u32, light: Light, band: f32) {
     let ctx = validated_context();
-    let with = ball_scene(Some(1.0), 0.0);
-    let without = ball_scene(None, 0.0);
+    let with = ball_scene_lit(Some(1.0), 0.0, light);
+    let without = ball_scene_lit(None, 0.0, light);
     let mode = format!("photon_mode={mode}");
     let a = render(&ctx, &with, &[&mode]);
     let b_ = render(&ctx, &without, &[&mode]);
     let ra = a.targets.radiance.download_rgba32f().unwrap();
     let rb = b_.targets.radiance.download_rgba32f().unwrap();
     assert_finite(&ra);
-    // The shadow's rim: cone half-angle asin(R / D); the caustic splat blurs
-    // it by (splat/2 + 1) caustic texels of 2 / 512 rad on the -y cube face,
-    // the shadow's PCF by about a shadow texel: skip 0.02 rad either side.
-    let alpha = (RADIUS / (LIGHT - CENTRE).length()).asin();
-    let band = 0.02;
     let (mut worst_in, mut worst_out) = (0.0f32, 0.0f32);
     let (mut sum_a, mut sum_b, mut n_in) = (0.0f64, 0.0f64, 0);
-    for (i, gamma) in floor_pixels(&with) {
+    for (i, x) in floor_pixels(&with) {
+        let dir = match light.kind {
+            LightKind::Directional => light.direction.normalize(),
+            _ => (x - light.position).normalize(),
+        };
+        let line = (CENTRE - x).cross(dir).length();
         let (va, vb) = (ra[4 * i], rb[4 * i]);
+        if vb <= 0.0 {
+            continue; // outside a spot's cone
+        }
         let rel = (va - vb).abs() / vb;
-        if gamma < alpha - band {
+        if line < RADIUS - band {
             worst_in = worst_in.max(rel);
             sum_a += va as f64;
             sum_b += vb as f64;
             n_in += 1;
-        } else if gamma > alpha + band {
+        } else if line > RADIUS + band {
             worst_out = worst_out.max(rel);
         }
     }
     let mean_rel = (sum_a - sum_b).abs() / sum_b;
     println!(
-        "IOR 1: {n_in} pixels inside the shadow cone: worst relative error {worst_in:.4}, mean {mean_rel:.2e}; outside: worst {worst_out:.2e}"
+        "IOR 1, {:?} light, {mode}: {n_in} pixels inside the shadow: worst relative error {worst_in:.4}, mean {mean_rel:.2e}; outside: worst {worst_out:.2e}",
+        light.kind
     );
     assert!(n_in > 100);
     assert!(worst_out < 1e-4, "outside the shadow: {worst_out}");
