@@ -25,7 +25,13 @@
 //! Limits: the specular bounds are taken once at construction (animated
 //! specular objects would need them per frame); a point light inside the
 //! specular bounding sphere gets no caustics (logged); sprites crossing a
-//! map edge or a cube-face edge lose their clipped part.
+//! map edge or a cube-face edge lose their clipped part. The splat draws
+//! every photon once per view of the light (6x for a point light, culled in
+//! the vertex shader): 0.6 s of a 1.05 s frame at 512² on lavapipe.
+//! Mode 1 (Eq. 6.3.1) on the ball lens shows a faint halo outside the
+//! shadow (photons clamped to the critical angle) and four small dark
+//! spots in the caustic whose cause is not yet found; modes 0 and 2 show
+//! neither.
 
 use crate::passes::shadow::{shadow_views, GpuShadowLight};
 use crate::renderer::SceneGpu;
