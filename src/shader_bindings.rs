@@ -64,3 +64,26 @@ pub const DIRECT_BINDING_SHADOW_LIGHTS: u32 = 4;
 pub const PROBE_BINDING_RAYS: u32 = 10;
 pub const PROBE_BINDING_RESULTS: u32 = 11;
 pub const PROBE_BINDING_ANY: u32 = 12;
+
+// Caustic maps (src/passes/caustic_map.rs, glsl/caustic_map/), descriptor set 1.
+pub const CAUSTIC_BINDING_PHOTONS: u32 = 0;
+pub const CAUSTIC_BINDING_VIEWS: u32 = 1;
+pub const CAUSTIC_BINDING_MAP: u32 = 2;
+pub const CAUSTIC_BINDING_POSITION: u32 = 3;
+pub const CAUSTIC_BINDING_NORMAL: u32 = 4;
+pub const CAUSTIC_BINDING_RADIANCE: u32 = 5;
+/// Photon buffer halves: refracted photons first, then reflected ones.
+pub const PHOTON_REFRACTED: u32 = 0;
+pub const PHOTON_REFLECTED: u32 = 1;
+// Light-space G-buffers of the specular objects (image-space photon mode).
+pub const CAUSTIC_BINDING_FRONT_POSITION: u32 = 6;
+pub const CAUSTIC_BINDING_FRONT_NORMAL: u32 = 7;
+pub const CAUSTIC_BINDING_BACK_POSITION: u32 = 8;
+pub const CAUSTIC_BINDING_BACK_NORMAL: u32 = 9;
+/// Photon modes (`photon_mode` parameter of image_space).
+pub const PHOTON_MODE_TRACED: u32 = 0;
+pub const PHOTON_MODE_IMAGE_SPACE: u32 = 1;
+pub const PHOTON_MODE_BACK_MARCH: u32 = 2;
+/// Light-view G-buffer passes: nearest front faces, nearest back faces.
+pub const LIGHT_VIEW_FRONT: u32 = 0;
+pub const LIGHT_VIEW_BACK: u32 = 1;

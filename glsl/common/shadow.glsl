@@ -33,7 +33,11 @@ struct ShadowLight {
 layout(set = SHADOW_SET, binding = SHADOW_BINDING_LIGHTS, std140) uniform ShadowLightBlock {
     ShadowLight shadow_lights[MAX_LIGHTS];
 };
+// Define SHADOW_NO_MAP to get the views and their helpers without the map
+// (passes that only project into the light's views, e.g. caustic splats).
+#ifndef SHADOW_NO_MAP
 layout(set = SHADOW_SET, binding = SHADOW_BINDING_MAP) uniform sampler2DArray shadow_map;
+#endif
 
 const float NORMAL_OFFSET_TEXELS = 1.0;
 const float DEPTH_BIAS_TEXELS = 0.5;
@@ -62,6 +66,7 @@ float shadow_texel_world(ShadowLight s, vec3 x) {
     return s.info.x == SHADOW_PLANAR ? s.origin.w : s.origin.w * length(x - s.origin.xyz);
 }
 
+#ifndef SHADOW_NO_MAP
 // Fraction in [0, 1] of the (2 pcf + 1)^2 nearest-texel taps around x whose
 // stored occluder is not nearer the light than x: 1 exactly where every tap
 // is lit, 0 exactly where every tap is shadowed. n: unit normal on the lit
@@ -93,5 +98,7 @@ float shadow_visibility(uint l, vec3 x, vec3 n, vec3 to_light, int pcf) {
     float taps = float((2 * pcf + 1) * (2 * pcf + 1));
     return lit / taps;
 }
+
+#endif // SHADOW_NO_MAP
 
 #endif

@@ -4,6 +4,7 @@
 //! overlay and the benchmarks read the same list.
 
 pub mod direct;
+pub mod image_space;
 
 use crate::renderer::{FrameTargets, SceneGpu};
 use crate::scene::Scene;
@@ -119,6 +120,10 @@ pub const TECHNIQUES: &[TechniqueInfo] = &[TechniqueInfo {
     name: "direct",
     description: "direct light with shadow maps (the base frame every technique adds to)",
     params: direct::PARAMS,
+}, TechniqueInfo {
+    name: "image_space",
+    description: "Wyman 2005-06 caustic maps: photons through the specular objects, Gaussian splats, projected onto diffuse receivers",
+    params: image_space::PARAMS,
 }];
 
 pub fn find(name: &str) -> anyhow::Result<&'static TechniqueInfo> {
@@ -140,6 +145,9 @@ pub fn create(
 ) -> anyhow::Result<Box<dyn Technique>> {
     Ok(match name {
         "direct" => Box::new(direct::Direct::new(
+            ctx, params, scene, scene_gpu, width, height,
+        )?),
+        "image_space" => Box::new(image_space::ImageSpace::new(
             ctx, params, scene, scene_gpu, width, height,
         )?),
         other => {

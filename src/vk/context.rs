@@ -382,6 +382,13 @@ impl Context {
             .fragment_stores_and_atomics(true)
             .vertex_pipeline_stores_and_atomics(true)
             .multi_draw_indirect(true)
+            // Point sprites wider than one pixel (caustic-map splats), where offered.
+            .large_points(unsafe {
+                instance
+                    .get_physical_device_features(physical_device)
+                    .large_points
+                    == vk::TRUE
+            })
             .wide_lines(
                 props.limits.line_width_range[1] > 1.0
                     && unsafe {

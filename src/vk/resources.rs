@@ -357,6 +357,22 @@ impl Image {
 
     /// Reads layer 0 back as raw texels of `texel_size` bytes.
     pub fn download_bytes(&self, texel_size: u64) -> VkResult<Vec<u8>> {
+        self.download_layer_bytes(0, texel_size)
+    }
+
+    /// Reads layer `layer` back as 32-bit floats, four per pixel (RGBA32F).
+    pub fn download_layer_rgba32f(&self, layer: u32) -> VkResult<Vec<f32>> {
+        assert_eq!(
+            self.desc.format,
+            vk::Format::R32G32B32A32_SFLOAT,
+            "download_layer_rgba32f needs an RGBA32F image"
+        );
+        let bytes = self.download_layer_bytes(layer, 16)?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+
+    /// Reads layer `layer` back as raw texels of `texel_size` bytes.
+    pub fn download_layer_bytes(&self, layer: u32, texel_size: u64) -> VkResult<Vec<u8>> {
         let size = self.desc.width as u64 * self.desc.height as u64 * texel_size;
         let readback = Buffer::new(&self.ctx, "image readback", size, BufferUsage::Readback)?;
         self.ctx.submit_and_wait(|cmd| {
@@ -370,7 +386,7 @@ impl Image {
                 .image_subresource(vk::ImageSubresourceLayers {
                     aspect_mask: self.aspect(),
                     mip_level: 0,
-                    base_array_layer: 0,
+                    base_array_layer: layer,
                     layer_count: 1,
                 })
                 .image_extent(vk::Extent3D {

@@ -1,0 +1,124 @@
+#version 460
+// Caustic maps, step 3: project the light-space caustic map onto the diffuse
+// receivers of the camera G-buffer and add L = albedo / pi * E_caustic to
+// the radiance already there (the `direct` frame).
+//
+// The map holds flux per texel Phi (W). The texel's footprint on a receiver
+// at x with unit normal n has area
+//   perspective view: A = Omega_texel * d^2 / cos(theta)  (d = |x - light|,
+//                     theta between n and the direction to the light,
+//                     Omega_texel the texel's exact solid angle),
+//   orthographic:     A = a_texel / cos(theta)            (a_texel = texel side^2),
+// so E = Phi / A, exactly the flux that landed in that texel spread over the
+// area it covers on this receiver (flux is conserved: the integral of E over
+// a planar receiver is the sum of the texels' flux).
+//
+// Receivers hidden from the light by a diffuse surface get none of the
+// texel's flux: instead of the light's depth map we trace the straight line
+// to the light through the BVH, skipping specular surfaces (they are what
+// the caustic map accounts for), which is exact.
+#include "scene.glsl"
+#include "optics.glsl"
+#include "bvh.glsl"
+
+#define SHADOW_SET 1
+#define SHADOW_BINDING_LIGHTS CAUSTIC_BINDING_VIEWS
+#define SHADOW_NO_MAP
+#include "shadow.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 1, binding = CAUSTIC_BINDING_MAP) uniform sampler2DArray caustic_map;
+layout(set = 1, binding = CAUSTIC_BINDING_POSITION, rgba32f) uniform readonly image2D g_position;
+layout(set = 1, binding = CAUSTIC_BINDING_NORMAL, rgba32f) uniform readonly image2D g_normal;
+layout(set = 1, binding = CAUSTIC_BINDING_RADIANCE, rgba32f) uniform image2D radiance;
+
+layout(push_constant) uniform Push {
+    uint light_count;
+} pc;
+
+// Solid angle of the tan-plane rectangle [u0,u1] x [v0,v1] (2x2 Gauss-Legendre,
+// as in photons.comp).
+float texel_solid_angle(float u0, float u1, float v0, float v1) {
+    const float g = 0.5773502691896258;
+    float hu = 0.5 * (u1 - u0), hv = 0.5 * (v1 - v0);
+    float cu = 0.5 * (u1 + u0), cv = 0.5 * (v1 + v0);
+    float sum = 0.0;
+    for (int i = 0; i < 2; ++i) {
+        for (int j = 0; j < 2; ++j) {
+            float u = cu + (i == 0 ? -g : g) * hu;
+            float v = cv + (j == 0 ? -g : g) * hv;
+            float r2 = 1.0 + u * u + v * v;
+            sum += inversesqrt(r2 * r2 * r2);
+        }
+    }
+    return sum * hu * hv;
+}
+
+// True if no diffuse surface lies between x and the light (specular ones are skipped).
+bool diffuse_visible(vec3 x, vec3 to_light, float dist) {
+    vec3 o = x;
+    float travelled = 0.0;
+    for (int i = 0; i < 32; ++i) {
+        Hit h;
+        if (!trace_closest(o, to_light, 0.0, dist - travelled, h)) return true;
+        if (material_kind(hit_material(h)) == MATERIAL_DIFFUSE) return false;
+        vec3 p = hit_position(h, o, to_light);
+        travelled += h.t;
+        o = p + to_light * (1e-4 * max(1.0, bvh_max_abs(p)));
+        travelled += 1e-4 * max(1.0, bvh_max_abs(p));
+        if (travelled >= dist) return true;
+    }
+    return true;
+}
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(p, imageSize(radiance)))) return;
+    vec4 position = imageLoad(g_position, p);
+    if (position.w == 0.0) return;
+    vec4 nm = imageLoad(g_normal, p);
+    uint material = uint(nm.w + 0.5);
+    if (material_kind(material) != MATERIAL_DIFFUSE) return;
+    vec3 x = position.xyz;
+    vec3 n = normalize(nm.xyz);
+    ivec2 size = textureSize(caustic_map, 0).xy;
+    vec3 e_sum = vec3(0.0);
+    for (uint l = 0u; l < pc.light_count; ++l) {
+        ShadowLight s = shadow_lights[l];
+        uint view = shadow_view(s, x);
+        vec4 clip = s.view_proj[view] * vec4(x, 1.0);
+        if (clip.w <= 0.0) continue;
+        vec2 ndc = clip.xy / clip.w;
+        if (any(greaterThan(abs(ndc), vec2(1.0)))) continue;
+        ivec2 texel = clamp(ivec2(floor((ndc * 0.5 + 0.5) * vec2(size))), ivec2(0), size - 1);
+        vec3 flux = texelFetch(caustic_map, ivec3(texel, int(s.info.z + view)), 0).rgb;
+        if (all(equal(flux, vec3(0.0)))) continue;
+        vec3 to_light;
+        float dist;
+        float area;
+        if (s.info.x == SHADOW_PLANAR) {
+            to_light = -s.direction.xyz;
+            dist = 1e30;
+            area = s.origin.w * s.origin.w;
+        } else {
+            vec3 v = s.origin.xyz - x;
+            dist = length(v);
+            to_light = v / dist;
+            // origin.w = 2 tan(half fov) / size: texel edges in the tan plane.
+            float h = s.origin.w * float(size.x) * 0.5;
+            float u0 = (2.0 * float(texel.x) / float(size.x) - 1.0) * h;
+            float u1 = (2.0 * float(texel.x + 1) / float(size.x) - 1.0) * h;
+            float v0 = (2.0 * float(texel.y) / float(size.y) - 1.0) * h;
+            float v1 = (2.0 * float(texel.y + 1) / float(size.y) - 1.0) * h;
+            area = texel_solid_angle(u0, u1, v0, v1) * dist * dist;
+        }
+        float cos_t = dot(n, to_light);
+        if (cos_t <= 0.0) continue;
+        if (!diffuse_visible(x + n * (1e-4 * max(1.0, bvh_max_abs(x))), to_light, dist)) continue;
+        e_sum += flux * cos_t / area;
+    }
+    vec3 albedo = materials[material].color.rgb;
+    vec4 prev = imageLoad(radiance, p);
+    imageStore(radiance, p, vec4(prev.rgb + albedo / PI * e_sum, prev.a));
+}

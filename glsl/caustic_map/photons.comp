@@ -1,0 +1,381 @@
+#version 460
+// Caustic maps, step 1: the photon buffer (Wyman & Davis 2006, "Approximate,
+// Image-Space Caustics": render the specular objects from the light and
+// store where each texel's photon lands).
+//
+// One invocation per texel of the light-space photon view: a perspective
+// frustum fitted to the specular objects' bounding sphere (point and spot
+// lights) or an orthographic box (directional). The photon leaves the light
+// through the texel centre carrying
+//   point/spot:  Phi = I * falloff * Omega_texel, Omega_texel the texel's
+//                exact solid angle (2x2 Gauss-Legendre quadrature of
+//                dOmega = du dv / (1 + u^2 + v^2)^(3/2) over the texel in
+//                the tan plane: error O(h^4), below float rounding);
+//   directional: Phi = E * A_texel (texel area perpendicular to the light).
+// Three ways to find the refracted path (push constant `mode`):
+// - PHOTON_MODE_TRACED (default): interfaces and landing point by tracing
+//   the BVH; exact, any number of interfaces.
+// - PHOTON_MODE_IMAGE_SPACE: Wyman 2005's two-sided refraction from the
+//   light: front interface p1, N1 from the light-space front G-buffer; Snell;
+//   distance to the back interface by Eq. 6.3.1 between d_V (front/back
+//   light-space depth maps) and d_N (cast along -N1 through the BVH, where
+//   Wyman precomputes it per vertex); N2 from the back-face normal texture
+//   at p2's projection; Snell again.
+// - PHOTON_MODE_BACK_MARCH: the same G-buffers, but p2 where the refracted
+//   ray passes behind the back-face map (exact for convex objects).
+// In both light-space modes the exit ray is landed on the first diffuse
+// surface through the BVH (Wyman intersects the light-space depth map of
+// the receivers; the BVH is exact), passing through further specular
+// surfaces unrefracted. Mode 1 handles Wyman's failure cases as he suggests:
+// total internal reflection at the approximated exit clamps to the critical
+// angle (his second fix; the photon keeps its flux); a p2 projecting
+// outside the back faces gets N2 from Eq. 6.3.2. Mode 2 drops those (rare)
+// photons.
+// At the first dielectric interface the photon splits: the reflected part
+// (Fresnel F) goes to the second half of the buffer, the transmitted part
+// (1 - F) to the first. Further interfaces keep only transmission (weight
+// 1 - F); total internal reflection reflects and continues (up to
+// MAX_BOUNCES). Mirrors reflect with their reflectance. A photon that
+// leaves the scene or runs out of bounces is dropped (w = 0).
+#include "scene.glsl"
+#include "optics.glsl"
+#include "lights.glsl"
+#include "bvh.glsl"
+#include "photon.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 1, binding = CAUSTIC_BINDING_PHOTONS, std430) writeonly buffer PhotonBlock { Photon photons[]; };
+
+layout(push_constant) uniform Push {
+    vec4 origin;  // xyz: light position (perspective) or ortho plane centre; w: half-width (tan or metres)
+    vec4 right;   // xyz; w: light index (uint bits)
+    vec4 up;      // xyz; w: photon view size N (uint bits)
+    vec4 forward; // xyz; w: SHADOW_RADIAL (perspective) or SHADOW_PLANAR (ortho) (uint bits)
+    uvec4 mode;   // x: PHOTON_MODE_TRACED or PHOTON_MODE_IMAGE_SPACE
+} pc;
+
+// Light-space G-buffers of the specular objects (image-space mode only):
+// nearest front faces and nearest back faces, position (w: covered) and
+// outward smooth normal (w: material).
+layout(set = 1, binding = CAUSTIC_BINDING_FRONT_POSITION, rgba32f) uniform readonly image2D front_position;
+layout(set = 1, binding = CAUSTIC_BINDING_FRONT_NORMAL, rgba32f) uniform readonly image2D front_normal;
+layout(set = 1, binding = CAUSTIC_BINDING_BACK_POSITION, rgba32f) uniform readonly image2D back_position;
+layout(set = 1, binding = CAUSTIC_BINDING_BACK_NORMAL, rgba32f) uniform readonly image2D back_normal;
+
+const int MAX_BOUNCES = 8;
+
+vec3 offset_origin(vec3 x, vec3 n) {
+    return x + n * (1e-4 * max(1.0, bvh_max_abs(x)));
+}
+
+// Solid angle of the tan-plane rectangle [u0,u1] x [v0,v1] at unit distance.
+float texel_solid_angle(float u0, float u1, float v0, float v1) {
+    const float g = 0.5773502691896258; // 1/sqrt(3)
+    float hu = 0.5 * (u1 - u0), hv = 0.5 * (v1 - v0);
+    float cu = 0.5 * (u1 + u0), cv = 0.5 * (v1 + v0);
+    float sum = 0.0;
+    for (int i = 0; i < 2; ++i) {
+        for (int j = 0; j < 2; ++j) {
+            float u = cu + (i == 0 ? -g : g) * hu;
+            float v = cv + (j == 0 ? -g : g) * hv;
+            float r2 = 1.0 + u * u + v * v;
+            sum += inversesqrt(r2 * r2 * r2);
+        }
+    }
+    return sum * hu * hv; // 4 points of weight 1 on [-1,1]^2, Jacobian hu hv
+}
+
+// Follows a specular chain from (o, d) with weight w; true if it lands on a
+// diffuse surface (p3, arrival direction in `d`).
+bool follow(vec3 o, inout vec3 d, inout vec3 w, bool inside, vec3 absorption, out vec3 p3) {
+    p3 = vec3(0.0);
+    for (int bounce = 0; bounce < MAX_BOUNCES; ++bounce) {
+        Hit h;
+        if (!trace_closest(o, d, 0.0, 1e30, h)) return false;
+        vec3 x = hit_position(h, o, d);
+        if (inside) w *= exp(-absorption * h.t);
+        uint m = hit_material(h);
+        uint kind = material_kind(m);
+        if (kind == MATERIAL_DIFFUSE) {
+            p3 = x;
+            return true;
+        }
+        vec3 ng = hit_geometric_normal(h);
+        bool front = dot(d, ng) < 0.0;
+        vec3 ng_in = front ? ng : -ng;
+        vec3 ns = hit_normal(h);
+        vec3 n = dot(ns, ng_in) > 0.0 ? ns : -ns;
+        if (kind == MATERIAL_MIRROR) {
+            w *= materials[m].color.rgb;
+            vec3 r = reflect(d, n);
+            d = dot(r, ng_in) > 0.0 ? r : reflect(d, ng_in);
+            o = offset_origin(x, ng_in);
+            continue;
+        }
+        float eta = front ? 1.0 / materials[m].absorption_ior.w : materials[m].absorption_ior.w;
+        vec3 t;
+        bool ok = refract_dir(d, n, eta, t);
+        if (ok && dot(t, ng_in) >= 0.0) {
+            n = ng_in;
+            ok = refract_dir(d, n, eta, t);
+        }
+        if (ok) {
+            w *= 1.0 - fresnel_dielectric(-dot(d, n), eta);
+            d = t;
+            o = offset_origin(x, -ng_in);
+            inside = front;
+            absorption = materials[m].absorption_ior.rgb;
+        } else {
+            // Total internal reflection: all of the flux reflects.
+            vec3 r = reflect(d, n);
+            d = dot(r, ng_in) > 0.0 ? r : reflect(d, ng_in);
+            o = offset_origin(x, ng_in);
+        }
+    }
+    return false;
+}
+
+// Lands a photon leaving the specular objects at o along d on the first
+// diffuse surface, passing through specular ones unrefracted (image-space
+// mode: the caustic map models one refractor's two interfaces).
+bool land(vec3 o, vec3 d, out vec3 p3) {
+    p3 = vec3(0.0);
+    for (int i = 0; i < 16; ++i) {
+        Hit h;
+        if (!trace_closest(o, d, 0.0, 1e30, h)) return false;
+        vec3 x = hit_position(h, o, d);
+        if (material_kind(hit_material(h)) == MATERIAL_DIFFUSE) {
+            p3 = x;
+            return true;
+        }
+        o = x + d * (1e-4 * max(1.0, bvh_max_abs(x)));
+    }
+    return false;
+}
+
+// The photon-view texel x projects to, or (-1, -1) outside the view.
+ivec2 light_texel(vec3 x) {
+    uint n_size = floatBitsToUint(pc.up.w);
+    vec3 v = x - pc.origin.xyz;
+    vec2 st;
+    if (floatBitsToUint(pc.forward.w) == SHADOW_PLANAR) {
+        st = vec2(dot(v, pc.right.xyz), dot(v, pc.up.xyz));
+    } else {
+        float z = dot(v, pc.forward.xyz);
+        if (z <= 0.0) return ivec2(-1);
+        st = vec2(dot(v, pc.right.xyz), dot(v, pc.up.xyz)) / z;
+    }
+    ivec2 q = ivec2(floor((st / pc.origin.w * 0.5 + 0.5) * float(n_size)));
+    if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(n_size)))) return ivec2(-1);
+    return q;
+}
+
+// Depth of x along the light's rays (distance, or depth along the axis).
+float light_depth(vec3 x) {
+    vec3 v = x - pc.origin.xyz;
+    return floatBitsToUint(pc.forward.w) == SHADOW_PLANAR ? dot(v, pc.forward.xyz) : length(v);
+}
+
+// True if x lies at or behind the back surface stored at its texel (or
+// outside the back faces' coverage: the ray has left the object).
+bool behind_back(vec3 x) {
+    ivec2 q = light_texel(x);
+    if (q.x < 0) return true;
+    vec4 b = imageLoad(back_position, q);
+    if (b.w == 0.0) return true;
+    return light_depth(x) >= light_depth(b.xyz);
+}
+
+// Wyman 2005 two-sided refraction from the light (image-space mode), for the
+// refracted photon of texel `id` entering at p1 (normal n1 facing the light,
+// incident direction d, eta = 1 / ior, weight w already times 1 - F1):
+// - d_V: distance from p1 to the nearest back face along the light's ray
+//   at this texel (the two light-space depth maps);
+// - d_N: distance from p1 to the back surface along -n1. Wyman precomputes
+//   it per vertex by ray casting; here it is cast per texel against the BVH;
+// - Eq. 6.3.1: d~ = (theta_t / theta_i) d_V + (1 - theta_t / theta_i) d_N,
+//   p2 = p1 + d~ T1;
+// - N2: the back-face normal texture at p2's projection; refract out of the
+//   glass about -N2 (Snell), weight 1 - F2, Beer-Lambert over d~. Total
+//   internal reflection there: leave tangent (mode 1) or drop (mode 2);
+//   p2 outside the back faces: Eq. 6.3.2 (mode 1) or drop (mode 2).
+// Mode 2 replaces Eq. 6.3.1 by marching T1 against the back-face map.
+bool image_space_refraction(uvec2 id, vec3 p1, vec3 n1, vec3 d, uint m, inout vec3 w, out vec3 p3, out vec3 dir) {
+    p3 = vec3(0.0);
+    dir = vec3(0.0);
+    float ior = materials[m].absorption_ior.w;
+    vec3 t1;
+    if (!refract_dir(d, n1, 1.0 / ior, t1)) return false;
+    vec4 bp = imageLoad(back_position, ivec2(id));
+    if (bp.w == 0.0) return false;
+    float d_v = length(bp.xyz - p1);
+    float d_n = d_v;
+    Hit h;
+    vec3 o = p1 - n1 * (1e-4 * max(1.0, bvh_max_abs(p1)));
+    if (trace_closest(o, -n1, 0.0, 1e30, h)) d_n = h.t;
+    float dist;
+    ivec2 q;
+    vec3 n2_fallback = vec3(0.0);
+    bool use_fallback = false;
+    if (pc.mode.x == PHOTON_MODE_IMAGE_SPACE) {
+        float theta_i = acos(clamp(-dot(d, n1), -1.0, 1.0));
+        float theta_t = acos(clamp(-dot(t1, n1), -1.0, 1.0));
+        float ratio = theta_i > 1e-4 ? theta_t / theta_i : 1.0 / ior;
+        dist = ratio * d_v + (1.0 - ratio) * d_n;
+        q = light_texel(p1 + dist * t1);
+        if (q.x < 0 || imageLoad(back_position, q).w == 0.0) {
+            // d~ overshot past the back faces' coverage: Wyman's Eq. 6.3.2,
+            // N2 = T1 - (V . T1) V, perpendicular to the light's ray V.
+            n2_fallback = normalize(t1 - dot(d, t1) * d);
+            use_fallback = true;
+        }
+    } else {
+        // PHOTON_MODE_BACK_MARCH: march the refracted ray against the
+        // back-face map until it passes behind the stored back surface
+        // (steps of max(d_V, d_N) / 32, then 16 bisections). Exact for
+        // convex objects up to the map's resolution.
+        float t_max = 1.05 * max(max(d_v, d_n), 1e-4);
+        float lo = 0.0, hi = -1.0;
+        for (int i = 1; i <= 32; ++i) {
+            float t = t_max * float(i) / 32.0;
+            if (behind_back(p1 + t * t1)) { hi = t; break; }
+            lo = t;
+        }
+        if (hi < 0.0) return false;
+        for (int i = 0; i < 16; ++i) {
+            float mid = 0.5 * (lo + hi);
+            if (behind_back(p1 + mid * t1)) hi = mid; else lo = mid;
+        }
+        dist = hi;
+        q = light_texel(p1 + dist * t1);
+        if (q.x < 0 || imageLoad(back_position, q).w == 0.0) return false;
+    }
+    vec3 p2 = p1 + dist * t1;
+    vec3 n2 = use_fallback ? n2_fallback : imageLoad(back_normal, q).xyz;
+    n2 = -normalize(n2); // facing the ray inside the glass
+    if (dot(n2, t1) > 0.0) n2 = -n2;
+    w *= exp(-materials[m].absorption_ior.rgb * dist);
+    vec3 t2;
+    if (!refract_dir(t1, n2, ior, t2)) {
+        if (pc.mode.x != PHOTON_MODE_IMAGE_SPACE) return false;
+        // Total internal reflection at the approximated exit (for a convex
+        // refractor mostly an artefact of d~): Wyman's second ad hoc fix,
+        // clamp to the critical angle, i.e. leave tangent to the surface.
+        // The photon keeps its flux (the transmission it would have had is
+        // unknown; dropping it loses ~21% of a ball lens's caustic, and his
+        // third fix, reflecting, sends it back up past the light).
+        dir = normalize(t1 - dot(t1, n2) * n2);
+        return land(p2, dir, p3);
+    }
+    w *= 1.0 - fresnel_dielectric(-dot(t1, n2), ior);
+    dir = t2;
+    return land(p2, t2, p3);
+}
+
+void main() {
+    uint n_size = floatBitsToUint(pc.up.w);
+    uvec2 id = gl_GlobalInvocationID.xy;
+    if (id.x >= n_size || id.y >= n_size) return;
+    uint index = id.y * n_size + id.x;
+    uint count = n_size * n_size;
+    uint l = floatBitsToUint(pc.right.w);
+    bool planar = floatBitsToUint(pc.forward.w) == SHADOW_PLANAR;
+    float h = pc.origin.w;
+    float s0 = (2.0 * float(id.x) / float(n_size) - 1.0) * h;
+    float s1 = (2.0 * float(id.x + 1u) / float(n_size) - 1.0) * h;
+    float t0 = (2.0 * float(id.y) / float(n_size) - 1.0) * h;
+    float t1 = (2.0 * float(id.y + 1u) / float(n_size) - 1.0) * h;
+    float s = 0.5 * (s0 + s1), t = 0.5 * (t0 + t1);
+
+    vec3 o, d, w;
+    float measure;
+    Light light = lights[l];
+    if (planar) {
+        o = pc.origin.xyz + s * pc.right.xyz + t * pc.up.xyz;
+        d = pc.forward.xyz;
+        measure = (s1 - s0) * (t1 - t0);
+        w = light.intensity.rgb * measure;
+    } else {
+        o = pc.origin.xyz;
+        d = normalize(pc.forward.xyz + s * pc.right.xyz + t * pc.up.xyz);
+        measure = texel_solid_angle(s0, s1, t0, t1);
+        vec3 intensity = light.intensity.rgb;
+        if (light_kind(l) == LIGHT_SPOT) {
+            intensity *= spot_falloff(dot(d, light.direction.xyz), light.direction.w, light.intensity.w);
+        }
+        w = intensity * measure;
+    }
+    Photon none = Photon(vec4(0.0), vec4(0.0, 0.0, 0.0, measure), vec4(0.0));
+    photons[index] = none;
+    photons[count + index] = none;
+    if (all(equal(w, vec3(0.0)))) return;
+
+    // The first surface: only photons meeting a specular object first make
+    // caustics. Traced: the BVH; image space: the front-face G-buffer (its
+    // position lies on this texel's centre ray).
+    bool image_space = pc.mode.x != PHOTON_MODE_TRACED;
+    uint m;
+    vec3 x, ng, ns;
+    bool front = true;
+    if (image_space) {
+        vec4 fp = imageLoad(front_position, ivec2(id));
+        if (fp.w == 0.0) return;
+        vec4 fn = imageLoad(front_normal, ivec2(id));
+        m = uint(fn.w + 0.5);
+        x = fp.xyz;
+        ns = normalize(fn.xyz);
+        ng = dot(ns, d) < 0.0 ? ns : -ns;
+    } else {
+        Hit hit;
+        if (!trace_closest(o, d, 0.0, 1e30, hit)) return;
+        m = hit_material(hit);
+        x = hit_position(hit, o, d);
+        ng = hit_geometric_normal(hit);
+        front = dot(d, ng) < 0.0;
+        ns = hit_normal(hit);
+    }
+    uint kind = material_kind(m);
+    if (kind == MATERIAL_DIFFUSE) return;
+    vec3 ng_in = front ? ng : -ng;
+    vec3 n = dot(ns, ng_in) > 0.0 ? ns : -ns;
+
+    // Reflected photon (mirror: reflectance; dielectric: Fresnel F).
+    vec3 r = reflect(d, n);
+    r = dot(r, ng_in) > 0.0 ? r : reflect(d, ng_in);
+    float eta = 1.0;
+    float f = 1.0;
+    vec3 wr = w * materials[m].color.rgb;
+    if (kind == MATERIAL_DIELECTRIC) {
+        eta = front ? 1.0 / materials[m].absorption_ior.w : materials[m].absorption_ior.w;
+        f = fresnel_dielectric(-dot(d, n), eta);
+        wr = w * f;
+    }
+    vec3 p3;
+    vec3 dr = r;
+    if (any(greaterThan(wr, vec3(0.0))) && follow(offset_origin(x, ng_in), dr, wr, false, vec3(0.0), p3)) {
+        photons[count + index] = Photon(vec4(p3, 1.0), vec4(wr, measure), vec4(dr, 0.0));
+    }
+    if (kind != MATERIAL_DIELECTRIC) return;
+
+    // Refracted photon: Snell at the front interface, weight 1 - F, then the chain.
+    vec3 tdir;
+    bool ok = refract_dir(d, n, eta, tdir);
+    vec3 nt = n;
+    if (ok && dot(tdir, ng_in) >= 0.0) {
+        nt = ng_in;
+        ok = refract_dir(d, nt, eta, tdir);
+    }
+    if (!ok) return;
+    vec3 wt = w * (1.0 - fresnel_dielectric(-dot(d, nt), eta));
+    if (image_space) {
+        vec3 dt;
+        if (image_space_refraction(id, x, n, d, m, wt, p3, dt)) {
+            photons[index] = Photon(vec4(p3, 1.0), vec4(wt, measure), vec4(dt, 0.0));
+        }
+        return;
+    }
+    if (follow(offset_origin(x, -ng_in), tdir, wt, front, materials[m].absorption_ior.rgb, p3)) {
+        photons[index] = Photon(vec4(p3, 1.0), vec4(wt, measure), vec4(tdir, 0.0));
+    }
+}
