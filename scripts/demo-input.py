@@ -8,7 +8,8 @@
 
 Without a window manager nothing gives the window keyboard focus, so the
 script focuses the window under the pointer. It presses P (screenshot),
-2 and 9 (no such technique: ignored), Space, R, 1, Space, drags with the
+2 (image_space), C three times (direct alone, surface caustics alone, all),
+9 (no such technique: ignored), Space, R, 1, Space, drags with the
 left (orbit) and right (pan) buttons, scrolls, holds W, drags with L held
 (moves the light), then Esc.
 """
@@ -57,7 +58,7 @@ if not c.value:
     sys.exit("no window under the pointer at (200, 200)")
 x.XSetInputFocus(d, c, 2, 0)
 x.XFlush(d)
-for k in ["P", "2", "9", "space", "R", "1", "space"]:
+for k in ["P", "2", "c", "c", "c", "9", "space", "R", "1", "space"]:
     key(k)
 button(1, 1); move(250, 220); move(300, 240); button(1, 0)  # orbit
 button(3, 1); move(280, 230); button(3, 0)  # pan

@@ -91,6 +91,9 @@ pub struct GpuFrame {
     pub scene_sphere: [f32; 4],
     /// x lights, y triangles, z materials, w frame index.
     pub counts: [u32; 4],
+    /// x: the path-type components techniques draw, a bit mask
+    /// (1 << COMPONENT_*; `Component::mask`); yzw reserved.
+    pub components: [u32; 4],
 }
 
 const _: () = {
@@ -101,9 +104,10 @@ const _: () = {
     assert!(size_of::<GpuLight>() == 64);
     assert!(size_of::<GpuMedium>() == 96);
     assert!(offset_of!(GpuMedium, dims) == 80);
-    assert!(size_of::<GpuFrame>() == 320);
+    assert!(size_of::<GpuFrame>() == 336);
     assert!(offset_of!(GpuFrame, eye) == 256);
     assert!(offset_of!(GpuFrame, counts) == 304);
+    assert!(offset_of!(GpuFrame, components) == 320);
 };
 
 fn v4(v: Vec3, w: f32) -> [f32; 4] {

@@ -62,6 +62,9 @@ enum Command {
         /// Frames to render (time advances 1/60 s per frame); timings are averaged over them.
         #[arg(long, default_value_t = 1)]
         frames: u32,
+        /// Path-type component to draw: one the technique renders (`--technique list`) or all.
+        #[arg(long, default_value = "all")]
+        component: String,
         /// Output image; .png or .exr (the other format is written beside it).
         #[arg(long, default_value = "out/render.png")]
         out: PathBuf,
@@ -286,6 +289,8 @@ fn list_techniques() {
     println!("techniques (caustics render --technique NAME):");
     for t in techniques::TECHNIQUES {
         println!("  {:<14} {}", t.name, t.description);
+        let components: Vec<_> = t.components.iter().map(|c| c.name()).collect();
+        println!("      --component {}|all", components.join("|"));
         for p in t.params {
             println!(
                 "      --param {}=VALUE  {} [{} .. {}], default {}",
@@ -365,6 +370,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             technique,
             params,
             frames,
+            component,
             out,
             device,
         } => {
@@ -374,6 +380,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             output::format_of(&out)?;
             let (loaded, params) = checked_technique_run(&scene, &technique, &params, frames)?;
+            let components = techniques::find(&technique)?.component_mask(&component)?;
             let outputs = output::prepare(&out)?;
             let ctx = context(&device)?;
             let mut renderer = Renderer::new(
@@ -385,6 +392,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 scene.height,
                 scene.time,
             )?;
+            renderer.scene_gpu.components = components;
             let mut all = Vec::new();
             for i in 0..frames {
                 all.push(renderer.render_frame(scene.time + i as f32 / 60.0)?);

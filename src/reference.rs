@@ -60,6 +60,15 @@ impl Component {
             .unwrap_or("all")
     }
 
+    /// This component's bit in the frame constants' component mask
+    /// (`component_weight` in glsl/common/scene.glsl); `All`: every bit.
+    pub fn mask(self) -> u32 {
+        match self {
+            Component::All => (1 << b::COMPONENT_COUNT) - 1,
+            c => 1 << c.index(),
+        }
+    }
+
     fn index(self) -> u32 {
         match self {
             Component::Direct => b::COMPONENT_DIRECT,

@@ -393,6 +393,17 @@ fn bad_arguments_fail_cleanly() {
             vec!["unknown component `nope`", "surface_caustics"],
         ),
         (
+            vec!["render", "--component", "nope"],
+            vec!["unknown component `nope`", "surface_caustics"],
+        ),
+        (
+            vec!["render", "--component", "surface_caustics"],
+            vec![
+                "technique `direct` does not render component `surface_caustics`",
+                "it renders: direct, all",
+            ],
+        ),
+        (
             vec!["render", "--device", "99"],
             vec!["no device matches --device \"99\"", "caustics info"],
         ),
@@ -527,6 +538,70 @@ fn info_lists_the_device_with_every_required_feature() {
         );
     }
     assert!(!o.stdout.contains("NO "), "{}", o.describe());
+}
+
+/// `render --component` splits a frame into its path-type components: with
+/// `image_space` on the ball lens, direct + surface caustics is the full
+/// frame (the technique adds the caustic term onto the direct term, so the
+/// sum holds to float rounding), the caustic part is not empty, and it is
+/// zero where the component mask drops it.
+#[test]
+fn render_components_add_up_to_the_frame() {
+    let dir = temp_dir("components");
+    let scene = manifest("assets/scenes/ball_lens.toml");
+    let mut images = Vec::new();
+    for component in ["all", "direct", "surface_caustics"] {
+        let exr = dir.join(format!("{component}.exr"));
+        let o = run(&[
+            "render",
+            "--scene",
+            s(&scene),
+            "--technique",
+            "image_space",
+            "--param",
+            "photon_buffer_size=128",
+            "--param",
+            "caustic_map_size=128",
+            "--component",
+            component,
+            "--width",
+            "64",
+            "--height",
+            "64",
+            "--validate",
+            "--out",
+            s(&exr),
+        ]);
+        assert_eq!(o.code, Some(0), "{}", o.describe());
+        assert_silent_teardown(&o);
+        check_exr(&exr, 64, 64);
+        images.push(caustics::output::read_exr(&exr).expect("read EXR").2);
+    }
+    let (all, direct, caustic) = (&images[0], &images[1], &images[2]);
+    let total = |img: &[f32]| {
+        img.chunks_exact(4)
+            .map(|p| (p[0] + p[1] + p[2]) as f64)
+            .sum::<f64>()
+    };
+    let (e_all, e_direct, e_caustic) = (total(all), total(direct), total(caustic));
+    assert!(e_caustic > 0.01 * e_all, "caustic {e_caustic} of {e_all}");
+    assert!(e_direct > 0.5 * e_all, "direct {e_direct} of {e_all}");
+    for ((a, d), c) in all
+        .chunks_exact(4)
+        .zip(direct.chunks_exact(4))
+        .zip(caustic.chunks_exact(4))
+    {
+        for k in 0..3 {
+            let sum = d[k] + c[k];
+            assert!(
+                (a[k] - sum).abs() <= 1e-5 * a[k].abs().max(1.0),
+                "all {} != direct {} + caustic {}",
+                a[k],
+                d[k],
+                c[k]
+            );
+        }
+    }
 }
 
 // ---------------------------------------------------------------- canonical scenes

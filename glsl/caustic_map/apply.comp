@@ -120,5 +120,6 @@ void main() {
     }
     vec3 albedo = materials[material].color.rgb;
     vec4 prev = imageLoad(radiance, p);
-    imageStore(radiance, p, vec4(prev.rgb + albedo / PI * e_sum, prev.a));
+    vec3 caustic = component_weight(COMPONENT_SURFACE_CAUSTICS) * albedo / PI * e_sum;
+    imageStore(radiance, p, vec4(prev.rgb + caustic, prev.a));
 }

@@ -56,7 +56,13 @@ layout(set = SCENE_SET, binding = BINDING_FRAME, std140) uniform FrameBlock {
     vec4 viewport;     // width, height, aspect, time
     vec4 scene_sphere; // centre, radius
     uvec4 counts;      // lights, triangles, materials, frame index
+    uvec4 components;  // x: bit mask of the components drawn (1 << COMPONENT_*)
 } frame;
+
+// 1.0 when the path-type component `c` (COMPONENT_*) is drawn this frame,
+// else 0.0: techniques multiply each component's radiance by it (the
+// demo's C key, `caustics render --component`).
+float component_weight(uint c) { return (frame.components.x & (1u << c)) != 0u ? 1.0 : 0.0; }
 
 layout(set = SCENE_SET, binding = BINDING_TRIANGLES, std430) readonly buffer TriangleBlock { Triangle triangles[]; };
 layout(set = SCENE_SET, binding = BINDING_BVH_NODES, std430) readonly buffer BvhBlock { BvhNode bvh_nodes[]; };

@@ -50,5 +50,5 @@ void main() {
         e_sum += e * shadow_visibility(l, x, n, to_light, pc.pcf_radius);
     }
     vec3 albedo = materials[material].color.rgb;
-    imageStore(radiance, p, vec4(albedo / PI * e_sum, 1.0));
+    imageStore(radiance, p, vec4(component_weight(COMPONENT_DIRECT) * albedo / PI * e_sum, 1.0));
 }

@@ -17,9 +17,10 @@ mod camera;
 mod overlay;
 
 pub use camera::OrbitCamera;
-use overlay::{Action, Overlay, UiData};
+use overlay::{Action, MediumValues, Overlay, UiData};
 
 use crate::output;
+use crate::reference::Component;
 use crate::renderer::Renderer;
 use crate::scene::Scene;
 use crate::techniques::{self, Params};
@@ -232,8 +233,11 @@ struct State {
     presented: u32,
     /// The swapchain no longer matches the window (resize, out of date).
     stale: bool,
-    /// A light moved: the scene is re-uploaded before the next frame.
-    light_moved: bool,
+    /// A light moved or its intensity changed: the lights are re-uploaded
+    /// before the next frame.
+    lights_changed: bool,
+    /// The medium's coefficients changed: re-uploaded before the next frame.
+    medium_changed: bool,
     timings: Vec<Vec<PassTiming>>,
     frame_ms: Vec<f64>,
     /// The last frame's per-pass timings and recent frame intervals (overlay).
@@ -307,7 +311,8 @@ impl App {
             last: now,
             presented: 0,
             stale: true,
-            light_moved: false,
+            lights_changed: false,
+            medium_changed: false,
             timings: Vec::new(),
             frame_ms: Vec::new(),
             last_timings: Vec::new(),
@@ -319,7 +324,7 @@ impl App {
         };
         state.recreate(o.present_mode)?;
         println!(
-            "demo: {} at {}x{}, present mode {:?}; keys: 1-9 technique, Space pause, R reload, P screenshot, Esc quit; \
+            "demo: {} at {}x{}, present mode {:?}; keys: 1-9 technique, C components, F1 overlay, Space pause, R reload, P screenshot, Esc quit; \
              mouse: left orbit, right pan, wheel zoom, L+left move light; WASD fly",
             state.renderer.technique_name(),
             state.renderer.targets.width,
@@ -414,11 +419,18 @@ impl State {
             self.time += dt;
         }
         self.apply_fly(dt);
-        if self.light_moved {
-            self.light_moved = false;
+        if self.lights_changed {
+            self.lights_changed = false;
             // The scene (lights) is re-uploaded: nothing may still read it.
             self.ctx().wait_idle();
             self.renderer.lights_changed(self.time)?;
+        }
+        if self.medium_changed {
+            self.medium_changed = false;
+            self.ctx().wait_idle();
+            self.renderer
+                .scene_gpu
+                .update_medium(&self.renderer.scene)?;
         }
         self.renderer.scene.camera = self.camera.camera();
 
@@ -447,11 +459,40 @@ impl State {
                 params: self.renderer.params(),
                 timings: &self.last_timings,
                 history_ms: &history,
+                components: self.renderer.technique_info().components,
+                component_mask: self.renderer.scene_gpu.components,
+                medium: self.renderer.scene.medium.as_ref().map(|m| MediumValues {
+                    sigma_s: m.sigma_s.to_array(),
+                    sigma_a: m.sigma_a.to_array(),
+                    g: m.g,
+                }),
+                light_intensities: self
+                    .renderer
+                    .scene
+                    .lights
+                    .iter()
+                    .map(|l| l.intensity.to_array())
+                    .collect(),
             },
         )?;
         for action in actions {
             match action {
                 Action::Technique(name) => self.switch_technique_named(name)?,
+                Action::Components(mask) => self.renderer.scene_gpu.components = mask,
+                Action::Medium(values) => {
+                    if let Some(m) = self.renderer.scene.medium.as_mut() {
+                        m.sigma_s = values.sigma_s.into();
+                        m.sigma_a = values.sigma_a.into();
+                        m.g = values.g;
+                        self.medium_changed = true;
+                    }
+                }
+                Action::LightIntensity { light, rgb } => {
+                    if let Some(l) = self.renderer.scene.lights.get_mut(light) {
+                        l.intensity = rgb.into();
+                        self.lights_changed = true;
+                    }
+                }
                 Action::Params(params) => {
                     ctx.wait_idle();
                     let name = self.renderer.technique_name();
@@ -621,7 +662,7 @@ impl State {
         let step = self.camera.distance * 0.003;
         if let Some(light) = self.renderer.scene.lights.first_mut() {
             light.position += (right * dx - ahead * dy) * step;
-            self.light_moved = true;
+            self.lights_changed = true;
         }
     }
 
@@ -680,8 +721,25 @@ impl State {
         let params = Params::resolve(info.name, info.params, &[])?;
         self.ctx().wait_idle();
         self.renderer.set_technique(info.name, &params)?;
+        self.renderer.scene_gpu.components = Component::All.mask();
         println!("technique: {}", info.name);
         Ok(())
+    }
+
+    /// C: all components, then each one the technique renders alone, then
+    /// all again.
+    fn cycle_components(&mut self) {
+        let all = Component::All.mask();
+        let own = self.renderer.technique_info().components;
+        let current = self.renderer.scene_gpu.components;
+        let position = own.iter().position(|c| c.mask() == current);
+        let next = match position {
+            None if current == all => own.first(),
+            Some(i) => own.get(i + 1),
+            None => None,
+        };
+        self.renderer.scene_gpu.components = next.map_or(all, |c| c.mask());
+        println!("components: {}", next.map_or("all", |c| c.name()));
     }
 }
 
@@ -821,6 +879,10 @@ impl ApplicationHandler for App {
                         Ok(())
                     }
                     KeyCode::KeyP => state.screenshot(),
+                    KeyCode::KeyC => {
+                        state.cycle_components();
+                        Ok(())
+                    }
                     _ => match digit {
                         Some(n) => state.switch_technique(n),
                         None => Ok(()),

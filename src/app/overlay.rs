@@ -10,6 +10,7 @@
 //! once per submitted frame, so a buffer is rewritten only after the fence
 //! of the frame that last read it has been waited for.
 
+use crate::reference::Component;
 use crate::techniques::Params;
 use crate::vk::{Context, PassTiming};
 use ash::vk;
@@ -25,6 +26,22 @@ pub struct UiData<'a> {
     pub timings: &'a [PassTiming],
     /// Recent frame intervals, oldest first.
     pub history_ms: &'a [f32],
+    /// The technique's components and the mask of those drawn.
+    pub components: &'static [Component],
+    pub component_mask: u32,
+    /// The scene's medium, if any (sigma_s, sigma_a in 1/m; g).
+    pub medium: Option<MediumValues>,
+    /// Each light's intensity (W/sr) or, for a directional light, irradiance (W/m^2).
+    pub light_intensities: Vec<[f32; 3]>,
+}
+
+/// The medium coefficients the overlay edits.
+#[cfg_attr(not(feature = "overlay"), allow(dead_code))]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MediumValues {
+    pub sigma_s: [f32; 3],
+    pub sigma_a: [f32; 3],
+    pub g: f32,
 }
 
 /// What the user asked for in the overlay.
@@ -32,6 +49,13 @@ pub struct UiData<'a> {
 pub enum Action {
     Technique(&'static str),
     Params(Params),
+    /// The component mask to draw (`Component::mask` bits).
+    Components(u32),
+    Medium(MediumValues),
+    LightIntensity {
+        light: usize,
+        rgb: [f32; 3],
+    },
 }
 
 #[cfg(not(feature = "overlay"))]
@@ -277,6 +301,9 @@ mod enabled {
                         }
                     }
                 }
+                components(ui, data, actions);
+                medium(ui, data, actions);
+                light_intensities(ui, data, actions);
                 ui.separator();
                 egui::Grid::new("timings").striped(true).show(ui, |ui| {
                     let mut total = 0.0;
@@ -293,6 +320,81 @@ mod enabled {
                 ui.separator();
                 frame_graph(ui, data.history_ms);
             });
+    }
+
+    /// One checkbox per component the technique renders.
+    fn components(ui: &mut egui::Ui, data: &UiData, actions: &mut Vec<Action>) {
+        ui.separator();
+        ui.horizontal_wrapped(|ui| {
+            ui.label("components (C)");
+            let mut mask = data.component_mask;
+            for c in data.components {
+                let mut on = mask & c.mask() != 0;
+                if ui.checkbox(&mut on, c.name()).changed() {
+                    mask ^= c.mask();
+                }
+            }
+            if mask != data.component_mask {
+                actions.push(Action::Components(mask));
+            }
+        });
+    }
+
+    /// Three drag values for an RGB quantity; true when one changed.
+    fn rgb(ui: &mut egui::Ui, label: &str, v: &mut [f32; 3], speed: f64, hover: &str) -> bool {
+        let mut changed = false;
+        ui.horizontal(|ui| {
+            for c in v.iter_mut() {
+                changed |= ui
+                    .add(egui::DragValue::new(c).speed(speed).range(0.0..=1.0e6))
+                    .on_hover_text(hover)
+                    .changed();
+            }
+            ui.label(label);
+        });
+        changed
+    }
+
+    fn medium(ui: &mut egui::Ui, data: &UiData, actions: &mut Vec<Action>) {
+        let Some(old) = data.medium else {
+            return;
+        };
+        ui.separator();
+        let mut m = old;
+        rgb(
+            ui,
+            "σs (1/m)",
+            &mut m.sigma_s,
+            0.005,
+            "scattering coefficient per channel",
+        );
+        rgb(
+            ui,
+            "σa (1/m)",
+            &mut m.sigma_a,
+            0.005,
+            "absorption coefficient per channel",
+        );
+        ui.add(egui::Slider::new(&mut m.g, -0.99..=0.99).text("g"))
+            .on_hover_text("Henyey-Greenstein anisotropy");
+        if m != old {
+            actions.push(Action::Medium(m));
+        }
+    }
+
+    fn light_intensities(ui: &mut egui::Ui, data: &UiData, actions: &mut Vec<Action>) {
+        ui.separator();
+        for (light, old) in data.light_intensities.iter().enumerate() {
+            let mut rgb_value = *old;
+            let label = format!("light {light}");
+            let hover = "intensity (W/sr; directional: irradiance, W/m²) per channel";
+            if rgb(ui, &label, &mut rgb_value, 0.1, hover) {
+                actions.push(Action::LightIntensity {
+                    light,
+                    rgb: rgb_value,
+                });
+            }
+        }
     }
 
     /// Frame intervals as a polyline, scaled to the largest recent one.

@@ -118,7 +118,8 @@ impl Renderer {
     /// the lights. On error the old scene stays. The caller has waited for
     /// every frame that used the old scene.
     pub fn set_scene(&mut self, scene: Scene, time: f32) -> anyhow::Result<()> {
-        let scene_gpu = SceneGpu::new(&self.ctx, &scene, time)?;
+        let mut scene_gpu = SceneGpu::new(&self.ctx, &scene, time)?;
+        scene_gpu.components = self.scene_gpu.components;
         let technique = techniques::create(
             &self.ctx,
             self.technique.name(),
@@ -153,6 +154,10 @@ impl Renderer {
 
     pub fn technique_name(&self) -> &'static str {
         self.technique.name()
+    }
+
+    pub fn technique_info(&self) -> &'static techniques::TechniqueInfo {
+        techniques::find(self.technique.name()).expect("a built technique is listed")
     }
 
     /// Renders one frame at animation time `time` and waits for it; returns

@@ -4,6 +4,7 @@
 
 use crate::bvh::Bvh;
 use crate::gpu::{GpuFrame, GpuLight, GpuMaterial, GpuMedium, GpuTriangle};
+use crate::reference::Component;
 use crate::scene::{Camera, Density, Scene};
 use crate::shader_bindings as b;
 use crate::vk::{
@@ -36,7 +37,18 @@ pub struct SceneGpu {
     /// Bounding sphere (centre, radius) of the scene at the uploaded time.
     pub sphere: (Vec3, f32),
     pub triangle_count: u32,
+    /// The path-type components techniques draw (`Component::mask` bits),
+    /// written into the frame constants; all of them unless a caller narrows it.
+    pub components: u32,
     bvh: Bvh,
+}
+
+fn gpu_medium(scene: &Scene) -> GpuMedium {
+    scene
+        .medium
+        .as_ref()
+        .map(GpuMedium::new)
+        .unwrap_or_else(GpuMedium::none)
 }
 
 /// View and projection for Vulkan: right-handed view, depth 0..1, y down in
@@ -82,11 +94,7 @@ impl SceneGpu {
             .iter()
             .map(|l| GpuLight::new(l, sphere.1))
             .collect();
-        let medium = scene
-            .medium
-            .as_ref()
-            .map(GpuMedium::new)
-            .unwrap_or_else(GpuMedium::none);
+        let medium = gpu_medium(scene);
         let grid: Vec<f32> = match scene.medium.as_ref().map(|m| &m.density) {
             Some(Density::Grid { values, .. }) => values.clone(),
             _ => vec![0.0],
@@ -131,6 +139,7 @@ impl SceneGpu {
             set,
             stats,
             sphere,
+            components: Component::All.mask(),
             bvh,
         })
     }
@@ -166,6 +175,14 @@ impl SceneGpu {
         self.lights.upload(bytemuck::cast_slice(&lights))
     }
 
+    /// Re-uploads the medium's coefficients after `scene.medium` was edited
+    /// in place (the demo's sliders; same density kind and grid). The caller
+    /// has waited for every frame that read the old ones.
+    pub fn update_medium(&self, scene: &Scene) -> VkResult<()> {
+        let medium = gpu_medium(scene);
+        self.medium.upload(bytemuck::bytes_of(&medium))
+    }
+
     /// Writes the per-frame constants for an image of `width` x `height`.
     pub fn update_frame(
         &self,
@@ -196,6 +213,7 @@ impl SceneGpu {
                 scene.materials.len() as u32,
                 frame_index,
             ],
+            components: [self.components, 0, 0, 0],
         };
         self.frame.upload(bytemuck::bytes_of(&data))
     }

@@ -6,6 +6,7 @@
 pub mod direct;
 pub mod image_space;
 
+use crate::reference::Component;
 use crate::renderer::{FrameTargets, SceneGpu};
 use crate::scene::Scene;
 use crate::vk::{Context, FrameRecorder, VkResult};
@@ -114,16 +115,21 @@ pub struct TechniqueInfo {
     pub name: &'static str,
     pub description: &'static str,
     pub params: &'static [ParamSpec],
+    /// The path-type components it renders (the demo's C key and
+    /// `caustics render --component` pick among them).
+    pub components: &'static [Component],
 }
 
 pub const TECHNIQUES: &[TechniqueInfo] = &[TechniqueInfo {
     name: "direct",
     description: "direct light with shadow maps (the base frame every technique adds to)",
     params: direct::PARAMS,
+    components: &[Component::Direct],
 }, TechniqueInfo {
     name: "image_space",
     description: "Wyman 2005-06 caustic maps: photons through the specular objects, Gaussian splats, projected onto diffuse receivers",
     params: image_space::PARAMS,
+    components: &[Component::Direct, Component::SurfaceCaustics],
 }];
 
 pub fn find(name: &str) -> anyhow::Result<&'static TechniqueInfo> {
@@ -131,6 +137,24 @@ pub fn find(name: &str) -> anyhow::Result<&'static TechniqueInfo> {
         let names: Vec<_> = TECHNIQUES.iter().map(|t| t.name).collect();
         anyhow::anyhow!("unknown technique `{name}`; available: {} (and `caustics reference` for the ground truth)", names.join(", "))
     })
+}
+
+impl TechniqueInfo {
+    /// The component mask (`Component::mask`) that draws only `component`
+    /// of this technique, or everything for `all`; an error names the
+    /// components it has.
+    pub fn component_mask(&self, component: &str) -> anyhow::Result<u32> {
+        let c = Component::parse(component)?;
+        if c == Component::All || self.components.contains(&c) {
+            return Ok(c.mask());
+        }
+        let names: Vec<_> = self.components.iter().map(|c| c.name()).collect();
+        anyhow::bail!(
+            "technique `{}` does not render component `{component}`; it renders: {}, all",
+            self.name,
+            names.join(", ")
+        )
+    }
 }
 
 /// Builds the technique `name` for frames of `width` x `height`.
