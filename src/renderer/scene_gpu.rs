@@ -4,7 +4,7 @@
 
 use crate::bvh::Bvh;
 use crate::gpu::{GpuFrame, GpuLight, GpuMaterial, GpuMedium, GpuTriangle};
-use crate::scene::{Camera, Density, Scene};
+use crate::scene::{Camera, Density, MaterialKind, Scene};
 use crate::shader_bindings as b;
 use crate::vk::{
     BindingKind, Buffer, BufferUsage, Context, DescriptorSet, DescriptorSetLayout, VkResult,
@@ -39,6 +39,14 @@ pub struct SceneGpu {
     bvh: Bvh,
 }
 
+/// Dielectric materials get Wyman's per-vertex d_N (`Bvh::set_normal_thickness`).
+fn is_refractor(scene: &Scene, material: u32) -> bool {
+    scene
+        .materials
+        .get(material as usize)
+        .is_some_and(|m| m.kind == MaterialKind::Dielectric)
+}
+
 /// View and projection for Vulkan: right-handed view, depth 0..1, y down in
 /// clip space so image row 0 is the top.
 pub fn camera_matrices(camera: &Camera, aspect: f32) -> (Mat4, Mat4) {
@@ -67,7 +75,8 @@ impl SceneGpu {
     pub fn new(ctx: &Arc<Context>, scene: &Scene, time: f32) -> VkResult<SceneGpu> {
         let triangles = scene.triangles(time);
         let bvh = Bvh::build(&triangles);
-        let gpu_triangles = bvh.gpu_triangles(&triangles);
+        let mut gpu_triangles = bvh.gpu_triangles(&triangles);
+        bvh.set_normal_thickness(&mut gpu_triangles, |m| is_refractor(scene, m));
         let stats = GeometryStats {
             triangles: triangles.len(),
             bvh_nodes: bvh.nodes.len(),
@@ -146,7 +155,11 @@ impl SceneGpu {
     pub fn update_geometry(&mut self, scene: &Scene, time: f32) -> VkResult<()> {
         let triangles = scene.triangles(time);
         self.bvh.refit(&triangles);
-        let gpu_triangles = self.bvh.gpu_triangles(&triangles);
+        let mut gpu_triangles = self.bvh.gpu_triangles(&triangles);
+        // Deforming refractors (water) change their thickness: d_N is
+        // recomputed with the geometry (3 rays per refractor triangle).
+        self.bvh
+            .set_normal_thickness(&mut gpu_triangles, |m| is_refractor(scene, m));
         self.triangles
             .upload(bytemuck::cast_slice(&gpu_triangles))?;
         self.bvh_nodes
