@@ -10,9 +10,14 @@
 //! Glass objects seen directly stay black (two-sided image-space refraction
 //! toward the camera is not implemented yet).
 
+mod refraction;
+
+pub use refraction::{CameraRefraction, RefractionPush};
+
 use super::direct::Direct;
 use super::{ParamSpec, Params, Technique};
 use crate::passes::caustic_map::CausticMap;
+use crate::passes::gbuffer::GBufferContents;
 use crate::renderer::{FrameTargets, SceneGpu};
 use crate::scene::Scene;
 use crate::shader_bindings as b;
@@ -72,14 +77,43 @@ pub const PARAMS: &[ParamSpec] = &[
         default: 0.0,
         integer: true,
     },
+    ParamSpec {
+        name: "tir_remedy",
+        description: "total internal reflection at the approximated exit (Wyman 2006's ad hoc remedies; camera and photon_mode 1): 0 single refraction (T2 = T1), 1 clamp to the critical angle (T2 tangent to the back face), 2 reflect and ignore the refractor. Default 1, of the two Wyman recommends (the first 'behaves poorly in dynamic scenes'): a reflected ray heads back toward the camera or the light, where the image-space search has no data and photons fly up past the light, while the clamped ray goes on through, as the light does on average",
+        min: 0.0,
+        max: 2.0,
+        default: 1.0,
+        integer: true,
+    },
+    ParamSpec {
+        name: "eq_6_3_2",
+        description: "1: where d~ overshoots and the back-face texel holds no normal, use Wyman's Eq. 6.3.2 (N2 = T1 - (V.T1) V, the exit through the side); 0: drop the transmitted light there",
+        min: 0.0,
+        max: 1.0,
+        default: 1.0,
+        integer: true,
+    },
+    ParamSpec {
+        name: "search_steps",
+        description: "linear steps of the image-space search of refracted and reflected camera rays against the opaque frame (then 10 bisections)",
+        min: 4.0,
+        max: 256.0,
+        default: 32.0,
+        integer: true,
+    },
 ];
 
 pub struct ImageSpace {
+    /// Direct light on the opaque scene (its G-buffer leaves the specular
+    /// surfaces out; they still cast shadows and caustics).
     pub direct: Direct,
     pub caustics: CausticMap,
+    /// The opaque frame: direct light + surface caustics without the
+    /// specular surfaces, what the refraction pass looks up.
+    pub opaque: FrameTargets,
+    pub refraction: CameraRefraction,
     apply: ComputePipeline,
     set: DescriptorSet,
-    bound_radiance: vk::ImageView,
     _layout: DescriptorSetLayout,
     _sampler: Sampler,
 }
@@ -93,7 +127,18 @@ impl ImageSpace {
         width: u32,
         height: u32,
     ) -> VkResult<Self> {
-        let direct = Direct::new(ctx, params, scene, scene_gpu, width, height)?;
+        let direct = Direct::with_contents(
+            ctx,
+            params,
+            scene,
+            scene_gpu,
+            width,
+            height,
+            GBufferContents::Opaque,
+        )?;
+        let opaque = FrameTargets::new(ctx, width, height)?;
+        let tir_remedy = params.get("tir_remedy") as u32;
+        let use_eq632 = params.get("eq_6_3_2") as u32;
         let caustics = CausticMap::new(
             ctx,
             scene,
@@ -102,6 +147,7 @@ impl ImageSpace {
             params.get("caustic_map_size") as u32,
             params.get("splat_size") as u32,
             params.get("photon_mode") as u32,
+            [tir_remedy, use_eq632],
         )?;
         let layout = DescriptorSetLayout::new(
             ctx,
@@ -123,19 +169,33 @@ impl ImageSpace {
                 vk::ImageLayout::GENERAL,
             )
             .write_storage_image(b::CAUSTIC_BINDING_POSITION, &direct.gbuffer.position)
-            .write_storage_image(b::CAUSTIC_BINDING_NORMAL, &direct.gbuffer.normal);
+            .write_storage_image(b::CAUSTIC_BINDING_NORMAL, &direct.gbuffer.normal)
+            .write_storage_image(b::CAUSTIC_BINDING_RADIANCE, &opaque.radiance);
         let apply = ComputePipeline::new(
             ctx,
             "caustic_map/apply.comp",
             &[&scene_gpu.layout, &layout],
             4,
         )?;
+        let refraction = CameraRefraction::new(
+            ctx,
+            scene_gpu,
+            &opaque.radiance,
+            &direct.gbuffer,
+            RefractionPush {
+                tir_remedy,
+                use_eq632,
+                search_steps: params.get("search_steps") as u32,
+                pad: 0,
+            },
+        )?;
         Ok(Self {
             direct,
             caustics,
+            opaque,
+            refraction,
             apply,
             set,
-            bound_radiance: vk::ImageView::null(),
             _layout: layout,
             _sampler: sampler,
         })
@@ -153,13 +213,7 @@ impl Technique for ImageSpace {
         scene: &SceneGpu,
         targets: &FrameTargets,
     ) -> VkResult<()> {
-        if self.bound_radiance != targets.radiance.view {
-            // Legal: the renderer waits for every frame before the next.
-            self.set
-                .write_storage_image(b::CAUSTIC_BINDING_RADIANCE, &targets.radiance);
-            self.bound_radiance = targets.radiance.view;
-        }
-        self.direct.record(rec, scene, targets)?;
+        self.direct.record(rec, scene, &self.opaque)?;
         self.caustics.record(rec, scene)?;
         let ctx = rec.ctx().clone();
         let light_count = self.caustics.light_count();
@@ -173,7 +227,7 @@ impl Technique for ImageSpace {
                     ImageAccess::new(&self.caustics.map, Access::ComputeRead),
                     ImageAccess::new(&self.direct.gbuffer.position, Access::ComputeRead),
                     ImageAccess::new(&self.direct.gbuffer.normal, Access::ComputeRead),
-                    ImageAccess::new(&targets.radiance, Access::ComputeWrite),
+                    ImageAccess::new(&self.opaque.radiance, Access::ComputeWrite),
                 ],
                 &[],
             );
@@ -185,6 +239,13 @@ impl Technique for ImageSpace {
                 groups,
             );
         });
+        self.refraction.record(
+            rec,
+            scene,
+            &self.opaque.radiance,
+            &self.direct.gbuffer,
+            targets,
+        );
         Ok(())
     }
 }
