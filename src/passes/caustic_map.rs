@@ -169,6 +169,17 @@ pub fn specular_bounds(scene: &Scene) -> Option<(Vec3, f32)> {
     any.then(|| ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-4)))
 }
 
+/// How photons find their refracted paths.
+#[derive(Clone, Copy, Debug)]
+pub struct PhotonPaths {
+    /// `PHOTON_MODE_*`.
+    pub mode: u32,
+    /// `TIR_*` (photon mode 1).
+    pub tir_remedy: u32,
+    /// Eq. 6.3.2 where the back-face texel holds no normal (photon mode 1).
+    pub use_eq632: bool,
+}
+
 pub struct CausticMap {
     /// `2 N^2` photons (refracted, then reflected), storage, reused per light.
     pub photons: Buffer,
@@ -204,8 +215,7 @@ impl CausticMap {
         photon_size: u32,
         map_size: u32,
         splat_size: u32,
-        mode: u32,
-        refraction: [u32; 2],
+        paths: PhotonPaths,
     ) -> VkResult<Self> {
         let lights: Vec<Light> = scene
             .lights
@@ -283,8 +293,8 @@ impl CausticMap {
             photon_size,
             map_size,
             splat_size: splat_size | 1,
-            mode,
-            refraction,
+            mode: paths.mode,
+            refraction: [paths.tir_remedy, u32::from(paths.use_eq632)],
             light_view,
             lights,
             specular,

@@ -16,7 +16,7 @@ pub use refraction::{CameraRefraction, RefractionPush};
 
 use super::direct::Direct;
 use super::{ParamSpec, Params, Technique};
-use crate::passes::caustic_map::CausticMap;
+use crate::passes::caustic_map::{CausticMap, PhotonPaths};
 use crate::passes::gbuffer::GBufferContents;
 use crate::renderer::{FrameTargets, SceneGpu};
 use crate::scene::Scene;
@@ -146,8 +146,11 @@ impl ImageSpace {
             params.get("photon_buffer_size") as u32,
             params.get("caustic_map_size") as u32,
             params.get("splat_size") as u32,
-            params.get("photon_mode") as u32,
-            [tir_remedy, use_eq632],
+            PhotonPaths {
+                mode: params.get("photon_mode") as u32,
+                tir_remedy,
+                use_eq632: use_eq632 != 0,
+            },
         )?;
         let layout = DescriptorSetLayout::new(
             ctx,
