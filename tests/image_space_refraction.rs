@@ -3,7 +3,17 @@
 //! validation on, 128² frames.
 //!
 //! Measured (lavapipe, Mesa 22.3.6; `cargo test --test image_space_refraction -- --nocapture`):
-//! MEASUREMENTS
+//! - ior_one_refractor_is_invisible: 15512 pixels compared, 1464 of them
+//!   through the glass: worst relative difference 1.6e-3 (bound 2%, the
+//!   caustic map's own bound for refilling the shadow).
+//! - slab_head_on_transmits_fresnel_and_beer_lambert: 3168 pixels within
+//!   5 degrees of the axis; without absorption worst relative error 1.4e-7,
+//!   centre pixel L / L_behind = 0.92160 = (1 - 0.04)^2; with sigma_a =
+//!   (0.5, 1, 2) /m worst 3.4e-4 (the d~ error), centre (0.83390, 0.75454,
+//!   0.61777) = 0.9216 exp(-sigma_a 0.2 m); bound 1e-3.
+//! - tir_remedies_fill_and_differ: 2116 glass pixels, black pixels per
+//!   remedy [0, 0, 0] (bound 1% for remedies 1 and 2); pixels differing
+//!   between remedies 0-1: 958, 1-2: 1011, 0-2: 1035 (bound 10% each).
 
 mod common;
 

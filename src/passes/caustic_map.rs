@@ -10,7 +10,8 @@
 //!    E * A_texel, times Fresnel and Beer-Lambert. `mode` picks how the
 //!    refracted path is found: traced through the BVH (exact, default), or
 //!    from light-space front/back G-buffers of the specular objects
-//!    ("caustic light view", Wyman's two-sided refraction) with the back
+//!    ("caustic light view", `passes::specular_gbuffer` from the light:
+//!    Wyman's two-sided refraction, shared with the camera) with the back
 //!    interface by Eq. 6.3.1 or by marching the back-face map; the exit ray
 //!    lands through the BVH. Buffer: `2 N^2` `GpuPhoton`s, refracted photons
 //!    first, reflected ones second (reflected photons are always traced).
@@ -28,10 +29,15 @@
 //! map edge or a cube-face edge lose their clipped part. The splat draws
 //! every photon once per view of the light (6x for a point light, culled in
 //! the vertex shader): 0.6 s of a 1.05 s frame at 512² on lavapipe.
-//! Mode 1 (Eq. 6.3.1) on the ball lens shows a faint halo outside the
-//! shadow (photons clamped to the critical angle) and four small dark
-//! spots in the caustic whose cause is not yet found; modes 0 and 2 show
-//! neither.
+//! Mode 1 runs the camera's two-sided refraction code
+//! (glsl/common/image_space_refraction.glsl) with the per-vertex d_N. On
+//! the ball lens it still shows a faint halo outside the shadow with the
+//! default `tir_remedy` 1: about 21% of the entering photons meet total
+//! internal reflection at the approximated exit (Eq. 6.3.1's d~ falls
+//! short near the rim, whatever d_N) and, clamped to the critical angle,
+//! leave tangent to the sphere. `tir_remedy` 0 (T2 = T1) or 2 (reflect,
+//! losing that flux upward) show no halo. The default stays mode 0
+//! (exact) for that reason; mode 2 shows no halo either.
 
 use crate::passes::shadow::{shadow_views, GpuShadowLight};
 use crate::passes::specular_gbuffer::{SpecularGBuffer, Viewpoint};
@@ -192,7 +198,7 @@ pub struct CausticMap {
     pub splat_size: u32,
     /// `PHOTON_MODE_TRACED` or `PHOTON_MODE_IMAGE_SPACE`.
     pub mode: u32,
-    /// `[TIR_*, Eq. 6.3.2 on]` for the image-space photon mode.
+    /// `[TIR_*, 1 if Eq. 6.3.2 is on]` for the image-space photon mode.
     pub refraction: [u32; 2],
     /// Light-space G-buffer of the specular objects (photon modes 1, 2),
     /// N x N, one light at a time.

@@ -1,14 +1,41 @@
-//! `image_space`: Wyman 2005-06 surface caustics on top of the `direct`
-//! frame. The frame is direct light with shadow maps (every caster, the
-//! glass too) plus, on diffuse receivers, L = albedo / pi * E_caustic from
-//! the caustic map (`passes::caustic_map`): the light the specular objects
-//! redirect, which includes the light their shadow removed, so with IOR 1
-//! the shadow is filled back in.
+//! `image_space`: Wyman 2005-06, image-space refraction and caustic maps.
 //!
-//! Passes: the `direct` passes; "caustic map clear", per light "caustic
-//! photons" and "caustic splat"; "caustic apply" (glsl/caustic_map/apply.comp).
-//! Glass objects seen directly stay black (two-sided image-space refraction
-//! toward the camera is not implemented yet).
+//! 1. The opaque frame (`opaque`): the `direct` passes over a G-buffer that
+//!    leaves the specular surfaces out (they still cast shadows: the shadow
+//!    maps hold every caster), plus, on diffuse receivers, L = albedo / pi *
+//!    E_caustic from the caustic map (`passes::caustic_map`): the light the
+//!    specular objects redirect, which includes the light their shadow
+//!    removed, so with IOR 1 the shadow is filled back in.
+//! 2. What the camera sees in the specular objects (`refraction`), Wyman's
+//!    two-sided image-space refraction: the camera's specular G-buffer
+//!    (`passes::specular_gbuffer`: nearest front faces with the per-vertex
+//!    d_N interpolated, farthest back faces: Wyman's preferred second
+//!    interface for non-convex refractors); per pixel, Snell at the front
+//!    (T1), d_V from the back-face depth, d~ by Eq. 6.3.1, p2 = p1 + d~ T1,
+//!    N2 from the back-face normal texture at p2's projection (Eq. 6.3.2
+//!    where the texel is empty), Snell again (T2) with the selected TIR
+//!    remedy; T2 and the Fresnel reflection ray are searched in the opaque
+//!    frame's depth (linear steps, then bisection) and read its radiance:
+//!    L = F1 L_reflected + (1 - F1)(1 - F2) exp(-sigma_a d~) L_behind.
+//!    Mirrors: L = reflectance * L_reflected by the same search.
+//!    The refraction math is glsl/common/image_space_refraction.glsl,
+//!    shared with the caustic photons of `photon_mode` 1 (Wyman: "render
+//!    the specular objects from the light ... with the same code").
+//!
+//! Passes: "shadow maps", "gbuffer", "direct lighting"; "caustic map
+//! clear", per light ("caustic light view" in photon modes 1 and 2)
+//! "caustic photons" and "caustic splat"; "caustic apply"; "refractor
+//! gbuffer"; "refraction" (glsl/image_space/refraction.comp).
+//!
+//! Limits: two interfaces only (light inside the glass is never reflected
+//! again; the remedies stand in for TIR); rays that leave the view or the
+//! scene's bounding sphere read the environment, which is black (scene
+//! files have no background; the reference also gives escaping rays 0);
+//! the search only finds what the camera sees (no surface hidden behind
+//! another or off screen), and a crossing deeper than one search step is
+//! taken for a ray passing behind a nearer object; glass seen through
+//! glass (nested or overlapping refractors) is not refracted twice: the
+//! opaque frame has no specular surfaces.
 
 mod refraction;
 
