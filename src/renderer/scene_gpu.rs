@@ -4,7 +4,7 @@
 
 use crate::bvh::Bvh;
 use crate::gpu::{GpuFrame, GpuLight, GpuMaterial, GpuMedium, GpuTriangle};
-use crate::scene::{Camera, Density, MaterialKind, Scene};
+use crate::scene::{Camera, Density, MaterialKind, Scene, Triangle};
 use crate::shader_bindings as b;
 use crate::vk::{
     BindingKind, Buffer, BufferUsage, Context, DescriptorSet, DescriptorSetLayout, VkResult,
@@ -75,8 +75,7 @@ impl SceneGpu {
     pub fn new(ctx: &Arc<Context>, scene: &Scene, time: f32) -> VkResult<SceneGpu> {
         let triangles = scene.triangles(time);
         let bvh = Bvh::build(&triangles);
-        let mut gpu_triangles = bvh.gpu_triangles(&triangles);
-        bvh.set_normal_thickness(&mut gpu_triangles, |m| is_refractor(scene, m));
+        let gpu_triangles = Self::gpu_triangles(scene, &bvh, &triangles);
         let stats = GeometryStats {
             triangles: triangles.len(),
             bvh_nodes: bvh.nodes.len(),
@@ -144,6 +143,14 @@ impl SceneGpu {
         })
     }
 
+    /// The triangle buffer's contents: `triangles` (of `scene`) in `bvh`'s
+    /// leaf order, with Wyman's per-vertex d_N on the dielectric ones.
+    pub fn gpu_triangles(scene: &Scene, bvh: &Bvh, triangles: &[Triangle]) -> Vec<GpuTriangle> {
+        let mut gpu = bvh.gpu_triangles(triangles);
+        bvh.set_normal_thickness(&mut gpu, |m| is_refractor(scene, m));
+        gpu
+    }
+
     /// The BVH the GPU traverses (its `nodes` are the uploaded `bvh_nodes`;
     /// `triangle_order` maps the uploaded leaf-order triangles to the scene's).
     pub fn bvh(&self) -> &Bvh {
@@ -155,11 +162,9 @@ impl SceneGpu {
     pub fn update_geometry(&mut self, scene: &Scene, time: f32) -> VkResult<()> {
         let triangles = scene.triangles(time);
         self.bvh.refit(&triangles);
-        let mut gpu_triangles = self.bvh.gpu_triangles(&triangles);
         // Deforming refractors (water) change their thickness: d_N is
         // recomputed with the geometry (3 rays per refractor triangle).
-        self.bvh
-            .set_normal_thickness(&mut gpu_triangles, |m| is_refractor(scene, m));
+        let gpu_triangles = Self::gpu_triangles(scene, &self.bvh, &triangles);
         self.triangles
             .upload(bytemuck::cast_slice(&gpu_triangles))?;
         self.bvh_nodes
