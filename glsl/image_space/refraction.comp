@@ -81,19 +81,54 @@ bool behind_opaque(vec3 x, out ivec2 q, out float gap) {
     return gap >= 0.0;
 }
 
+// How much the opaque surface's view depth changes from pixel q to its
+// neighbours: a ray meeting a surface seen at a grazing angle lands up to
+// that far behind the depth stored at the pixel's centre.
+float pixel_depth_extent(ivec2 q) {
+    float z0 = view_depth(imageLoad(opaque_position, q).xyz);
+    float extent = 0.0;
+    ivec2 size = imageSize(opaque_position);
+    for (int k = 0; k < 4; ++k) {
+        ivec2 n = q + ivec2(k == 0 ? 1 : (k == 1 ? -1 : 0), k == 2 ? 1 : (k == 3 ? -1 : 0));
+        if (any(lessThan(n, ivec2(0))) || any(greaterThanEqual(n, size))) continue;
+        vec4 s = imageLoad(opaque_position, n);
+        if (s.w != 0.0) extent = max(extent, abs(view_depth(s.xyz) - z0));
+    }
+    return extent;
+}
+
+// How far the ray (o, d) stays inside the view frustum (0 if o is outside):
+// clip coordinates are linear in t, and each side is a half-space g(t) =
+// g0 + t g1 >= 0. Shrunk a little so the last sample still projects inside.
+float frustum_exit(vec3 o, vec3 d) {
+    vec4 c0 = frame.view_proj * vec4(o, 1.0);
+    vec4 c1 = frame.view_proj * vec4(d, 0.0);
+    vec4 g0[2] = vec4[2](c0.wwww + vec4(-c0.x, c0.x, -c0.y, c0.y), vec4(c0.w - 1e-3));
+    vec4 g1[2] = vec4[2](c1.wwww + vec4(-c1.x, c1.x, -c1.y, c1.y), vec4(c1.w));
+    float t = 1e30;
+    for (int k = 0; k < 2; ++k) {
+        for (int j = 0; j < 4; ++j) {
+            if (g0[k][j] < 0.0) return 0.0;
+            if (g1[k][j] < 0.0) t = min(t, -g0[k][j] / g1[k][j]);
+        }
+    }
+    return t * (1.0 - 1e-4);
+}
+
 // Image-space search of the opaque frame along (o, d) (Wyman 2006 cites
 // linear [Wyman05b] and binary [Policarpo05] searches; we do both): linear
-// steps to where the ray leaves the scene's bounding sphere until the ray
-// passes behind the opaque depth, then bisection between the last two
-// steps. A crossing whose refined gap exceeds one step is the ray passing
-// behind a nearer object, not meeting it: the march goes on. A ray leaving
-// the image never comes back (the view frustum is convex): environment.
+// steps over the part of the ray inside both the view frustum and the
+// scene's bounding sphere until the ray passes behind the opaque depth,
+// then bisection between the last two steps. A crossing whose refined gap
+// exceeds one step plus the surface's depth change across a pixel is the
+// ray passing behind a nearer object, not meeting it: the march goes on. Past the frustum nothing can be found (the
+// frustum is convex, the ray never comes back): environment.
 vec3 search_opaque(vec3 o, vec3 d) {
     vec3 oc = o - frame.scene_sphere.xyz;
     float b = dot(oc, d);
     float disc = b * b - (dot(oc, oc) - frame.scene_sphere.w * frame.scene_sphere.w);
     if (disc <= 0.0) return ENVIRONMENT;
-    float t_max = -b + sqrt(disc);
+    float t_max = min(-b + sqrt(disc), frustum_exit(o, d));
     if (t_max <= 0.0) return ENVIRONMENT;
     float step = t_max / float(max(pc.search_steps, 1u));
     float t_prev = 0.0;
@@ -111,7 +146,7 @@ vec3 search_opaque(vec3 o, vec3 d) {
                 if (behind_opaque(o + mid * d, qm, gm)) hi = mid; else lo = mid;
             }
             behind_opaque(o + hi * d, q, gap);
-            if (gap <= step) return imageLoad(opaque_radiance, q).rgb;
+            if (gap <= step + pixel_depth_extent(q)) return imageLoad(opaque_radiance, q).rgb;
         }
         t_prev = t;
     }
