@@ -32,8 +32,9 @@
 //! scene's bounding sphere read the environment, which is black (scene
 //! files have no background; the reference also gives escaping rays 0);
 //! the search only finds what the camera sees (no surface hidden behind
-//! another or off screen), and a crossing deeper than one search step is
-//! taken for a ray passing behind a nearer object; glass seen through
+//! another or off screen), and a crossing deeper than one search step (plus
+//! a pixel's depth footprint) is taken for a ray passing behind a nearer
+//! object; glass seen through
 //! glass (nested or overlapping refractors) is not refracted twice: the
 //! opaque frame has no specular surfaces.
 
