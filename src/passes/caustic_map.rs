@@ -36,8 +36,11 @@
 //! internal reflection at the approximated exit (Eq. 6.3.1's d~ falls
 //! short near the rim, whatever d_N) and, clamped to the critical angle,
 //! leave tangent to the sphere. `tir_remedy` 0 (T2 = T1) or 2 (reflect,
-//! losing that flux upward) show no halo. The default stays mode 0
-//! (exact) for that reason; mode 2 shows no halo either.
+//! losing that flux upward) show no halo. The small dark spots in the
+//! caustic (four, symmetric about the light view's axes; three visible from
+//! the ball_lens camera) remain with every remedy, so the per-photon BVH
+//! cast for d_N was not their cause; still unexplained. The default stays
+//! mode 0 (exact) for both reasons; mode 2 shows neither.
 
 use crate::passes::shadow::{shadow_views, GpuShadowLight};
 use crate::passes::specular_gbuffer::{SpecularGBuffer, Viewpoint};
