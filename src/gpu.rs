@@ -19,7 +19,8 @@ pub struct GpuTriangle {
     /// w = object index (uint bits).
     pub p1: [f32; 4],
     pub p2: [f32; 4],
-    /// Vertex normals; w reserved for per-vertex technique data.
+    /// Vertex normals; w = Wyman's d_N for refractors (distance to the far
+    /// side of the object along -N, `Bvh::set_normal_thickness`), else 0.
     pub n0: [f32; 4],
     pub n1: [f32; 4],
     pub n2: [f32; 4],

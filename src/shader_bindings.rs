@@ -84,6 +84,26 @@ pub const CAUSTIC_BINDING_BACK_NORMAL: u32 = 9;
 pub const PHOTON_MODE_TRACED: u32 = 0;
 pub const PHOTON_MODE_IMAGE_SPACE: u32 = 1;
 pub const PHOTON_MODE_BACK_MARCH: u32 = 2;
-/// Light-view G-buffer passes: nearest front faces, nearest back faces.
-pub const LIGHT_VIEW_FRONT: u32 = 0;
-pub const LIGHT_VIEW_BACK: u32 = 1;
+/// Specular G-buffer passes (src/passes/specular_gbuffer.rs): nearest front
+/// faces, farthest back faces.
+pub const SPECULAR_GBUFFER_FRONT: u32 = 0;
+pub const SPECULAR_GBUFFER_BACK: u32 = 1;
+/// Specular G-buffer viewpoint kinds besides SHADOW_RADIAL (a light's
+/// perspective view) and SHADOW_PLANAR (orthographic): the frame's camera.
+pub const SPECULAR_VIEW_CAMERA: u32 = 2;
+/// Total internal reflection (or no exit) at the approximated second
+/// interface of two-sided image-space refraction: Wyman 2006's three ad hoc
+/// remedies (`tir_remedy` parameter of image_space).
+pub const TIR_SINGLE_REFRACTION: u32 = 0;
+pub const TIR_CLAMP_CRITICAL: u32 = 1;
+pub const TIR_REFLECT: u32 = 2;
+
+// image_space camera refraction (src/techniques/image_space/refraction.rs,
+// glsl/image_space/refraction.comp), descriptor set 1.
+pub const REFRACTION_BINDING_OPAQUE_RADIANCE: u32 = 0;
+pub const REFRACTION_BINDING_OPAQUE_POSITION: u32 = 1;
+pub const REFRACTION_BINDING_FRONT_POSITION: u32 = 2;
+pub const REFRACTION_BINDING_FRONT_NORMAL: u32 = 3;
+pub const REFRACTION_BINDING_BACK_POSITION: u32 = 4;
+pub const REFRACTION_BINDING_BACK_NORMAL: u32 = 5;
+pub const REFRACTION_BINDING_RADIANCE: u32 = 6;

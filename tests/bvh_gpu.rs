@@ -126,7 +126,7 @@ fn check(path: &str, scene: Scene, seed: u64) {
     // The CPU traverses exactly what was uploaded: the leaf-order triangles read back.
     let mut tris: Vec<GpuTriangle> = scene_gpu.triangles.download_pod().unwrap();
     tris.truncate(scene_gpu.triangle_count as usize);
-    let expected = bvh.gpu_triangles(&scene.triangles(0.0));
+    let expected = SceneGpu::gpu_triangles(&scene, bvh, &scene.triangles(0.0));
     assert!(
         bytemuck::cast_slice::<GpuTriangle, u8>(&tris)
             == bytemuck::cast_slice::<GpuTriangle, u8>(&expected),

@@ -21,7 +21,9 @@
 //!   (or Wyman's "reflect and ignore the refractor", which sends them up
 //!   past the light) lost 20.7% of the flux; clamping to the critical angle
 //!   (his second fix, flux kept) gives entering 4.6256 W, floor 3.9268 W vs
-//!   3.8671 W (+1.5%; bound 5%).
+//!   3.8671 W (+1.5%; bound 5%). With the shared two-sided refraction code
+//!   and per-vertex d_N (instead of a BVH cast per photon): floor 3.9275 W
+//!   (+1.6%).
 //! - ior_one_gives_back_the_shadowed_light (512²/512², defaults): inside the
 //!   shadow cone (0.02 rad from its rim left out) worst pixel 0.15%, mean
 //!   1.7e-4 (photon_mode 1 and 2: worst 0.15%, mean 1.7e-5); outside
@@ -40,8 +42,10 @@
 //!   least confusion of this strongly aberrated lens gathers more flux.
 //! - ball_lens_caustic_energy_matches_reference (assets/scenes/ball_lens.toml,
 //!   image_space minus direct vs the reference's L S+ D, 8M photons):
-//!   relative energy -2.0% (bound 5%; photon_mode=1 -1.0% and
-//!   photon_mode=2 -2.1%, asserted too): the caustic map keeps one reflected
+//!   relative energy -2.0% (bound 5%; photon_mode=1 -0.9% and
+//!   photon_mode=2 -2.1%, asserted too), over the pixels whose camera ray
+//!   meets a diffuse surface first (the glass shows L S+ D S+ E paths,
+//!   which the reference does not estimate): the caustic map keeps one reflected
 //!   and one transmitted chain per photon and drops partial internal
 //!   reflections (T R T ...), which the reference follows. Its 4 bright 8x8
 //!   blocks differ by 3.6% on average, 4.7% at worst.
@@ -498,6 +502,27 @@ fn ball_lens_focus() {
     assert_validation_clean(&ctx);
 }
 
+/// Per pixel of a SIZE² frame of `s`: true when the camera ray's first hit
+/// is a diffuse surface (CPU BVH).
+fn diffuse_first_mask(s: &Scene) -> Vec<bool> {
+    use caustics::bvh::Bvh;
+    use caustics::scene::MaterialKind;
+    let tris = s.triangles(0.0);
+    let bvh = Bvh::build(&tris);
+    let gpu = bvh.gpu_triangles(&tris);
+    let mut mask = Vec::with_capacity((SIZE * SIZE) as usize);
+    for py in 0..SIZE {
+        for px in 0..SIZE {
+            let (o, d) = pixel_ray(&s.camera, SIZE, SIZE, px, py);
+            mask.push(bvh.intersect(&gpu, o, d, 0.0, f32::MAX).is_some_and(|h| {
+                let m = gpu[h.triangle as usize].p0[3].to_bits() as usize;
+                s.materials[m].kind == MaterialKind::Diffuse
+            }));
+        }
+    }
+    mask
+}
+
 /// rgb summed over the image.
 fn energy(img: &[f32]) -> f64 {
     img.chunks(4).map(|p| (p[0] + p[1] + p[2]) as f64).sum()
@@ -524,14 +549,31 @@ fn ball_lens_caustic_energy_matches_reference() {
         r.render_frame(0.0).unwrap();
         r.radiance().unwrap()
     };
-    let direct = frame("direct", &[]);
-    let full = frame("image_space", &[]);
+    // image_space also shows what the camera sees through the glass
+    // (L S+ D S+ E, which the reference does not estimate: see "What the
+    // ground truth does not cover" in docs/ARCHITECTURE.md): compare only
+    // pixels whose camera ray meets a diffuse surface first.
+    let mask = diffuse_first_mask(&load());
+    let masked = |img: Vec<f32>| -> Vec<f32> {
+        img.chunks(4)
+            .zip(&mask)
+            .flat_map(|(p, &keep)| {
+                if keep {
+                    [p[0], p[1], p[2], p[3]]
+                } else {
+                    [0.0; 4]
+                }
+            })
+            .collect()
+    };
+    let direct = masked(frame("direct", &[]));
+    let full = masked(frame("image_space", &[]));
     let caustic: Vec<f32> = full.iter().zip(&direct).map(|(a, b)| a - b).collect();
     let mut reference =
         ReferenceRenderer::new(&ctx, load(), SIZE, SIZE, 0.0, ReferenceSettings::default())
             .unwrap();
     reference.trace(PHOTONS_REFERENCE, |_, _| {}).unwrap();
-    let truth = reference.resolve(Component::SurfaceCaustics).unwrap();
+    let truth = masked(reference.resolve(Component::SurfaceCaustics).unwrap());
     let (e, t) = (energy(&caustic), energy(&truth));
     let rel = (e - t) / t;
     println!(
@@ -574,7 +616,7 @@ fn ball_lens_caustic_energy_matches_reference() {
     assert!(rel.abs() < MAX_REFERENCE_ENERGY, "relative energy {rel}");
     // The light-space (image-space) photon modes against the same truth.
     for mode in [1, 2] {
-        let img = frame("image_space", &[format!("photon_mode={mode}")]);
+        let img = masked(frame("image_space", &[format!("photon_mode={mode}")]));
         let c: f64 = energy(&img) - energy(&direct);
         let rel_m = (c - t) / t;
         println!("photon_mode={mode}: caustic energy {c:.2}, relative {rel_m:+.4}");

@@ -16,21 +16,20 @@
 // - PHOTON_MODE_TRACED (default): interfaces and landing point by tracing
 //   the BVH; exact, any number of interfaces.
 // - PHOTON_MODE_IMAGE_SPACE: Wyman 2005's two-sided refraction from the
-//   light: front interface p1, N1 from the light-space front G-buffer; Snell;
-//   distance to the back interface by Eq. 6.3.1 between d_V (front/back
-//   light-space depth maps) and d_N (cast along -N1 through the BVH, where
-//   Wyman precomputes it per vertex); N2 from the back-face normal texture
-//   at p2's projection; Snell again.
+//   light (the chapter's caustics section: "render the specular objects
+//   from the light ... with the same refraction code"): front interface
+//   p1, N1 and the interpolated per-vertex d_N from the light-space front
+//   G-buffer; d_V to the (farthest) back face at the same texel; the
+//   shared glsl/common/image_space_refraction.glsl (Eq. 6.3.1, N2 from the
+//   back-face normal texture at p2's projection, Eq. 6.3.2 where it holds
+//   none, the selected TIR remedy), exactly as the camera uses it.
 // - PHOTON_MODE_BACK_MARCH: the same G-buffers, but p2 where the refracted
-//   ray passes behind the back-face map (exact for convex objects).
+//   ray passes behind the back-face map (exact for convex objects); photons
+//   meeting TIR or no back face there are dropped.
 // In both light-space modes the exit ray is landed on the first diffuse
 // surface through the BVH (Wyman intersects the light-space depth map of
 // the receivers; the BVH is exact), passing through further specular
-// surfaces unrefracted. Mode 1 handles Wyman's failure cases as he suggests:
-// total internal reflection at the approximated exit clamps to the critical
-// angle (his second fix; the photon keeps its flux); a p2 projecting
-// outside the back faces gets N2 from Eq. 6.3.2. Mode 2 drops those (rare)
-// photons.
+// surfaces unrefracted.
 // At the first dielectric interface the photon splits: the reflected part
 // (Fresnel F) goes to the second half of the buffer, the transmitted part
 // (1 - F) to the first. Further interfaces keep only transmission (weight
@@ -52,12 +51,13 @@ layout(push_constant) uniform Push {
     vec4 right;   // xyz; w: light index (uint bits)
     vec4 up;      // xyz; w: photon view size N (uint bits)
     vec4 forward; // xyz; w: SHADOW_RADIAL (perspective) or SHADOW_PLANAR (ortho) (uint bits)
-    uvec4 mode;   // x: PHOTON_MODE_TRACED or PHOTON_MODE_IMAGE_SPACE
+    uvec4 mode;   // x: PHOTON_MODE_*; y: TIR_* remedy; z: 1 = Eq. 6.3.2 on
 } pc;
 
-// Light-space G-buffers of the specular objects (image-space mode only):
-// nearest front faces and nearest back faces, position (w: covered) and
-// outward smooth normal (w: material).
+// Light-space specular G-buffer (src/passes/specular_gbuffer.rs; photon
+// modes 1 and 2): nearest front faces and farthest back faces, position
+// (w: d_N at the front, < 0 where not covered) and outward smooth normal
+// (w: material).
 layout(set = 1, binding = CAUSTIC_BINDING_FRONT_POSITION, rgba32f) uniform readonly image2D front_position;
 layout(set = 1, binding = CAUSTIC_BINDING_FRONT_NORMAL, rgba32f) uniform readonly image2D front_normal;
 layout(set = 1, binding = CAUSTIC_BINDING_BACK_POSITION, rgba32f) uniform readonly image2D back_position;
@@ -183,92 +183,67 @@ bool behind_back(vec3 x) {
     ivec2 q = light_texel(x);
     if (q.x < 0) return true;
     vec4 b = imageLoad(back_position, q);
-    if (b.w == 0.0) return true;
+    if (b.w < 0.0) return true;
     return light_depth(x) >= light_depth(b.xyz);
 }
 
-// Wyman 2005 two-sided refraction from the light (image-space mode), for the
-// refracted photon of texel `id` entering at p1 (normal n1 facing the light,
-// incident direction d, eta = 1 / ior, weight w already times 1 - F1):
-// - d_V: distance from p1 to the nearest back face along the light's ray
-//   at this texel (the two light-space depth maps);
-// - d_N: distance from p1 to the back surface along -n1. Wyman precomputes
-//   it per vertex by ray casting; here it is cast per texel against the BVH;
-// - Eq. 6.3.1: d~ = (theta_t / theta_i) d_V + (1 - theta_t / theta_i) d_N,
-//   p2 = p1 + d~ T1;
-// - N2: the back-face normal texture at p2's projection; refract out of the
-//   glass about -N2 (Snell), weight 1 - F2, Beer-Lambert over d~. Total
-//   internal reflection there: leave tangent (mode 1) or drop (mode 2);
-//   p2 outside the back faces: Eq. 6.3.2 (mode 1) or drop (mode 2).
-// Mode 2 replaces Eq. 6.3.1 by marching T1 against the back-face map.
-bool image_space_refraction(uvec2 id, vec3 p1, vec3 n1, vec3 d, uint m, inout vec3 w, out vec3 p3, out vec3 dir) {
+// The back-face normal at x's light-view texel (for the shared two-sided
+// refraction code), false where no back face covers it.
+bool back_face_normal(vec3 x, out vec3 n) {
+    n = vec3(0.0);
+    ivec2 q = light_texel(x);
+    if (q.x < 0 || imageLoad(back_position, q).w < 0.0) return false;
+    n = imageLoad(back_normal, q).xyz;
+    return true;
+}
+
+#include "image_space_refraction.glsl"
+
+// The refracted photon of texel `id` through the refractor seen from the
+// light, entering at p1 (outward normal n1 facing the light, incident
+// direction d, material m, interpolated d_N), weight w already times
+// 1 - F1: lands it on a diffuse surface (p3, arrival direction `dir`).
+// Mode 1: Wyman's two-sided refraction (shared with the camera). Mode 2:
+// the refracted ray marched against the back-face map instead of Eq. 6.3.1
+// (steps of max(d_V, d_N) / 32, then 16 bisections); exact for convex
+// objects up to the map's resolution.
+bool image_space_refraction(uvec2 id, vec3 p1, vec3 n1, vec3 d, uint m, float d_n, inout vec3 w, out vec3 p3, out vec3 dir) {
     p3 = vec3(0.0);
     dir = vec3(0.0);
     float ior = materials[m].absorption_ior.w;
+    vec4 bp = imageLoad(back_position, ivec2(id));
+    if (bp.w < 0.0) return false;
+    float d_v = length(bp.xyz - p1);
+    if (pc.mode.x == PHOTON_MODE_IMAGE_SPACE) {
+        TwoSidedExit e;
+        if (!two_sided_refraction(d, p1, n1, ior, d_v, d_n, pc.mode.y, pc.mode.z != 0u, e)) return false;
+        w *= e.transmit * exp(-materials[m].absorption_ior.rgb * e.dist);
+        dir = e.dir;
+        return land(e.p2, e.dir, p3);
+    }
+    // PHOTON_MODE_BACK_MARCH
     vec3 t1;
     if (!refract_dir(d, n1, 1.0 / ior, t1)) return false;
-    vec4 bp = imageLoad(back_position, ivec2(id));
-    if (bp.w == 0.0) return false;
-    float d_v = length(bp.xyz - p1);
-    float d_n = d_v;
-    Hit h;
-    vec3 o = p1 - n1 * (1e-4 * max(1.0, bvh_max_abs(p1)));
-    if (trace_closest(o, -n1, 0.0, 1e30, h)) d_n = h.t;
-    float dist;
-    ivec2 q;
-    vec3 n2_fallback = vec3(0.0);
-    bool use_fallback = false;
-    if (pc.mode.x == PHOTON_MODE_IMAGE_SPACE) {
-        float theta_i = acos(clamp(-dot(d, n1), -1.0, 1.0));
-        float theta_t = acos(clamp(-dot(t1, n1), -1.0, 1.0));
-        float ratio = theta_i > 1e-4 ? theta_t / theta_i : 1.0 / ior;
-        dist = ratio * d_v + (1.0 - ratio) * d_n;
-        q = light_texel(p1 + dist * t1);
-        if (q.x < 0 || imageLoad(back_position, q).w == 0.0) {
-            // d~ overshot past the back faces' coverage: Wyman's Eq. 6.3.2,
-            // N2 = T1 - (V . T1) V, perpendicular to the light's ray V.
-            n2_fallback = normalize(t1 - dot(d, t1) * d);
-            use_fallback = true;
-        }
-    } else {
-        // PHOTON_MODE_BACK_MARCH: march the refracted ray against the
-        // back-face map until it passes behind the stored back surface
-        // (steps of max(d_V, d_N) / 32, then 16 bisections). Exact for
-        // convex objects up to the map's resolution.
-        float t_max = 1.05 * max(max(d_v, d_n), 1e-4);
-        float lo = 0.0, hi = -1.0;
-        for (int i = 1; i <= 32; ++i) {
-            float t = t_max * float(i) / 32.0;
-            if (behind_back(p1 + t * t1)) { hi = t; break; }
-            lo = t;
-        }
-        if (hi < 0.0) return false;
-        for (int i = 0; i < 16; ++i) {
-            float mid = 0.5 * (lo + hi);
-            if (behind_back(p1 + mid * t1)) hi = mid; else lo = mid;
-        }
-        dist = hi;
-        q = light_texel(p1 + dist * t1);
-        if (q.x < 0 || imageLoad(back_position, q).w == 0.0) return false;
+    float t_max = 1.05 * max(max(d_v, d_n), 1e-4);
+    float lo = 0.0, hi = -1.0;
+    for (int i = 1; i <= 32; ++i) {
+        float t = t_max * float(i) / 32.0;
+        if (behind_back(p1 + t * t1)) { hi = t; break; }
+        lo = t;
     }
-    vec3 p2 = p1 + dist * t1;
-    vec3 n2 = use_fallback ? n2_fallback : imageLoad(back_normal, q).xyz;
+    if (hi < 0.0) return false;
+    for (int i = 0; i < 16; ++i) {
+        float mid = 0.5 * (lo + hi);
+        if (behind_back(p1 + mid * t1)) hi = mid; else lo = mid;
+    }
+    vec3 p2 = p1 + hi * t1;
+    vec3 n2;
+    if (!back_face_normal(p2, n2)) return false;
     n2 = -normalize(n2); // facing the ray inside the glass
     if (dot(n2, t1) > 0.0) n2 = -n2;
-    w *= exp(-materials[m].absorption_ior.rgb * dist);
     vec3 t2;
-    if (!refract_dir(t1, n2, ior, t2)) {
-        if (pc.mode.x != PHOTON_MODE_IMAGE_SPACE) return false;
-        // Total internal reflection at the approximated exit (for a convex
-        // refractor mostly an artefact of d~): Wyman's second ad hoc fix,
-        // clamp to the critical angle, i.e. leave tangent to the surface.
-        // The photon keeps its flux (the transmission it would have had is
-        // unknown; dropping it loses ~21% of a ball lens's caustic, and his
-        // third fix, reflecting, sends it back up past the light).
-        dir = normalize(t1 - dot(t1, n2) * n2);
-        return land(p2, dir, p3);
-    }
-    w *= 1.0 - fresnel_dielectric(-dot(t1, n2), ior);
+    if (!refract_dir(t1, n2, ior, t2)) return false;
+    w *= exp(-materials[m].absorption_ior.rgb * hi) * (1.0 - fresnel_dielectric(-dot(t1, n2), ior));
     dir = t2;
     return land(p2, t2, p3);
 }
@@ -317,10 +292,12 @@ void main() {
     bool image_space = pc.mode.x != PHOTON_MODE_TRACED;
     uint m;
     vec3 x, ng, ns;
+    float d_n = 0.0;
     bool front = true;
     if (image_space) {
         vec4 fp = imageLoad(front_position, ivec2(id));
-        if (fp.w == 0.0) return;
+        if (fp.w < 0.0) return;
+        d_n = fp.w;
         vec4 fn = imageLoad(front_normal, ivec2(id));
         m = uint(fn.w + 0.5);
         x = fp.xyz;
@@ -370,7 +347,7 @@ void main() {
     vec3 wt = w * (1.0 - fresnel_dielectric(-dot(d, nt), eta));
     if (image_space) {
         vec3 dt;
-        if (image_space_refraction(id, x, n, d, m, wt, p3, dt)) {
+        if (image_space_refraction(id, x, n, d, m, d_n, wt, p3, dt)) {
             photons[index] = Photon(vec4(p3, 1.0), vec4(wt, measure), vec4(dt, 0.0));
         }
         return;

@@ -14,7 +14,7 @@ struct Triangle {
     vec4 p0; // w: material index (uint bits)
     vec4 p1; // w: object index (uint bits)
     vec4 p2;
-    vec4 n0; // w: reserved
+    vec4 n0; // w: Wyman's d_N for refractors (distance to the far side along -n), else 0
     vec4 n1;
     vec4 n2;
 };

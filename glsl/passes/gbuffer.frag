@@ -1,8 +1,13 @@
 #version 460
 // Camera G-buffer, fragment stage: world position (w = 1: covered) and the
 // smooth normal turned toward the camera (two-sided surfaces) with the
-// material index in w.
+// material index in w. With `opaque_only` the specular surfaces are left
+// out (image_space refracts and reflects them in a later pass).
 #include "scene.glsl"
+
+layout(push_constant) uniform Push {
+    uint opaque_only;
+} pc;
 
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
@@ -12,6 +17,7 @@ layout(location = 0) out vec4 out_position;
 layout(location = 1) out vec4 out_normal;
 
 void main() {
+    if (pc.opaque_only != 0u && material_kind(v_material) != MATERIAL_DIFFUSE) discard;
     vec3 n = normalize(v_normal);
     if (dot(n, frame.eye.xyz - v_position) < 0.0) n = -n;
     out_position = vec4(v_position, 1.0);

@@ -17,6 +17,7 @@
 //! first and report a miss.
 
 mod build;
+mod thickness;
 mod traverse;
 
 #[cfg(test)]

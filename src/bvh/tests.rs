@@ -541,3 +541,115 @@ fn build_200k_triangles() {
     check_tree(&bvh, &tris);
     cross_check(&bvh, &tris, &rays_for(&tris, 200, 52, -12.0, 12.0));
 }
+
+/// Triangles of `mesh` as one object with material 0.
+fn mesh_triangles(mesh: &crate::scene::Mesh) -> Vec<Triangle> {
+    mesh.indices
+        .iter()
+        .map(|t| Triangle {
+            positions: t.map(|i| mesh.positions[i as usize]),
+            normals: t.map(|i| mesh.normals[i as usize]),
+            material: 0,
+            object: 0,
+        })
+        .collect()
+}
+
+/// d_N of every vertex of `triangles` (all refractors).
+fn normal_thickness(triangles: &[Triangle]) -> Vec<f32> {
+    let bvh = Bvh::build(triangles);
+    let mut gpu = bvh.gpu_triangles(triangles);
+    bvh.set_normal_thickness(&mut gpu, |_| true);
+    gpu.iter()
+        .flat_map(|t| [t.n0[3], t.n1[3], t.n2[3]])
+        .collect()
+}
+
+/// On a UV sphere every vertex lies on the sphere and -N points through the
+/// centre, so the ray meets the far side at distance r + rho, rho the
+/// distance from the centre to the hit point. A point of a triangle whose
+/// vertices lie on the sphere, x = sum b_i v_i, has |x|^2 = sum b_i b_j
+/// v_i.v_j >= r^2 cos(gamma), gamma the widest angle between two of its
+/// vertices, and gamma <= d_theta + d_phi (along a meridian, then a
+/// parallel). So 2r >= d_N >= r (1 + sqrt(cos(d_theta + d_phi))), up to
+/// float rounding (1e-5 r). With an even slice count the antipode of a
+/// vertex is a vertex and d_N = 2r; with an odd one it falls inside a
+/// triangle and the lower bound matters.
+#[test]
+fn normal_thickness_of_a_sphere_is_its_diameter() {
+    for (segments, radius, centre) in [
+        (64u32, 1.0f32, Vec3::new(0.0, 1.6, 0.0)),
+        (33, 0.5, Vec3::new(3.0, -2.0, 1.0)),
+    ] {
+        let mesh = crate::scene::shapes::sphere(centre, radius, segments);
+        let d = normal_thickness(&mesh_triangles(&mesh));
+        let (slices, stacks) = (segments as f32, (segments / 2) as f32);
+        let gamma = std::f32::consts::PI / stacks + std::f32::consts::TAU / slices;
+        let lo = radius * (1.0 + gamma.cos().sqrt()) - 1e-5 * radius;
+        let hi = 2.0 * radius * (1.0 + 1e-5);
+        let (min, max) = d
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+        println!("sphere r = {radius}, {segments} segments: d_N in [{min:.6}, {max:.6}], bounds [{lo:.6}, {hi:.6}]");
+        assert!(
+            min >= lo && max <= hi,
+            "d_N in [{min}, {max}], bounds [{lo}, {hi}]"
+        );
+    }
+}
+
+/// A box slab: every vertex's flat normal crosses the slab face to face, so
+/// d_N is the slab's extent along that normal (thickness 0.1 m for the top
+/// and bottom faces), to float rounding.
+#[test]
+fn normal_thickness_of_a_slab_is_its_thickness() {
+    let (min, max) = (Vec3::new(-1.0, 0.5, -0.7), Vec3::new(1.0, 0.6, 0.7));
+    let tris = mesh_triangles(&crate::scene::shapes::cuboid(min, max));
+    let extent = max - min;
+    let bvh = Bvh::build(&tris);
+    let mut gpu = bvh.gpu_triangles(&tris);
+    bvh.set_normal_thickness(&mut gpu, |_| true);
+    for t in &gpu {
+        for n in [t.n0, t.n1, t.n2] {
+            let normal = Vec3::new(n[0], n[1], n[2]);
+            let expected = normal.abs().dot(extent);
+            assert!(
+                (n[3] - expected).abs() < 1e-5,
+                "d_N {} along {normal}, expected {expected}",
+                n[3]
+            );
+        }
+    }
+    // Not a refractor: 0.
+    bvh.set_normal_thickness(&mut gpu, |_| false);
+    assert!(gpu
+        .iter()
+        .all(|t| t.n0[3] == 0.0 && t.n1[3] == 0.0 && t.n2[3] == 0.0));
+}
+
+/// The ray skips other objects: a small box inside a big one (separate
+/// objects) does not shorten the big one's d_N.
+#[test]
+fn normal_thickness_ignores_other_objects() {
+    let mut tris = mesh_triangles(&crate::scene::shapes::cuboid(
+        Vec3::splat(-1.0),
+        Vec3::splat(1.0),
+    ));
+    let mut inner = mesh_triangles(&crate::scene::shapes::cuboid(
+        Vec3::splat(-0.2),
+        Vec3::splat(0.2),
+    ));
+    for t in &mut inner {
+        t.object = 1;
+    }
+    tris.extend(inner);
+    let bvh = Bvh::build(&tris);
+    let mut gpu = bvh.gpu_triangles(&tris);
+    bvh.set_normal_thickness(&mut gpu, |_| true);
+    for t in &gpu {
+        let expected = if t.p1[3].to_bits() == 0 { 2.0 } else { 0.4 };
+        for d in [t.n0[3], t.n1[3], t.n2[3]] {
+            assert!((d - expected).abs() < 1e-5, "d_N {d}, expected {expected}");
+        }
+    }
+}

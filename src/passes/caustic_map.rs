@@ -10,7 +10,8 @@
 //!    E * A_texel, times Fresnel and Beer-Lambert. `mode` picks how the
 //!    refracted path is found: traced through the BVH (exact, default), or
 //!    from light-space front/back G-buffers of the specular objects
-//!    ("caustic light view", Wyman's two-sided refraction) with the back
+//!    ("caustic light view", `passes::specular_gbuffer` from the light:
+//!    Wyman's two-sided refraction, shared with the camera) with the back
 //!    interface by Eq. 6.3.1 or by marching the back-face map; the exit ray
 //!    lands through the BVH. Buffer: `2 N^2` `GpuPhoton`s, refracted photons
 //!    first, reflected ones second (reflected photons are always traced).
@@ -28,12 +29,21 @@
 //! map edge or a cube-face edge lose their clipped part. The splat draws
 //! every photon once per view of the light (6x for a point light, culled in
 //! the vertex shader): 0.6 s of a 1.05 s frame at 512² on lavapipe.
-//! Mode 1 (Eq. 6.3.1) on the ball lens shows a faint halo outside the
-//! shadow (photons clamped to the critical angle) and four small dark
-//! spots in the caustic whose cause is not yet found; modes 0 and 2 show
-//! neither.
+//! Mode 1 runs the camera's two-sided refraction code
+//! (glsl/common/image_space_refraction.glsl) with the per-vertex d_N. On
+//! the ball lens it still shows a faint halo outside the shadow with the
+//! default `tir_remedy` 1: about 21% of the entering photons meet total
+//! internal reflection at the approximated exit (Eq. 6.3.1's d~ falls
+//! short near the rim, whatever d_N) and, clamped to the critical angle,
+//! leave tangent to the sphere. `tir_remedy` 0 (T2 = T1) or 2 (reflect,
+//! losing that flux upward) show no halo. The small dark spots in the
+//! caustic (four, symmetric about the light view's axes; three visible from
+//! the ball_lens camera) remain with every remedy, so the per-photon BVH
+//! cast for d_N was not their cause; still unexplained. The default stays
+//! mode 0 (exact) for both reasons; mode 2 shows neither.
 
 use crate::passes::shadow::{shadow_views, GpuShadowLight};
+use crate::passes::specular_gbuffer::{SpecularGBuffer, Viewpoint};
 use crate::renderer::SceneGpu;
 use crate::scene::{Light, LightKind, MaterialKind, Scene};
 use crate::shader_bindings as b;
@@ -49,7 +59,6 @@ use std::mem::size_of;
 use std::sync::Arc;
 
 pub const CAUSTIC_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
-pub const LIGHT_GBUFFER_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 
 /// One photon, mirrored by `Photon` in glsl/caustic_map/photon.glsl.
 #[repr(C)]
@@ -72,17 +81,9 @@ pub struct PhotonViewPush {
     pub right: [f32; 4],
     pub up: [f32; 4],
     pub forward: [f32; 4],
-    /// x: `PHOTON_MODE_TRACED` or `PHOTON_MODE_IMAGE_SPACE`.
+    /// x: `PHOTON_MODE_*`; y: TIR remedy (`TIR_*`); z: 1 to use Eq. 6.3.2
+    /// where the back-face texel holds no normal (see image_space PARAMS).
     pub mode: [u32; 4],
-}
-
-/// Push constants of glsl/caustic_map/lightview.*.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct LightViewPush {
-    view_proj: [[f32; 4]; 4],
-    origin: [f32; 4],
-    forward: [f32; 4],
 }
 
 #[repr(C)]
@@ -177,6 +178,17 @@ pub fn specular_bounds(scene: &Scene) -> Option<(Vec3, f32)> {
     any.then(|| ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-4)))
 }
 
+/// How photons find their refracted paths.
+#[derive(Clone, Copy, Debug)]
+pub struct PhotonPaths {
+    /// `PHOTON_MODE_*`.
+    pub mode: u32,
+    /// `TIR_*` (photon mode 1).
+    pub tir_remedy: u32,
+    /// Eq. 6.3.2 where the back-face texel holds no normal (photon mode 1).
+    pub use_eq632: bool,
+}
+
 pub struct CausticMap {
     /// `2 N^2` photons (refracted, then reflected), storage, reused per light.
     pub photons: Buffer,
@@ -189,14 +201,11 @@ pub struct CausticMap {
     pub splat_size: u32,
     /// `PHOTON_MODE_TRACED` or `PHOTON_MODE_IMAGE_SPACE`.
     pub mode: u32,
-    /// Light-space G-buffers of the specular objects (image-space mode):
-    /// nearest front and back faces, position and normal (RGBA32F, N x N).
-    pub front_position: Image,
-    pub front_normal: Image,
-    pub back_position: Image,
-    pub back_normal: Image,
-    light_depth: Image,
-    lightview_pipeline: GraphicsPipeline,
+    /// `[TIR_*, 1 if Eq. 6.3.2 is on]` for the image-space photon mode.
+    pub refraction: [u32; 2],
+    /// Light-space G-buffer of the specular objects (photon modes 1, 2),
+    /// N x N, one light at a time.
+    pub light_view: SpecularGBuffer,
     lights: Vec<Light>,
     specular: Option<(Vec3, f32)>,
     photon_pipeline: ComputePipeline,
@@ -215,7 +224,7 @@ impl CausticMap {
         photon_size: u32,
         map_size: u32,
         splat_size: u32,
-        mode: u32,
+        paths: PhotonPaths,
     ) -> VkResult<Self> {
         let lights: Vec<Light> = scene
             .lights
@@ -261,47 +270,17 @@ impl CausticMap {
                 (b::CAUSTIC_BINDING_BACK_NORMAL, BindingKind::StorageImage),
             ],
         )?;
-        let gbuffer_image = |name: &str| {
-            Image::new(
-                ctx,
-                name,
-                ImageDesc::new_2d(
-                    photon_size,
-                    photon_size,
-                    LIGHT_GBUFFER_FORMAT,
-                    vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::STORAGE,
-                ),
-            )
-        };
-        let front_position = gbuffer_image("light view front position")?;
-        let front_normal = gbuffer_image("light view front normal")?;
-        let back_position = gbuffer_image("light view back position")?;
-        let back_normal = gbuffer_image("light view back normal")?;
-        let light_depth = Image::new(
-            ctx,
-            "light view depth",
-            ImageDesc::new_2d(
-                photon_size,
-                photon_size,
-                vk::Format::D32_SFLOAT,
-                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-            ),
-        )?;
+        let light_view = SpecularGBuffer::new(ctx, &scene_gpu.layout, photon_size, photon_size)?;
         let set = DescriptorSet::new(ctx, &layout)?;
         set.write_buffer(b::CAUSTIC_BINDING_PHOTONS, &photons)
             .write_buffer(b::CAUSTIC_BINDING_VIEWS, &views)
-            .write_storage_image(b::CAUSTIC_BINDING_FRONT_POSITION, &front_position)
-            .write_storage_image(b::CAUSTIC_BINDING_FRONT_NORMAL, &front_normal)
-            .write_storage_image(b::CAUSTIC_BINDING_BACK_POSITION, &back_position)
-            .write_storage_image(b::CAUSTIC_BINDING_BACK_NORMAL, &back_normal);
-        let mut lv =
-            GraphicsPipelineDesc::new("caustic_map/lightview.vert", "caustic_map/lightview.frag");
-        lv.color_formats = vec![LIGHT_GBUFFER_FORMAT, LIGHT_GBUFFER_FORMAT];
-        lv.depth_format = Some(vk::Format::D32_SFLOAT);
-        lv.depth_test = true;
-        lv.depth_write = true;
-        lv.push_size = size_of::<LightViewPush>() as u32;
-        let lightview_pipeline = GraphicsPipeline::new(ctx, &lv, &[&scene_gpu.layout])?;
+            .write_storage_image(
+                b::CAUSTIC_BINDING_FRONT_POSITION,
+                &light_view.front_position,
+            )
+            .write_storage_image(b::CAUSTIC_BINDING_FRONT_NORMAL, &light_view.front_normal)
+            .write_storage_image(b::CAUSTIC_BINDING_BACK_POSITION, &light_view.back_position)
+            .write_storage_image(b::CAUSTIC_BINDING_BACK_NORMAL, &light_view.back_normal);
         let photon_pipeline = ComputePipeline::new(
             ctx,
             "caustic_map/photons.comp",
@@ -323,13 +302,9 @@ impl CausticMap {
             photon_size,
             map_size,
             splat_size: splat_size | 1,
-            mode,
-            front_position,
-            front_normal,
-            back_position,
-            back_normal,
-            light_depth,
-            lightview_pipeline,
+            mode: paths.mode,
+            refraction: [paths.tir_remedy, u32::from(paths.use_eq632)],
+            light_view,
             lights,
             specular,
             photon_pipeline,
@@ -362,7 +337,7 @@ impl CausticMap {
     /// Photon view of light `l`, if it has one.
     pub fn photon_view(&self, l: usize) -> Option<PhotonViewPush> {
         let mut v = photon_view(&self.lights[l], l as u32, self.specular?, self.photon_size)?;
-        v.mode[0] = self.mode;
+        v.mode = [self.mode, self.refraction[0], self.refraction[1], 0];
         Some(v)
     }
 
@@ -397,62 +372,16 @@ impl CausticMap {
             };
             if self.mode != b::PHOTON_MODE_TRACED {
                 let view_proj = photon_view_proj(&push, self.specular.unwrap_or_default());
+                let view = Viewpoint::Light {
+                    view_proj,
+                    origin: Vec3::from_slice(&push.origin[..3]),
+                    forward: Vec3::from_slice(&push.forward[..3]),
+                    orthographic: push.forward[3].to_bits() == b::SHADOW_PLANAR,
+                };
                 rec.pass("caustic light view", |cmd| {
-                    let extent = self.front_position.extent();
-                    for (pass, pos, nrm) in [
-                        (
-                            b::LIGHT_VIEW_FRONT,
-                            &self.front_position,
-                            &self.front_normal,
-                        ),
-                        (b::LIGHT_VIEW_BACK, &self.back_position, &self.back_normal),
-                    ] {
-                        // Overwritten entirely; waits for the previous reader
-                        // (last light's photons); the depth image is reused
-                        // by both passes (write-after-write).
-                        barrier(
-                            &ctx,
-                            cmd,
-                            &[
-                                ImageAccess::discard(pos, Access::ColorAttachment),
-                                ImageAccess::discard(nrm, Access::ColorAttachment),
-                                ImageAccess::discard(&self.light_depth, Access::DepthAttachment),
-                            ],
-                            &[BufferAccess::new(&scene.triangles, Access::VertexRead)],
-                        );
-                        begin_rendering(
-                            &ctx,
-                            cmd,
-                            extent,
-                            &[(pos.view, Some([0.0; 4])), (nrm.view, Some([0.0; 4]))],
-                            Some(self.light_depth.view),
-                        );
-                        if scene.triangle_count > 0 {
-                            let lv = LightViewPush {
-                                view_proj: view_proj.to_cols_array_2d(),
-                                origin: [
-                                    push.origin[0],
-                                    push.origin[1],
-                                    push.origin[2],
-                                    push.forward[3],
-                                ],
-                                forward: [
-                                    push.forward[0],
-                                    push.forward[1],
-                                    push.forward[2],
-                                    f32::from_bits(pass),
-                                ],
-                            };
-                            self.lightview_pipeline.bind(
-                                cmd,
-                                &[&scene.set],
-                                bytemuck::bytes_of(&lv),
-                                extent,
-                            );
-                            unsafe { ctx.device.cmd_draw(cmd, 3 * scene.triangle_count, 1, 0, 0) };
-                        }
-                        end_rendering(&ctx, cmd);
-                    }
+                    // Overwritten entirely; the barriers inside wait for the
+                    // previous reader (last light's photons).
+                    self.light_view.draw(&ctx, cmd, scene, &view);
                 });
             }
             rec.pass("caustic photons", |cmd| {
@@ -470,17 +399,7 @@ impl CausticMap {
                     // The light-view attachments, read as storage images
                     // (in GENERAL layout even in traced mode: the shader
                     // declares them, so they must be in the bound layout).
-                    barrier(
-                        &ctx,
-                        cmd,
-                        &[
-                            ImageAccess::new(&self.front_position, Access::ComputeRead),
-                            ImageAccess::new(&self.front_normal, Access::ComputeRead),
-                            ImageAccess::new(&self.back_position, Access::ComputeRead),
-                            ImageAccess::new(&self.back_normal, Access::ComputeRead),
-                        ],
-                        &[],
-                    );
+                    barrier(&ctx, cmd, &self.light_view.compute_reads(), &[]);
                 }
                 let groups = [
                     self.photon_size.div_ceil(8),

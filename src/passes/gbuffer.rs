@@ -8,6 +8,9 @@
 //!   0 for background (cleared to zero).
 //! - `normal`: xyz unit smooth normal flipped to face the camera (surfaces are
 //!   two-sided); w = material index as a float (exact below 2^24).
+//!
+//! `GBufferContents::Opaque` leaves the specular surfaces out (`image_space`
+//! sees the opaque scene behind them and adds them by image-space refraction).
 
 use crate::renderer::SceneGpu;
 use crate::vk::{
@@ -21,10 +24,20 @@ pub const POSITION_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const NORMAL_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
+/// Which surfaces the G-buffer holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GBufferContents {
+    /// Every surface.
+    All,
+    /// Diffuse surfaces only: mirrors and dielectrics are skipped.
+    Opaque,
+}
+
 pub struct GBuffer {
     pub position: Image,
     pub normal: Image,
     pub depth: Image,
+    pub contents: GBufferContents,
     pipeline: GraphicsPipeline,
 }
 
@@ -35,6 +48,7 @@ impl GBuffer {
         scene_layout: &DescriptorSetLayout,
         width: u32,
         height: u32,
+        contents: GBufferContents,
     ) -> VkResult<Self> {
         let color_usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
             | vk::ImageUsageFlags::STORAGE
@@ -66,11 +80,13 @@ impl GBuffer {
         desc.depth_write = true;
         // Two-sided surfaces: no culling; the fragment shader flips normals.
         desc.cull = vk::CullModeFlags::NONE;
+        desc.push_size = 4;
         let pipeline = GraphicsPipeline::new(ctx, &desc, &[scene_layout])?;
         Ok(Self {
             position,
             normal,
             depth,
+            contents,
             pipeline,
         })
     }
@@ -110,7 +126,9 @@ impl GBuffer {
                 Some(self.depth.view),
             );
             if scene.triangle_count > 0 {
-                self.pipeline.bind(cmd, &[&scene.set], &[], extent);
+                let opaque_only = u32::from(self.contents == GBufferContents::Opaque);
+                self.pipeline
+                    .bind(cmd, &[&scene.set], bytemuck::bytes_of(&opaque_only), extent);
                 unsafe { ctx.device.cmd_draw(cmd, 3 * scene.triangle_count, 1, 0, 0) };
             }
             end_rendering(&ctx, cmd);

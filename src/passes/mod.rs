@@ -4,4 +4,5 @@
 pub mod caustic_map;
 pub mod gbuffer;
 pub mod shadow;
+pub mod specular_gbuffer;
 pub mod tonemap;

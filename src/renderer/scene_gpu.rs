@@ -5,7 +5,7 @@
 use crate::bvh::Bvh;
 use crate::gpu::{GpuFrame, GpuLight, GpuMaterial, GpuMedium, GpuTriangle};
 use crate::reference::Component;
-use crate::scene::{Camera, Density, Scene};
+use crate::scene::{Camera, Density, MaterialKind, Scene, Triangle};
 use crate::shader_bindings as b;
 use crate::vk::{
     BindingKind, Buffer, BufferUsage, Context, DescriptorSet, DescriptorSetLayout, VkResult,
@@ -51,6 +51,14 @@ fn gpu_medium(scene: &Scene) -> GpuMedium {
         .unwrap_or_else(GpuMedium::none)
 }
 
+/// Dielectric materials get Wyman's per-vertex d_N (`Bvh::set_normal_thickness`).
+fn is_refractor(scene: &Scene, material: u32) -> bool {
+    scene
+        .materials
+        .get(material as usize)
+        .is_some_and(|m| m.kind == MaterialKind::Dielectric)
+}
+
 /// View and projection for Vulkan: right-handed view, depth 0..1, y down in
 /// clip space so image row 0 is the top.
 pub fn camera_matrices(camera: &Camera, aspect: f32) -> (Mat4, Mat4) {
@@ -79,7 +87,7 @@ impl SceneGpu {
     pub fn new(ctx: &Arc<Context>, scene: &Scene, time: f32) -> VkResult<SceneGpu> {
         let triangles = scene.triangles(time);
         let bvh = Bvh::build(&triangles);
-        let gpu_triangles = bvh.gpu_triangles(&triangles);
+        let gpu_triangles = Self::gpu_triangles(scene, &bvh, &triangles);
         let stats = GeometryStats {
             triangles: triangles.len(),
             bvh_nodes: bvh.nodes.len(),
@@ -144,6 +152,14 @@ impl SceneGpu {
         })
     }
 
+    /// The triangle buffer's contents: `triangles` (of `scene`) in `bvh`'s
+    /// leaf order, with Wyman's per-vertex d_N on the dielectric ones.
+    pub fn gpu_triangles(scene: &Scene, bvh: &Bvh, triangles: &[Triangle]) -> Vec<GpuTriangle> {
+        let mut gpu = bvh.gpu_triangles(triangles);
+        bvh.set_normal_thickness(&mut gpu, |m| is_refractor(scene, m));
+        gpu
+    }
+
     /// The BVH the GPU traverses (its `nodes` are the uploaded `bvh_nodes`;
     /// `triangle_order` maps the uploaded leaf-order triangles to the scene's).
     pub fn bvh(&self) -> &Bvh {
@@ -155,7 +171,9 @@ impl SceneGpu {
     pub fn update_geometry(&mut self, scene: &Scene, time: f32) -> VkResult<()> {
         let triangles = scene.triangles(time);
         self.bvh.refit(&triangles);
-        let gpu_triangles = self.bvh.gpu_triangles(&triangles);
+        // Deforming refractors (water) change their thickness: d_N is
+        // recomputed with the geometry (3 rays per refractor triangle).
+        let gpu_triangles = Self::gpu_triangles(scene, &self.bvh, &triangles);
         self.triangles
             .upload(bytemuck::cast_slice(&gpu_triangles))?;
         self.bvh_nodes

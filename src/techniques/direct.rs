@@ -14,7 +14,7 @@
 //! attenuation (the medium techniques add it).
 
 use super::{ParamSpec, Params, Technique};
-use crate::passes::gbuffer::GBuffer;
+use crate::passes::gbuffer::{GBuffer, GBufferContents};
 use crate::passes::shadow::ShadowMaps;
 use crate::renderer::{FrameTargets, SceneGpu};
 use crate::scene::Scene;
@@ -78,10 +78,32 @@ impl Direct {
         width: u32,
         height: u32,
     ) -> VkResult<Self> {
+        Self::with_contents(
+            ctx,
+            params,
+            scene,
+            scene_gpu,
+            width,
+            height,
+            GBufferContents::All,
+        )
+    }
+
+    /// The same passes over a G-buffer holding `contents` (`image_space`
+    /// lights the opaque scene behind its refractors).
+    pub fn with_contents(
+        ctx: &Arc<Context>,
+        params: &Params,
+        scene: &Scene,
+        scene_gpu: &SceneGpu,
+        width: u32,
+        height: u32,
+        contents: GBufferContents,
+    ) -> VkResult<Self> {
         let shadow_map_size = params.get("shadow_map_size") as u32;
         let pcf_radius = params.get("pcf_radius") as i32;
         let shadows = ShadowMaps::new(ctx, &scene_gpu.layout, &scene.lights, shadow_map_size)?;
-        let gbuffer = GBuffer::new(ctx, &scene_gpu.layout, width, height)?;
+        let gbuffer = GBuffer::new(ctx, &scene_gpu.layout, width, height, contents)?;
         let layout = DescriptorSetLayout::new(
             ctx,
             &[

@@ -127,7 +127,7 @@ pub const TECHNIQUES: &[TechniqueInfo] = &[TechniqueInfo {
     components: &[Component::Direct],
 }, TechniqueInfo {
     name: "image_space",
-    description: "Wyman 2005-06 caustic maps: photons through the specular objects, Gaussian splats, projected onto diffuse receivers",
+    description: "Wyman 2005-06: two-sided image-space refraction of what the camera sees through glass (and in mirrors), and caustic maps (photons through the specular objects, Gaussian splats, projected onto diffuse receivers)",
     params: image_space::PARAMS,
     components: &[Component::Direct, Component::SurfaceCaustics],
 }];

@@ -1,0 +1,191 @@
+#version 460
+// What the camera sees in the specular objects (technique image_space):
+// Wyman 2005-06 two-sided image-space refraction, per pixel of the camera's
+// specular G-buffer (front: nearest specular surface, with the
+// interpolated per-vertex d_N; back: farthest back face of the
+// dielectrics). Everything else is the opaque frame (direct light + surface
+// caustics of the scene without its specular surfaces) copied through.
+//
+// Dielectric at p1 (normal N1 toward the viewer, view direction V):
+//   L = F1 L(p1, R) + (1 - F1) T2 exp(-sigma_a d~) L(p2, T2)
+// F1 the exact unpolarised Fresnel reflectance at p1, R the mirror
+// direction, and p2, T2, d~ and the exit transmittance T2 = 1 - F2 (1 where
+// a TIR remedy applied) from glsl/common/image_space_refraction.glsl
+// (Eq. 6.3.1, back-face normal texture, Eq. 6.3.2, TIR remedies). Radiance
+// entering glass is scaled by (n2/n1)^2 and leaving it by (n1/n2)^2: across
+// the two interfaces the factors cancel, so no n^2 appears here.
+// Mirror at p1: L = reflectance * L(p1, R).
+// L(o, d): the image-space search of the opaque frame (below); a ray that
+// leaves the view or the scene's bounding sphere reads the environment,
+// which is black: scene files have no background, and the reference
+// tracer and `direct` give escaping rays 0 too.
+#include "scene.glsl"
+#include "optics.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 1, binding = REFRACTION_BINDING_OPAQUE_RADIANCE, rgba32f) uniform readonly image2D opaque_radiance;
+layout(set = 1, binding = REFRACTION_BINDING_OPAQUE_POSITION, rgba32f) uniform readonly image2D opaque_position;
+layout(set = 1, binding = REFRACTION_BINDING_FRONT_POSITION, rgba32f) uniform readonly image2D front_position;
+layout(set = 1, binding = REFRACTION_BINDING_FRONT_NORMAL, rgba32f) uniform readonly image2D front_normal;
+layout(set = 1, binding = REFRACTION_BINDING_BACK_POSITION, rgba32f) uniform readonly image2D back_position;
+layout(set = 1, binding = REFRACTION_BINDING_BACK_NORMAL, rgba32f) uniform readonly image2D back_normal;
+layout(set = 1, binding = REFRACTION_BINDING_RADIANCE, rgba32f) uniform writeonly image2D radiance;
+
+layout(push_constant) uniform Push {
+    uint tir_remedy;   // TIR_*
+    uint use_eq632;    // 1: Eq. 6.3.2 where the back-face texel is empty
+    uint search_steps; // linear steps of the image-space search
+    uint pad;
+} pc;
+
+const vec3 ENVIRONMENT = vec3(0.0);
+const int BISECTIONS = 10;
+
+// The pixel x projects to and its view depth (clip w); false behind the
+// camera or outside the image.
+bool project(vec3 x, out ivec2 q, out float depth) {
+    vec4 c = frame.view_proj * vec4(x, 1.0);
+    depth = c.w;
+    q = ivec2(-1);
+    if (c.w <= 1e-6) return false;
+    vec2 pixel = (c.xy / c.w * 0.5 + 0.5) * frame.viewport.xy;
+    if (any(lessThan(pixel, vec2(0.0))) || any(greaterThanEqual(pixel, frame.viewport.xy))) return false;
+    q = ivec2(pixel);
+    return true;
+}
+
+float view_depth(vec3 x) { return (frame.view_proj * vec4(x, 1.0)).w; }
+
+// For the shared two-sided refraction: the camera's back-face normal at x.
+bool back_face_normal(vec3 x, out vec3 n) {
+    n = vec3(0.0);
+    ivec2 q;
+    float z;
+    if (!project(x, q, z) || imageLoad(back_position, q).w < 0.0) return false;
+    n = imageLoad(back_normal, q).xyz;
+    return true;
+}
+
+#include "image_space_refraction.glsl"
+
+// True when x lies at or behind the opaque surface at its pixel (the ray
+// has reached the surface); `gap` is how far behind, in view depth.
+bool behind_opaque(vec3 x, out ivec2 q, out float gap) {
+    float z;
+    gap = 0.0;
+    if (!project(x, q, z)) return false;
+    vec4 s = imageLoad(opaque_position, q);
+    if (s.w == 0.0) return false; // background: nothing to meet there
+    gap = z - view_depth(s.xyz);
+    return gap >= 0.0;
+}
+
+// How much the opaque surface's view depth changes from pixel q to its
+// neighbours: a ray meeting a surface seen at a grazing angle lands up to
+// that far behind the depth stored at the pixel's centre.
+float pixel_depth_extent(ivec2 q) {
+    float z0 = view_depth(imageLoad(opaque_position, q).xyz);
+    float extent = 0.0;
+    ivec2 size = imageSize(opaque_position);
+    for (int k = 0; k < 4; ++k) {
+        ivec2 n = q + ivec2(k == 0 ? 1 : (k == 1 ? -1 : 0), k == 2 ? 1 : (k == 3 ? -1 : 0));
+        if (any(lessThan(n, ivec2(0))) || any(greaterThanEqual(n, size))) continue;
+        vec4 s = imageLoad(opaque_position, n);
+        if (s.w != 0.0) extent = max(extent, abs(view_depth(s.xyz) - z0));
+    }
+    return extent;
+}
+
+// How far the ray (o, d) stays inside the view frustum (0 if o is outside):
+// clip coordinates are linear in t, and each side is a half-space g(t) =
+// g0 + t g1 >= 0. Shrunk a little so the last sample still projects inside.
+float frustum_exit(vec3 o, vec3 d) {
+    vec4 c0 = frame.view_proj * vec4(o, 1.0);
+    vec4 c1 = frame.view_proj * vec4(d, 0.0);
+    vec4 g0[2] = vec4[2](c0.wwww + vec4(-c0.x, c0.x, -c0.y, c0.y), vec4(c0.w - 1e-3));
+    vec4 g1[2] = vec4[2](c1.wwww + vec4(-c1.x, c1.x, -c1.y, c1.y), vec4(c1.w));
+    float t = 1e30;
+    for (int k = 0; k < 2; ++k) {
+        for (int j = 0; j < 4; ++j) {
+            if (g0[k][j] < 0.0) return 0.0;
+            if (g1[k][j] < 0.0) t = min(t, -g0[k][j] / g1[k][j]);
+        }
+    }
+    return t * (1.0 - 1e-4);
+}
+
+// Image-space search of the opaque frame along (o, d) (Wyman 2006 cites
+// linear [Wyman05b] and binary [Policarpo05] searches; we do both): linear
+// steps over the part of the ray inside both the view frustum and the
+// scene's bounding sphere until the ray passes behind the opaque depth,
+// then bisection between the last two steps. A crossing whose refined gap
+// exceeds one step plus the surface's depth change across a pixel is the
+// ray passing behind a nearer object, not meeting it: the march goes on. Past the frustum nothing can be found (the
+// frustum is convex, the ray never comes back): environment.
+vec3 search_opaque(vec3 o, vec3 d) {
+    vec3 oc = o - frame.scene_sphere.xyz;
+    float b = dot(oc, d);
+    float disc = b * b - (dot(oc, oc) - frame.scene_sphere.w * frame.scene_sphere.w);
+    if (disc <= 0.0) return ENVIRONMENT;
+    float t_max = min(-b + sqrt(disc), frustum_exit(o, d));
+    if (t_max <= 0.0) return ENVIRONMENT;
+    float step = t_max / float(max(pc.search_steps, 1u));
+    float t_prev = 0.0;
+    for (uint i = 1u; i <= pc.search_steps; ++i) {
+        float t = step * float(i);
+        ivec2 q;
+        float gap, z;
+        if (!project(o + t * d, q, z)) return ENVIRONMENT;
+        if (behind_opaque(o + t * d, q, gap)) {
+            float lo = t_prev, hi = t;
+            for (int k = 0; k < BISECTIONS; ++k) {
+                float mid = 0.5 * (lo + hi);
+                ivec2 qm;
+                float gm;
+                if (behind_opaque(o + mid * d, qm, gm)) hi = mid; else lo = mid;
+            }
+            behind_opaque(o + hi * d, q, gap);
+            if (gap <= step + pixel_depth_extent(q)) return imageLoad(opaque_radiance, q).rgb;
+        }
+        t_prev = t;
+    }
+    return ENVIRONMENT;
+}
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(p, imageSize(radiance)))) return;
+    vec4 fp = imageLoad(front_position, p);
+    if (fp.w < 0.0) {
+        imageStore(radiance, p, vec4(imageLoad(opaque_radiance, p).rgb, 1.0));
+        return;
+    }
+    vec4 fn = imageLoad(front_normal, p);
+    uint m = uint(fn.w + 0.5);
+    vec3 p1 = fp.xyz;
+    vec3 v = normalize(p1 - frame.eye.xyz);
+    vec3 n1 = normalize(fn.xyz);
+    if (dot(n1, v) > 0.0) n1 = -n1;
+    vec3 r = reflect(v, n1);
+    // The reflected ray starts on the surface; the opaque frame holds no
+    // specular surface, so only the start's own pixel could be met early,
+    // and its opaque surface lies behind p1.
+    if (material_kind(m) == MATERIAL_MIRROR) {
+        imageStore(radiance, p, vec4(materials[m].color.rgb * search_opaque(p1, r), 1.0));
+        return;
+    }
+    float ior = materials[m].absorption_ior.w;
+    float f1 = fresnel_dielectric(-dot(v, n1), 1.0 / ior);
+    vec3 l = f1 * search_opaque(p1, r);
+    // d_V: front to the farthest back face along this pixel's ray; a sheet
+    // with no back face here has no thickness.
+    vec4 bp = imageLoad(back_position, p);
+    float d_v = bp.w >= 0.0 ? max(length(bp.xyz - p1), 0.0) : 0.0;
+    TwoSidedExit e;
+    if (two_sided_refraction(v, p1, n1, ior, d_v, fp.w, pc.tir_remedy, pc.use_eq632 != 0u, e)) {
+        vec3 absorbed = exp(-materials[m].absorption_ior.rgb * e.dist);
+        l += (1.0 - f1) * e.transmit * absorbed * search_opaque(e.p2, e.dir);
+    }
+    imageStore(radiance, p, vec4(l, 1.0));
+}

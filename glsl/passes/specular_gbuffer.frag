@@ -1,0 +1,39 @@
+#version 460
+// Specular G-buffer, fragment stage. Front pass: the nearest specular
+// surface (dielectric faces whose winding normal faces the viewer; mirrors
+// from either side). Back pass: the farthest dielectric face turned away
+// from the viewer (reversed depth, see the vertex stage). Stores world
+// position with the interpolated d_N in w (clear value -1: not covered) and
+// the smooth outward normal with the material index in w.
+#include "scene.glsl"
+
+layout(push_constant) uniform Push {
+    mat4 view_proj;
+    vec4 origin;
+    vec4 forward;
+} pc;
+
+layout(location = 0) in vec3 v_position;
+layout(location = 1) in vec4 v_normal;
+layout(location = 2) flat in vec3 v_geometric;
+layout(location = 3) flat in uint v_material;
+
+layout(location = 0) out vec4 out_position;
+layout(location = 1) out vec4 out_normal;
+
+void main() {
+    uint kind = material_kind(v_material);
+    if (kind == MATERIAL_DIFFUSE) discard;
+    bool back_pass = floatBitsToUint(pc.forward.w) == SPECULAR_GBUFFER_BACK;
+    uint view = floatBitsToUint(pc.origin.w);
+    vec3 ray = view == SHADOW_PLANAR ? pc.forward.xyz
+             : v_position - (view == SPECULAR_VIEW_CAMERA ? frame.eye.xyz : pc.origin.xyz);
+    bool facing_viewer = dot(v_geometric, ray) < 0.0;
+    if (back_pass) {
+        if (kind != MATERIAL_DIELECTRIC || facing_viewer) discard;
+    } else if (kind == MATERIAL_DIELECTRIC && !facing_viewer) {
+        discard;
+    }
+    out_position = vec4(v_position, back_pass ? 0.0 : max(v_normal.w, 0.0));
+    out_normal = vec4(normalize(v_normal.xyz), float(v_material));
+}

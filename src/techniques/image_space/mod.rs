@@ -1,0 +1,282 @@
+//! `image_space`: Wyman 2005-06, image-space refraction and caustic maps.
+//!
+//! 1. The opaque frame (`opaque`): the `direct` passes over a G-buffer that
+//!    leaves the specular surfaces out (they still cast shadows: the shadow
+//!    maps hold every caster), plus, on diffuse receivers, L = albedo / pi *
+//!    E_caustic from the caustic map (`passes::caustic_map`): the light the
+//!    specular objects redirect, which includes the light their shadow
+//!    removed, so with IOR 1 the shadow is filled back in.
+//! 2. What the camera sees in the specular objects (`refraction`), Wyman's
+//!    two-sided image-space refraction: the camera's specular G-buffer
+//!    (`passes::specular_gbuffer`: nearest front faces with the per-vertex
+//!    d_N interpolated, farthest back faces: Wyman's preferred second
+//!    interface for non-convex refractors); per pixel, Snell at the front
+//!    (T1), d_V from the back-face depth, d~ by Eq. 6.3.1, p2 = p1 + d~ T1,
+//!    N2 from the back-face normal texture at p2's projection (Eq. 6.3.2
+//!    where the texel is empty), Snell again (T2) with the selected TIR
+//!    remedy; T2 and the Fresnel reflection ray are searched in the opaque
+//!    frame's depth (linear steps, then bisection) and read its radiance:
+//!    L = F1 L_reflected + (1 - F1)(1 - F2) exp(-sigma_a d~) L_behind.
+//!    Mirrors: L = reflectance * L_reflected by the same search.
+//!    The refraction math is glsl/common/image_space_refraction.glsl,
+//!    shared with the caustic photons of `photon_mode` 1 (Wyman: "render
+//!    the specular objects from the light ... with the same code").
+//!
+//! Passes: "shadow maps", "gbuffer", "direct lighting"; "caustic map
+//! clear", per light ("caustic light view" in photon modes 1 and 2)
+//! "caustic photons" and "caustic splat"; "caustic apply"; "refractor
+//! gbuffer"; "refraction" (glsl/image_space/refraction.comp).
+//!
+//! Limits: two interfaces only (light inside the glass is never reflected
+//! again; the remedies stand in for TIR); rays that leave the view or the
+//! scene's bounding sphere read the environment, which is black (scene
+//! files have no background; the reference also gives escaping rays 0);
+//! the search only finds what the camera sees (no surface hidden behind
+//! another or off screen), and a crossing deeper than one search step (plus
+//! a pixel's depth footprint) is taken for a ray passing behind a nearer
+//! object; glass seen through
+//! glass (nested or overlapping refractors) is not refracted twice: the
+//! opaque frame has no specular surfaces.
+
+mod refraction;
+
+pub use refraction::{CameraRefraction, RefractionPush};
+
+use super::direct::Direct;
+use super::{ParamSpec, Params, Technique};
+use crate::passes::caustic_map::{CausticMap, PhotonPaths};
+use crate::passes::gbuffer::GBufferContents;
+use crate::renderer::{FrameTargets, SceneGpu};
+use crate::scene::Scene;
+use crate::shader_bindings as b;
+use crate::vk::{
+    barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    FrameRecorder, ImageAccess, Sampler, VkResult,
+};
+use ash::vk;
+use std::sync::Arc;
+
+pub const PARAMS: &[ParamSpec] = &[
+    ParamSpec {
+        name: "shadow_map_size",
+        description: "shadow map resolution per view (texels per side)",
+        min: 64.0,
+        max: 4096.0,
+        default: 1024.0,
+        integer: true,
+    },
+    ParamSpec {
+        name: "pcf_radius",
+        description: "percentage-closer filter half-width in shadow texels (0: one tap)",
+        min: 0.0,
+        max: 4.0,
+        default: 1.0,
+        integer: true,
+    },
+    ParamSpec {
+        name: "photon_buffer_size",
+        description: "photon buffer resolution (photons per side of the light view)",
+        min: 64.0,
+        max: 1024.0,
+        default: 512.0,
+        integer: true,
+    },
+    ParamSpec {
+        name: "caustic_map_size",
+        description: "caustic map resolution per light view (texels per side)",
+        min: 64.0,
+        max: 1024.0,
+        default: 512.0,
+        integer: true,
+    },
+    ParamSpec {
+        name: "splat_size",
+        description: "photon splat width in caustic-map texels (odd; an even value is raised by 1)",
+        min: 1.0,
+        max: 15.0,
+        default: 7.0,
+        integer: true,
+    },
+    ParamSpec {
+        name: "photon_mode",
+        description: "0: photon paths traced exactly through the BVH; 1: Wyman's two-sided image-space refraction from light-space front/back G-buffers (Eq. 6.3.1 distance); 2: the same G-buffers, the refracted ray marched against the back-face map (exact for convex objects)",
+        min: 0.0,
+        max: 2.0,
+        default: 0.0,
+        integer: true,
+    },
+    ParamSpec {
+        name: "tir_remedy",
+        description: "total internal reflection at the approximated exit (Wyman 2006's ad hoc remedies; camera and photon_mode 1): 0 single refraction (T2 = T1), 1 clamp to the critical angle (T2 tangent to the back face), 2 reflect and ignore the refractor. Default 1, of the two Wyman recommends (the first 'behaves poorly in dynamic scenes'): a reflected ray heads back toward the camera or the light, where the image-space search has no data and photons fly up past the light, while the clamped ray goes on through, as the light does on average",
+        min: 0.0,
+        max: 2.0,
+        default: 1.0,
+        integer: true,
+    },
+    ParamSpec {
+        name: "eq_6_3_2",
+        description: "1: where d~ overshoots and the back-face texel holds no normal, use Wyman's Eq. 6.3.2 (N2 = T1 - (V.T1) V, the exit through the side); 0: drop the transmitted light there",
+        min: 0.0,
+        max: 1.0,
+        default: 1.0,
+        integer: true,
+    },
+    ParamSpec {
+        name: "search_steps",
+        description: "linear steps of the image-space search of refracted and reflected camera rays against the opaque frame (then 10 bisections)",
+        min: 4.0,
+        max: 256.0,
+        default: 32.0,
+        integer: true,
+    },
+];
+
+pub struct ImageSpace {
+    /// Direct light on the opaque scene (its G-buffer leaves the specular
+    /// surfaces out; they still cast shadows and caustics).
+    pub direct: Direct,
+    pub caustics: CausticMap,
+    /// The opaque frame: direct light + surface caustics without the
+    /// specular surfaces, what the refraction pass looks up.
+    pub opaque: FrameTargets,
+    pub refraction: CameraRefraction,
+    apply: ComputePipeline,
+    set: DescriptorSet,
+    _layout: DescriptorSetLayout,
+    _sampler: Sampler,
+}
+
+impl ImageSpace {
+    pub fn new(
+        ctx: &Arc<Context>,
+        params: &Params,
+        scene: &Scene,
+        scene_gpu: &SceneGpu,
+        width: u32,
+        height: u32,
+    ) -> VkResult<Self> {
+        let direct = Direct::with_contents(
+            ctx,
+            params,
+            scene,
+            scene_gpu,
+            width,
+            height,
+            GBufferContents::Opaque,
+        )?;
+        let opaque = FrameTargets::new(ctx, width, height)?;
+        let tir_remedy = params.get("tir_remedy") as u32;
+        let use_eq632 = params.get("eq_6_3_2") as u32;
+        let caustics = CausticMap::new(
+            ctx,
+            scene,
+            scene_gpu,
+            params.get("photon_buffer_size") as u32,
+            params.get("caustic_map_size") as u32,
+            params.get("splat_size") as u32,
+            PhotonPaths {
+                mode: params.get("photon_mode") as u32,
+                tir_remedy,
+                use_eq632: use_eq632 != 0,
+            },
+        )?;
+        let layout = DescriptorSetLayout::new(
+            ctx,
+            &[
+                (b::CAUSTIC_BINDING_VIEWS, BindingKind::Uniform),
+                (b::CAUSTIC_BINDING_MAP, BindingKind::Sampled),
+                (b::CAUSTIC_BINDING_POSITION, BindingKind::StorageImage),
+                (b::CAUSTIC_BINDING_NORMAL, BindingKind::StorageImage),
+                (b::CAUSTIC_BINDING_RADIANCE, BindingKind::StorageImage),
+            ],
+        )?;
+        let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
+        let set = DescriptorSet::new(ctx, &layout)?;
+        set.write_buffer(b::CAUSTIC_BINDING_VIEWS, &caustics.views)
+            .write_sampled_image(
+                b::CAUSTIC_BINDING_MAP,
+                &caustics.map,
+                &sampler,
+                vk::ImageLayout::GENERAL,
+            )
+            .write_storage_image(b::CAUSTIC_BINDING_POSITION, &direct.gbuffer.position)
+            .write_storage_image(b::CAUSTIC_BINDING_NORMAL, &direct.gbuffer.normal)
+            .write_storage_image(b::CAUSTIC_BINDING_RADIANCE, &opaque.radiance);
+        let apply = ComputePipeline::new(
+            ctx,
+            "caustic_map/apply.comp",
+            &[&scene_gpu.layout, &layout],
+            4,
+        )?;
+        let refraction = CameraRefraction::new(
+            ctx,
+            scene_gpu,
+            &opaque.radiance,
+            &direct.gbuffer,
+            RefractionPush {
+                tir_remedy,
+                use_eq632,
+                search_steps: params.get("search_steps") as u32,
+                pad: 0,
+            },
+        )?;
+        Ok(Self {
+            direct,
+            caustics,
+            opaque,
+            refraction,
+            apply,
+            set,
+            _layout: layout,
+            _sampler: sampler,
+        })
+    }
+}
+
+impl Technique for ImageSpace {
+    fn name(&self) -> &'static str {
+        "image_space"
+    }
+
+    fn record(
+        &mut self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        targets: &FrameTargets,
+    ) -> VkResult<()> {
+        self.direct.record(rec, scene, &self.opaque)?;
+        self.caustics.record(rec, scene)?;
+        let ctx = rec.ctx().clone();
+        let light_count = self.caustics.light_count();
+        rec.pass("caustic apply", |cmd| {
+            // The splats' attachment writes and the direct pass's radiance
+            // writes must be visible to this read-modify-write.
+            barrier(
+                &ctx,
+                cmd,
+                &[
+                    ImageAccess::new(&self.caustics.map, Access::ComputeRead),
+                    ImageAccess::new(&self.direct.gbuffer.position, Access::ComputeRead),
+                    ImageAccess::new(&self.direct.gbuffer.normal, Access::ComputeRead),
+                    ImageAccess::new(&self.opaque.radiance, Access::ComputeWrite),
+                ],
+                &[],
+            );
+            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
+            self.apply.dispatch(
+                cmd,
+                &[&scene.set, &self.set],
+                bytemuck::bytes_of(&light_count),
+                groups,
+            );
+        });
+        self.refraction.record(
+            rec,
+            scene,
+            &self.opaque.radiance,
+            &self.direct.gbuffer,
+            targets,
+        );
+        Ok(())
+    }
+}

@@ -1,0 +1,160 @@
+//! What the camera sees in the specular objects: Wyman 2005-06 two-sided
+//! image-space refraction (and mirror reflection) over the opaque frame.
+//! "refractor gbuffer": the camera's specular G-buffer
+//! (`passes::specular_gbuffer`: nearest front faces with d_N, farthest back
+//! faces); "refraction" (glsl/image_space/refraction.comp): per pixel,
+//! Fresnel-weighted reflection plus the twice-refracted ray, each found in
+//! the opaque frame by an image-space search, into the frame's radiance.
+
+use crate::passes::gbuffer::GBuffer;
+use crate::passes::specular_gbuffer::{SpecularGBuffer, Viewpoint};
+use crate::renderer::{FrameTargets, SceneGpu};
+use crate::shader_bindings as b;
+use crate::vk::{
+    barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    FrameRecorder, Image, ImageAccess, VkResult,
+};
+use ash::vk;
+use bytemuck::{Pod, Zeroable};
+use std::sync::Arc;
+
+/// Push constants of glsl/image_space/refraction.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct RefractionPush {
+    /// `TIR_*`.
+    pub tir_remedy: u32,
+    /// 1: Eq. 6.3.2 where the back-face texel holds no normal.
+    pub use_eq632: u32,
+    /// Linear steps of the image-space search.
+    pub search_steps: u32,
+    pub pad: u32,
+}
+
+pub struct CameraRefraction {
+    pub gbuffer: SpecularGBuffer,
+    push: RefractionPush,
+    pipeline: ComputePipeline,
+    set: DescriptorSet,
+    bound_radiance: vk::ImageView,
+    _layout: DescriptorSetLayout,
+}
+
+impl CameraRefraction {
+    /// `opaque` is the frame of the scene without its specular surfaces and
+    /// `opaque_gbuffer` its G-buffer (positions: the depth image searched).
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene_gpu: &SceneGpu,
+        opaque: &Image,
+        opaque_gbuffer: &GBuffer,
+        push: RefractionPush,
+    ) -> VkResult<Self> {
+        let extent = opaque.extent();
+        let gbuffer = SpecularGBuffer::new(ctx, &scene_gpu.layout, extent.width, extent.height)?;
+        let layout = DescriptorSetLayout::new(
+            ctx,
+            &[
+                (
+                    b::REFRACTION_BINDING_OPAQUE_RADIANCE,
+                    BindingKind::StorageImage,
+                ),
+                (
+                    b::REFRACTION_BINDING_OPAQUE_POSITION,
+                    BindingKind::StorageImage,
+                ),
+                (
+                    b::REFRACTION_BINDING_FRONT_POSITION,
+                    BindingKind::StorageImage,
+                ),
+                (
+                    b::REFRACTION_BINDING_FRONT_NORMAL,
+                    BindingKind::StorageImage,
+                ),
+                (
+                    b::REFRACTION_BINDING_BACK_POSITION,
+                    BindingKind::StorageImage,
+                ),
+                (b::REFRACTION_BINDING_BACK_NORMAL, BindingKind::StorageImage),
+                (b::REFRACTION_BINDING_RADIANCE, BindingKind::StorageImage),
+            ],
+        )?;
+        let set = DescriptorSet::new(ctx, &layout)?;
+        set.write_storage_image(b::REFRACTION_BINDING_OPAQUE_RADIANCE, opaque)
+            .write_storage_image(
+                b::REFRACTION_BINDING_OPAQUE_POSITION,
+                &opaque_gbuffer.position,
+            )
+            .write_storage_image(
+                b::REFRACTION_BINDING_FRONT_POSITION,
+                &gbuffer.front_position,
+            )
+            .write_storage_image(b::REFRACTION_BINDING_FRONT_NORMAL, &gbuffer.front_normal)
+            .write_storage_image(b::REFRACTION_BINDING_BACK_POSITION, &gbuffer.back_position)
+            .write_storage_image(b::REFRACTION_BINDING_BACK_NORMAL, &gbuffer.back_normal);
+        let pipeline = ComputePipeline::new(
+            ctx,
+            "image_space/refraction.comp",
+            &[&scene_gpu.layout, &layout],
+            std::mem::size_of::<RefractionPush>() as u32,
+        )?;
+        Ok(Self {
+            gbuffer,
+            push,
+            pipeline,
+            set,
+            bound_radiance: vk::ImageView::null(),
+            _layout: layout,
+        })
+    }
+
+    /// Records "refractor gbuffer" and "refraction": reads `opaque` (all of
+    /// it written by earlier passes) and `opaque_gbuffer`, writes every
+    /// pixel of `targets.radiance`.
+    pub fn record(
+        &mut self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        opaque: &Image,
+        opaque_gbuffer: &GBuffer,
+        targets: &FrameTargets,
+    ) {
+        if self.bound_radiance != targets.radiance.view {
+            // Legal: the renderer waits for every frame before the next.
+            self.set
+                .write_storage_image(b::REFRACTION_BINDING_RADIANCE, &targets.radiance);
+            self.bound_radiance = targets.radiance.view;
+        }
+        let ctx = rec.ctx().clone();
+        rec.pass("refractor gbuffer", |cmd| {
+            self.gbuffer.draw(&ctx, cmd, scene, &Viewpoint::Camera);
+        });
+        rec.pass("refraction", |cmd| {
+            // The specular G-buffer's attachment writes and the opaque
+            // frame's compute writes (caustic apply) must be visible; the
+            // output is overwritten entirely after last frame's readers.
+            let [a, b_, c, d] = self.gbuffer.compute_reads();
+            barrier(
+                &ctx,
+                cmd,
+                &[
+                    a,
+                    b_,
+                    c,
+                    d,
+                    ImageAccess::new(opaque, Access::ComputeRead),
+                    ImageAccess::new(&opaque_gbuffer.position, Access::ComputeRead),
+                    ImageAccess::discard(&targets.radiance, Access::ComputeWrite),
+                ],
+                &[],
+            );
+            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
+            self.pipeline.dispatch(
+                cmd,
+                &[&scene.set, &self.set],
+                bytemuck::bytes_of(&self.push),
+                groups,
+            );
+        });
+    }
+}
