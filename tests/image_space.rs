@@ -585,3 +585,96 @@ fn ball_lens_caustic_energy_matches_reference() {
     }
     assert_validation_clean(&ctx);
 }
+
+/// `caustics_on_change=1` on assets/scenes/gemstone.toml (animated: the gem
+/// spins): a frame at an unchanged time skips the photon and splat passes
+/// and gives the same image as recomputing; a new animation time or a moved
+/// light recomputes, and matches a renderer that recomputes every frame.
+#[test]
+fn caustics_on_change_reuses_the_map_until_something_moves() {
+    use caustics::renderer::Renderer;
+    let ctx = validated_context();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/gemstone.toml");
+    let renderer = |on_change: u32| {
+        let overrides = [
+            "photon_buffer_size=128".to_string(),
+            "caustic_map_size=128".to_string(),
+            format!("caustics_on_change={on_change}"),
+        ];
+        let params = Params::resolve("image_space", PARAMS, &overrides).unwrap();
+        Renderer::new(
+            &ctx,
+            Scene::load(&path).unwrap(),
+            "image_space",
+            &params,
+            64,
+            64,
+            0.0,
+        )
+        .unwrap()
+    };
+    let mut cached = renderer(1);
+    let mut every_frame = renderer(0);
+    // Renders both at `time`; checks whether `cached` shot photons and that
+    // its image equals the recomputed one; returns that image.
+    let frame = |cached: &mut Renderer,
+                 every_frame: &mut Renderer,
+                 time: f32,
+                 recomputes: bool,
+                 what: &str| {
+        let shot = |r: &mut Renderer| {
+            r.render_frame(time)
+                .unwrap()
+                .iter()
+                .any(|t| t.name == "caustic photons")
+        };
+        assert_eq!(
+            shot(cached),
+            recomputes,
+            "{what}: caustic photons recorded?"
+        );
+        assert!(shot(every_frame));
+        let (a, b) = (cached.radiance().unwrap(), every_frame.radiance().unwrap());
+        assert_finite(&a);
+        let worst = a
+            .iter()
+            .zip(&b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0f32, f32::max);
+        println!("{what}: photons shot {recomputes}, largest difference from recomputing {worst:e}, energy {:.4}", energy(&a));
+        assert_eq!(a, b, "{what}: image differs from a recomputed caustic map");
+        a
+    };
+    let first = frame(&mut cached, &mut every_frame, 0.0, true, "first frame");
+    frame(
+        &mut cached,
+        &mut every_frame,
+        0.0,
+        false,
+        "same time, nothing moved",
+    );
+    let rotated = frame(
+        &mut cached,
+        &mut every_frame,
+        0.5,
+        true,
+        "gem rotated (time 0.5 s)",
+    );
+    frame(&mut cached, &mut every_frame, 0.5, false, "same time again");
+    for r in [&mut cached, &mut every_frame] {
+        r.scene.lights[0].position += Vec3::new(0.4, 0.0, -0.3);
+        r.lights_changed(0.5).unwrap();
+    }
+    let moved = frame(&mut cached, &mut every_frame, 0.5, true, "light moved");
+    frame(
+        &mut cached,
+        &mut every_frame,
+        0.5,
+        false,
+        "after the move, nothing moved",
+    );
+    // The changes were visible, so a stale map would have failed above.
+    assert_ne!(first, rotated);
+    assert_ne!(rotated, moved);
+    assert_validation_clean(&ctx);
+}

@@ -35,6 +35,9 @@ pub struct SceneGpu {
     pub stats: GeometryStats,
     /// Bounding sphere (centre, radius) of the scene at the uploaded time.
     pub sphere: (Vec3, f32),
+    /// Animation time of the uploaded geometry: techniques that cache
+    /// light-space results (`image_space` with `caustics_on_change`) compare it.
+    pub geometry_time: f32,
     pub triangle_count: u32,
     bvh: Bvh,
 }
@@ -131,6 +134,7 @@ impl SceneGpu {
             set,
             stats,
             sphere,
+            geometry_time: time,
             bvh,
         })
     }
@@ -152,6 +156,7 @@ impl SceneGpu {
         self.bvh_nodes
             .upload(bytemuck::cast_slice(&self.bvh.nodes))?;
         self.sphere = scene.bounding_sphere(time);
+        self.geometry_time = time;
         Ok(())
     }
 

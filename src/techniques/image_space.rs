@@ -7,6 +7,9 @@
 //!
 //! Passes: the `direct` passes; "caustic map clear", per light "caustic
 //! photons" and "caustic splat"; "caustic apply" (glsl/caustic_map/apply.comp).
+//! With `caustics_on_change` = 1 the clear, photon and splat passes run only
+//! when a light moved (`set_lights`) or the geometry's animation time
+//! changed; other frames reuse the last caustic map.
 //! Glass objects seen directly stay black (two-sided image-space refraction
 //! toward the camera is not implemented yet).
 
@@ -72,6 +75,14 @@ pub const PARAMS: &[ParamSpec] = &[
         default: 0.0,
         integer: true,
     },
+    ParamSpec {
+        name: "caustics_on_change",
+        description: "1: recompute the caustic map only when a light moved or animated geometry changed, reusing the last one otherwise; 0: every frame (benchmarks)",
+        min: 0.0,
+        max: 1.0,
+        default: 0.0,
+        integer: true,
+    },
 ];
 
 pub struct ImageSpace {
@@ -80,6 +91,13 @@ pub struct ImageSpace {
     apply: ComputePipeline,
     set: DescriptorSet,
     bound_radiance: vk::ImageView,
+    /// `caustics_on_change`: reuse the caustic map while nothing it depends
+    /// on moved (Wyman 2006, "Putting it Together": "we only update the
+    /// caustic map after changes to the light or scene geometry").
+    caustics_on_change: bool,
+    /// Geometry time the caustic map was computed for; `None` when it must
+    /// be recomputed (never computed, or a light moved).
+    caustics_geometry_time: Option<f32>,
     _layout: DescriptorSetLayout,
     _sampler: Sampler,
 }
@@ -136,6 +154,8 @@ impl ImageSpace {
             apply,
             set,
             bound_radiance: vk::ImageView::null(),
+            caustics_on_change: params.get("caustics_on_change") != 0.0,
+            caustics_geometry_time: None,
             _layout: layout,
             _sampler: sampler,
         })
@@ -160,7 +180,10 @@ impl Technique for ImageSpace {
             self.bound_radiance = targets.radiance.view;
         }
         self.direct.record(rec, scene, targets)?;
-        self.caustics.record(rec, scene)?;
+        if !self.caustics_on_change || self.caustics_geometry_time != Some(scene.geometry_time) {
+            self.caustics.record(rec, scene)?;
+            self.caustics_geometry_time = Some(scene.geometry_time);
+        }
         let ctx = rec.ctx().clone();
         let light_count = self.caustics.light_count();
         rec.pass("caustic apply", |cmd| {
@@ -186,5 +209,10 @@ impl Technique for ImageSpace {
             );
         });
         Ok(())
+    }
+
+    fn set_lights(&mut self, lights: &[crate::scene::Light]) -> bool {
+        self.caustics_geometry_time = None;
+        self.direct.set_lights(lights) && self.caustics.set_lights(lights)
     }
 }
