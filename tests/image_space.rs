@@ -38,13 +38,35 @@
 //!   unfocused irradiance. Peak irradiance is higher 0.4 m nearer the lens
 //!   (149 W/m²; 20.6 W/m² 0.4 m beyond): at splat resolution the circle of
 //!   least confusion of this strongly aberrated lens gathers more flux.
-//! - ball_lens_caustic_energy_matches_reference (assets/scenes/ball_lens.toml,
-//!   image_space minus direct vs the reference's L S+ D, 8M photons):
-//!   relative energy -2.0% (bound 5%; photon_mode=1 -1.0% and
-//!   photon_mode=2 -2.1%, asserted too): the caustic map keeps one reflected
-//!   and one transmitted chain per photon and drops partial internal
-//!   reflections (T R T ...), which the reference follows. Its 4 bright 8x8
-//!   blocks differ by 3.6% on average, 4.7% at worst.
+//! - *_caustics_match_reference (assets/scenes/{ball_lens,ring,gemstone}.toml
+//!   at 128², time 0, default 512² photons and 512² maps; the caustic image
+//!   image_space minus direct vs the reference's L S+ D, 8M photons, fixed
+//!   seeds; FLIP mean of the two tonemapped images; 24-30 s per scene):
+//!
+//!   | scene | reference halves (4M vs 4M) | photon_mode 0 | 1 | 2 |
+//!   | --- | --- | --- | --- | --- |
+//!   | ball_lens | energy -1.1%, FLIP 0.042 | energy -1.95%, FLIP 0.028 | -0.9%, 0.067 | -2.0%, 0.028 |
+//!   | ring | +0.9%, 0.104 | +0.6%, 0.076 | -38.7%, 0.176 | - |
+//!   | gemstone | -0.4%, 0.026 | -61.3%, 0.105 | +621%, 0.163 | - |
+//!
+//!   ball_lens: the caustic map keeps one reflected and one transmitted
+//!   chain per photon and drops partial internal reflections (T R T ...),
+//!   which the reference follows (-2%). Mode 1's FLIP is higher: the halo
+//!   and dark spots of Eq. 6.3.1 (src/passes/caustic_map.rs).
+//!   ring: mode 0 lies within the reference's own noise (its FLIP against
+//!   the 8M truth is below that of the two 4M halves against each other).
+//!   Mode 1 loses the whole caustic inside the ring: the light-space front
+//!   pass (glsl/caustic_map/lightview.frag) keeps faces whose winding normal
+//!   faces the light, and the ring's inside is the back of the open
+//!   cylinder's faces, so photons hitting it are never shot; only the
+//!   reflections off the outside remain.
+//!   gemstone (diamond, n = 2.42, flat facets): mode 0 has 39% of the
+//!   reference's caustic energy; the reference shows light spread over the
+//!   whole floor in many small facet caustics that the caustic map lacks,
+//!   consistent with (not yet proven to be) the dropped partial internal
+//!   reflections, which are strong in diamond. Mode 1 creates energy (7.2x):
+//!   a bright region around the gem's shadow; not yet understood (Eq. 6.3.1
+//!   assumes two interfaces and smooth normals; a faceted gem has neither).
 
 mod common;
 
@@ -68,7 +90,6 @@ const RADIUS: f32 = 1.0;
 const ALBEDO: f32 = 0.8;
 const SIZE: u32 = 128;
 const PHOTONS_REFERENCE: u64 = 8_000_000;
-const MAX_REFERENCE_ENERGY: f64 = 0.05;
 
 fn ball_scene(ior: Option<f32>, floor_y: f32) -> Scene {
     ball_scene_lit(ior, floor_y, point_light(LIGHT, INTENSITY))
@@ -503,87 +524,169 @@ fn energy(img: &[f32]) -> f64 {
     img.chunks(4).map(|p| (p[0] + p[1] + p[2]) as f64).sum()
 }
 
-/// The caustic component (image_space minus direct) on assets/scenes/ball_lens.toml
-/// against the reference's L S+ D component: relative total energy.
-#[test]
-fn ball_lens_caustic_energy_matches_reference() {
+/// The bound of one photon mode against the reference on one scene.
+struct Bound {
+    photon_mode: u32,
+    /// |relative total energy| of the caustic image.
+    energy: f64,
+    /// FLIP mean of the tonemapped caustic image.
+    flip: f32,
+}
+
+/// The caustic image of `image_space` (its frame minus the `direct` frame:
+/// L S+ D on diffuse receivers) on assets/scenes/`name`.toml at SIZE² and
+/// time 0, against the reference's L S+ D component (`photons` photons)
+/// with the same camera: relative total energy and FLIP mean of the two
+/// tonemapped images, for each photon mode in `bounds` (passed explicitly,
+/// so a change of the default keeps every mode measured). Pixels showing a
+/// specular object read 0 in both (glass stays black in `image_space`, and
+/// the light tracer cannot connect through it) and stay in the FLIP mean.
+fn caustics_match_reference(name: &str, photons: u64, bounds: &[Bound]) {
     use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
     use caustics::renderer::Renderer;
     let ctx = validated_context();
-    let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/ball_lens.toml");
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("assets/scenes")
+        .join(format!("{name}.toml"));
     let load = || Scene::load(&path).unwrap();
-    let frame = |name: &str, overrides: &[String]| {
+    let frame = |technique: &str, overrides: &[String]| {
         let params = Params::resolve(
-            name,
-            caustics::techniques::find(name).unwrap().params,
+            technique,
+            caustics::techniques::find(technique).unwrap().params,
             overrides,
         )
         .unwrap();
-        let mut r = Renderer::new(&ctx, load(), name, &params, SIZE, SIZE, 0.0).unwrap();
+        let mut r = Renderer::new(&ctx, load(), technique, &params, SIZE, SIZE, 0.0).unwrap();
         r.render_frame(0.0).unwrap();
         r.radiance().unwrap()
     };
-    let direct = frame("direct", &[]);
-    let full = frame("image_space", &[]);
-    let caustic: Vec<f32> = full.iter().zip(&direct).map(|(a, b)| a - b).collect();
     let mut reference =
         ReferenceRenderer::new(&ctx, load(), SIZE, SIZE, 0.0, ReferenceSettings::default())
             .unwrap();
-    reference.trace(PHOTONS_REFERENCE, |_, _| {}).unwrap();
+    // Two halves, to measure the reference's own noise in FLIP terms.
+    reference.trace(photons / 2, |_, _| {}).unwrap();
+    let half_a = reference.resolve(Component::SurfaceCaustics).unwrap();
+    reference.trace(photons / 2, |_, _| {}).unwrap();
     let truth = reference.resolve(Component::SurfaceCaustics).unwrap();
-    let (e, t) = (energy(&caustic), energy(&truth));
-    let rel = (e - t) / t;
+    let half_b: Vec<f32> = truth
+        .iter()
+        .zip(&half_a)
+        .map(|(t, a)| 2.0 * t - a)
+        .collect();
+    let (noise_flip, _) = flip(&tonemap(&half_b), &tonemap(&half_a), SIZE);
+    let truth_ldr = tonemap(&truth);
+    let t = energy(&truth);
+    let halves = (energy(&half_b) - energy(&half_a)) / t;
     println!(
-        "ball_lens caustic energy: image_space {e:.2}, reference L S+ D {t:.2} ({} M photons), relative {rel:+.4}",
+        "{name}: reference L S+ D energy {t:.2} ({} M photons); its two halves differ by {halves:+.4} in energy, {noise_flip:.4} in FLIP mean",
         reference.reference.photons / 1_000_000
     );
-    // Where the light lands: 8x8 block sums over the blocks holding at
-    // least 5% of the brightest block (printed, not asserted).
-    let block = |img: &[f32], bx: u32, by: u32| {
-        let mut sum = 0.0f64;
-        for y in by * 8..by * 8 + 8 {
-            for x in bx * 8..bx * 8 + 8 {
-                let i = ((y * SIZE + x) * 4) as usize;
-                sum += (img[i] + img[i + 1] + img[i + 2]) as f64;
-            }
-        }
-        sum
-    };
-    let nb = SIZE / 8;
-    let blocks: Vec<(f64, f64)> = (0..nb * nb)
-        .map(|k| {
-            (
-                block(&caustic, k % nb, k / nb),
-                block(&truth, k % nb, k / nb),
-            )
-        })
-        .collect();
-    let top = blocks.iter().map(|b| b.1).fold(0.0, f64::max);
-    let bright: Vec<f64> = blocks
-        .iter()
-        .filter(|b| b.1 > 0.05 * top)
-        .map(|b| (b.0 - b.1).abs() / b.1)
-        .collect();
-    println!(
-        "{} bright 8x8 blocks: mean relative difference {:.3}, worst {:.3}",
-        bright.len(),
-        bright.iter().sum::<f64>() / bright.len() as f64,
-        bright.iter().cloned().fold(0.0, f64::max)
-    );
-    assert!(rel.abs() < MAX_REFERENCE_ENERGY, "relative energy {rel}");
-    // The light-space (image-space) photon modes against the same truth.
-    for mode in [1, 2] {
-        let img = frame("image_space", &[format!("photon_mode={mode}")]);
-        let c: f64 = energy(&img) - energy(&direct);
-        let rel_m = (c - t) / t;
-        println!("photon_mode={mode}: caustic energy {c:.2}, relative {rel_m:+.4}");
-        assert!(
-            rel_m.abs() < MAX_REFERENCE_ENERGY,
-            "photon_mode={mode}: {rel_m}"
+    assert!(t > 0.0, "{name}: the reference has no caustic");
+    drop(reference);
+    let direct = frame("direct", &[]);
+    let mut failures = Vec::new();
+    for bound in bounds {
+        let mode = bound.photon_mode;
+        let full = frame("image_space", &[format!("photon_mode={mode}")]);
+        assert_finite(&full);
+        let caustic: Vec<f32> = full.iter().zip(&direct).map(|(a, b)| a - b).collect();
+        let rel = (energy(&caustic) - t) / t;
+        let caustic_ldr = tonemap(&caustic);
+        let (flip_mean, flip_map) = flip(&caustic_ldr, &truth_ldr, SIZE);
+        println!(
+            "{name}, photon_mode={mode}: caustic energy {:.2}, relative {rel:+.4} (bound {}); FLIP mean {flip_mean:.4} (bound {})",
+            energy(&caustic),
+            bound.energy,
+            bound.flip
         );
+        if rel.abs() >= bound.energy || flip_mean >= bound.flip {
+            let dir = write_comparison_pngs(
+                &format!("image_space_{name}_mode{mode}"),
+                SIZE,
+                &caustic_ldr,
+                &truth_ldr,
+                &flip_map,
+            );
+            failures.push(format!(
+                "photon_mode={mode}: relative energy {rel:+.4}, FLIP mean {flip_mean:.4} (images in {dir})"
+            ));
+        }
     }
+    assert!(failures.is_empty(), "{name}: {}", failures.join("; "));
     assert_validation_clean(&ctx);
+}
+
+// Bounds of the three comparisons: measured (see the file's header) plus a
+// margin: energy |measured| + 0.02, FLIP mean 1.25 x measured, each rounded
+// up to 0.005. The reference's seeds are fixed, so a rerun on lavapipe
+// repeats the measurement; the margin covers other drivers' rounding and
+// float-atomic order (the reference's two halves differ by up to 1% in
+// energy). Bounds far above the others record known defects (ring and
+// gemstone, photon_mode=1; gemstone, photon_mode=0), so that they cannot
+// grow unnoticed; fixing one should lower its bound.
+#[test]
+fn ball_lens_caustics_match_reference() {
+    caustics_match_reference(
+        "ball_lens",
+        PHOTONS_REFERENCE,
+        &[
+            Bound {
+                photon_mode: 0,
+                energy: 0.04,
+                flip: 0.036,
+            },
+            Bound {
+                photon_mode: 1,
+                energy: 0.03,
+                flip: 0.085,
+            },
+            Bound {
+                photon_mode: 2,
+                energy: 0.04,
+                flip: 0.036,
+            },
+        ],
+    );
+}
+
+#[test]
+fn ring_caustics_match_reference() {
+    caustics_match_reference(
+        "ring",
+        PHOTONS_REFERENCE,
+        &[
+            Bound {
+                photon_mode: 0,
+                energy: 0.03,
+                flip: 0.1,
+            },
+            Bound {
+                photon_mode: 1,
+                energy: 0.41,
+                flip: 0.225,
+            },
+        ],
+    );
+}
+
+#[test]
+fn gemstone_caustics_match_reference() {
+    caustics_match_reference(
+        "gemstone",
+        PHOTONS_REFERENCE,
+        &[
+            Bound {
+                photon_mode: 0,
+                energy: 0.635,
+                flip: 0.135,
+            },
+            Bound {
+                photon_mode: 1,
+                energy: 6.235,
+                flip: 0.205,
+            },
+        ],
+    );
 }
 
 /// `caustics_on_change=1` on assets/scenes/gemstone.toml (animated: the gem
