@@ -1,31 +1,73 @@
 #!/usr/bin/env bash
 # Reproduces the tables of BENCHMARKS.md on this machine's default Vulkan
-# device (set VK_DRIVER_FILES to pick lavapipe): the `direct` base frame per
-# pass at 512^2 and 1024^2, reference photons per second, BVH build time and
-# size per canonical scene. JSON goes to out/bench/.
+# device (set VK_DRIVER_FILES to pick lavapipe). JSON goes to out/bench/.
+#   scripts/bench.sh               every section below
+#   scripts/bench.sh SECTION...    only those: direct, reference, geometry,
+#                                  image_space
+# direct: the base frame per pass at 512^2 and 1024^2; reference: photons per
+# second; geometry: BVH build time and size per canonical scene; image_space:
+# caustic-map passes over photon buffers 64^2/256^2/1024^2, caustic maps
+# 128^2/512^2 and screens 512^2/1024^2 on ball_lens (Wyman's Figs. 6.3.7-8
+# sweep). FRAMES (10) and PHOTONS (2e7) set the effort.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+sections=("$@")
+[ ${#sections[@]} -eq 0 ] && sections=(direct reference geometry image_space)
+wants() { [[ " ${sections[*]} " == *" $1 "* ]]; }
 cargo build --release --quiet
 bin=target/release/caustics
 mkdir -p out/bench
-$bin info | head -1
+$bin info | sed -n 1p  # sed reads everything: no broken pipe under pipefail
 
-for size in 512 1024; do
-  $bin bench --scene assets/scenes/ball_lens.toml --technique direct --width $size --height $size \
-    --frames ${FRAMES:-10} --warmup 2 --json out/bench/direct_ball_lens_$size.json
-done
+if wants direct; then
+  for size in 512 1024; do
+    $bin bench --scene assets/scenes/ball_lens.toml --technique direct --width $size --height $size \
+      --frames ${FRAMES:-10} --warmup 2 --json out/bench/direct_ball_lens_$size.json
+  done
+fi
 
-for scene in ball_lens ring volume_cone; do
-  $bin reference --scene assets/scenes/$scene.toml --width 256 --height 256 --photons ${PHOTONS:-20000000} \
-    --out out/bench/reference_$scene.png | grep photons
-done
+if wants reference; then
+  for scene in ball_lens ring volume_cone; do
+    $bin reference --scene assets/scenes/$scene.toml --width 256 --height 256 --photons ${PHOTONS:-20000000} \
+      --out out/bench/reference_$scene.png | grep photons
+  done
+fi
 
-for scene in assets/scenes/*.toml; do
-  $bin bench --scene "$scene" --technique direct --width 64 --height 64 --frames 1 --warmup 0 \
-    --json out/bench/geometry_$(basename "$scene" .toml).json > /dev/null
-  python3 - "$scene" out/bench/geometry_$(basename "$scene" .toml).json <<'PY'
+if wants geometry; then
+  for scene in assets/scenes/*.toml; do
+    $bin bench --scene "$scene" --technique direct --width 64 --height 64 --frames 1 --warmup 0 \
+      --json out/bench/geometry_$(basename "$scene" .toml).json > /dev/null
+    python3 - "$scene" out/bench/geometry_$(basename "$scene" .toml).json <<'PY'
 import json, sys
 g = json.load(open(sys.argv[2]))["geometry"]
 print(f"{sys.argv[1]}: {g['triangles']} triangles, {g['bvh_nodes']} nodes, {g['bvh_leaves']} leaves, depth {g['bvh_depth']}, {g['bvh_build_ms']:.2f} ms")
 PY
-done
+  done
+fi
+
+if wants image_space; then
+  # caustics_on_change stays 0 (its default): every frame recomputes the map.
+  echo "| screen | photons | caustic map | caustic photons | caustic splat | caustic apply | caustic total | frame |"
+  echo "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+  for size in 512 1024; do
+    for photons in 64 256 1024; do
+      for map in 128 512; do
+        json=out/bench/image_space_ball_lens_${size}_p${photons}_m${map}.json
+        $bin bench --scene assets/scenes/ball_lens.toml --technique image_space \
+          --param photon_buffer_size=$photons --param caustic_map_size=$map \
+          --width $size --height $size --frames ${FRAMES:-10} --warmup 2 --json $json \
+          > /dev/null 2> ${json%.json}.log || { cat ${json%.json}.log; exit 1; }
+        python3 - $json <<'PY'
+import json, sys
+b = json.load(open(sys.argv[1]))
+ms = {p["name"]: p["ms"] for p in b["passes_ms"]}
+caustic = ["caustic map clear", "caustic photons", "caustic splat", "caustic apply"]
+p, m = int(b["params"]["photon_buffer_size"]), int(b["params"]["caustic_map_size"])
+cells = [f"{ms[n]:.1f}" for n in caustic[1:]]
+print(f"| {b['width']}x{b['height']} | {p}² | {m}² | " + " | ".join(cells)
+      + f" | {sum(ms[n] for n in caustic):.1f} | {b['frame_ms']:.1f} |")
+PY
+      done
+    done
+  done
+fi

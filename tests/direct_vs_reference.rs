@@ -72,35 +72,6 @@ fn sum_rgb(img: &[f32], i: usize) -> f64 {
     (img[i * 4] + img[i * 4 + 1] + img[i * 4 + 2]) as f64
 }
 
-fn rgb8(rgba: &[u8]) -> Vec<u8> {
-    rgba.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect()
-}
-
-/// glsl/common/tonemap.glsl on the CPU: exposure 1, Reinhard, sRGB, 8 bits.
-fn tonemap(rgba: &[f32]) -> Vec<u8> {
-    let encode = |l: f32| {
-        let x = l.max(0.0);
-        let x = x / (1.0 + x);
-        let s = if x <= 0.0031308 {
-            x * 12.92
-        } else {
-            1.055 * x.powf(1.0 / 2.4) - 0.055
-        };
-        (s.clamp(0.0, 1.0) * 255.0).round() as u8
-    };
-    rgba.chunks(4)
-        .flat_map(|p| [encode(p[0]), encode(p[1]), encode(p[2]), 255])
-        .collect()
-}
-
-/// FLIP mean error of `test` against `reference` (8-bit RGBA) and the error map.
-fn flip(test: &[u8], reference: &[u8]) -> (f32, nv_flip::FlipImageFloat) {
-    let t = nv_flip::FlipImageRgb8::with_data(SIZE, SIZE, &rgb8(test));
-    let r = nv_flip::FlipImageRgb8::with_data(SIZE, SIZE, &rgb8(reference));
-    let map = nv_flip::flip(r, t, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
-    (nv_flip::FlipPool::from_image(&map).mean(), map)
-}
-
 /// Pixels away from discontinuities of the noise-free `direct` image.
 fn smooth_mask(img: &[f32]) -> Vec<bool> {
     let s = SIZE as i32;
@@ -171,22 +142,6 @@ fn load() -> Scene {
     Scene::load(Path::new("assets/scenes/diffuse_room.toml")).unwrap()
 }
 
-fn write_pngs(actual: &[u8], reference: &[u8], flip_map: &nv_flip::FlipImageFloat) -> String {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("test-output");
-    std::fs::create_dir_all(&dir).unwrap();
-    let save = |name: &str, rgb: &[u8]| {
-        let path = dir.join(format!("direct_vs_reference_{name}.png"));
-        image::save_buffer(&path, rgb, SIZE, SIZE, image::ExtendedColorType::Rgb8).unwrap();
-    };
-    save("actual", &rgb8(actual));
-    save("reference", &rgb8(reference));
-    save(
-        "difference",
-        &flip_map.apply_color_lut(&nv_flip::magma_lut()).to_vec(),
-    );
-    dir.display().to_string()
-}
-
 #[test]
 fn direct_matches_reference_direct_component() {
     let start = std::time::Instant::now();
@@ -231,7 +186,7 @@ fn direct_matches_reference_direct_component() {
         .zip(&half_a)
         .map(|(t, a)| 2.0 * t - a)
         .collect();
-    let (noise_flip, _) = flip(&tonemap(&half_b), &tonemap(&half_a));
+    let (noise_flip, _) = flip(&tonemap(&half_b), &tonemap(&half_a), SIZE);
 
     let n = (SIZE * SIZE) as usize;
     let sum_a: f64 = (0..n).map(|i| sum_rgb(&actual, i)).sum();
@@ -240,7 +195,7 @@ fn direct_matches_reference_direct_component() {
     let mask = smooth_mask(&actual);
     let blocks = block_errors(&actual, &truth, &mask);
     let all_blocks = block_errors(&actual, &truth, &vec![true; n]);
-    let (flip_mean, flip_map) = flip(&actual_ldr, &truth_ldr);
+    let (flip_mean, flip_map) = flip(&actual_ldr, &truth_ldr, SIZE);
     eprintln!(
         "reference: {}M photons in {trace_s:.1} s; Σ direct {sum_a:.1}, Σ reference {sum_r:.1}",
         photons / 1_000_000
@@ -283,7 +238,13 @@ fn direct_matches_reference_direct_component() {
         failures.push(format!("FLIP mean {flip_mean:.4} >= {MAX_FLIP_MEAN}"));
     }
     if !failures.is_empty() {
-        let dir = write_pngs(&actual_ldr, &truth_ldr, &flip_map);
+        let dir = write_comparison_pngs(
+            "direct_vs_reference",
+            SIZE,
+            &actual_ldr,
+            &truth_ldr,
+            &flip_map,
+        );
         panic!(
             "direct differs from the reference: {}; images in {dir}",
             failures.join("; ")

@@ -40,15 +40,46 @@
 //!   unfocused irradiance. Peak irradiance is higher 0.4 m nearer the lens
 //!   (149 W/m²; 20.6 W/m² 0.4 m beyond): at splat resolution the circle of
 //!   least confusion of this strongly aberrated lens gathers more flux.
-//! - ball_lens_caustic_energy_matches_reference (assets/scenes/ball_lens.toml,
-//!   image_space minus direct vs the reference's L S+ D, 8M photons):
-//!   relative energy -2.0% (bound 5%; photon_mode=1 -0.9% and
-//!   photon_mode=2 -2.1%, asserted too), over the pixels whose camera ray
-//!   meets a diffuse surface first (the glass shows L S+ D S+ E paths,
-//!   which the reference does not estimate): the caustic map keeps one reflected
-//!   and one transmitted chain per photon and drops partial internal
-//!   reflections (T R T ...), which the reference follows. Its 4 bright 8x8
-//!   blocks differ by 3.6% on average, 4.7% at worst.
+//! - *_caustics_match_reference (assets/scenes/{ball_lens,ring,gemstone}.toml
+//!   at 128², time 0, default 512² photons and 512² maps; the caustic image
+//!   image_space minus direct vs the reference's L S+ D, 8M photons, fixed
+//!   seeds; FLIP mean of the two tonemapped images; 24-30 s per scene):
+//!
+//!   | scene | reference halves (4M vs 4M) | photon_mode 0 | 1 | 2 |
+//!   | --- | --- | --- | --- | --- |
+//!   | ball_lens | energy -1.1%, FLIP 0.042 | energy -1.95%, FLIP 0.028 | -0.9%, 0.067 | -2.0%, 0.028 |
+//!   | ring | +1.0%, 0.104 | +1.3%, 0.076 | +1.3%, 0.076 | - |
+//!   | gemstone | -0.4%, 0.026 | -61.1%, 0.105 | +633%, 0.162 | - |
+//!
+//!   ball_lens: the caustic map keeps one reflected and one transmitted
+//!   chain per photon and drops partial internal reflections (T R T ...),
+//!   which the reference follows (-2%). Mode 1's FLIP is higher: the halo
+//!   and dark spots of Eq. 6.3.1 (src/passes/caustic_map.rs).
+//!   ring: mode 0 lies within the reference's own noise (its FLIP against
+//!   the 8M truth is below that of the two 4M halves against each other).
+//!   Mode 1 matches mode 0 since the light-space front pass
+//!   (passes::specular_gbuffer) keeps mirror faces seen from either side
+//!   (before, the inside of the open cylinder, the back of its faces, was
+//!   culled and mode 1 lost the caustic inside the ring: -38.7%).
+//!   gemstone (diamond, n = 2.42, flat facets): mode 0 has 39% of the
+//!   reference's caustic energy; the reference shows light spread over the
+//!   whole floor in many small facet caustics that the caustic map lacks,
+//!   consistent with (not yet proven to be) the dropped partial internal
+//!   reflections, which are strong in diamond. Mode 1 creates energy (7.2x):
+//!   a bright region around the gem's shadow; not yet understood (Eq. 6.3.1
+//!   assumes two interfaces and smooth normals; a faceted gem has neither).
+//! - mirror_ring_cardioid_cusp (512² photons, 512² map, 3² splats,
+//!   directional light at elevation atan 1/2 on a 1 m mirror ring of
+//!   reflectance 0.9): reflected flux landing inside the ring 2.2994 W vs
+//!   2.3002 W from the analytic cylinder (-3.4e-4; bound 1%); brightest
+//!   caustic texel at (0.528, -0.004) m vs the cusp (0.5, 0): off by
+//!   (+2.8, -0.4) cm, tolerance (3.8, 1.7) cm (splat half-width + half a
+//!   texel of floor footprint). The peak sits on the wall's side of the cusp,
+//!   where the nephroid's two branches and the three-ray region blur in.
+//! - caustics_on_change_reuses_the_map_until_something_moves (gemstone,
+//!   64², 128² photons and map): frames at an unchanged time record no
+//!   photon pass and are bit-identical to recomputing; a new time and a
+//!   moved light recompute (bit-identical too).
 
 mod common;
 
@@ -72,7 +103,6 @@ const RADIUS: f32 = 1.0;
 const ALBEDO: f32 = 0.8;
 const SIZE: u32 = 128;
 const PHOTONS_REFERENCE: u64 = 8_000_000;
-const MAX_REFERENCE_ENERGY: f64 = 0.05;
 
 fn ball_scene(ior: Option<f32>, floor_y: f32) -> Scene {
     ball_scene_lit(ior, floor_y, point_light(LIGHT, INTENSITY))
@@ -528,31 +558,44 @@ fn energy(img: &[f32]) -> f64 {
     img.chunks(4).map(|p| (p[0] + p[1] + p[2]) as f64).sum()
 }
 
-/// The caustic component (image_space minus direct) on assets/scenes/ball_lens.toml
-/// against the reference's L S+ D component: relative total energy.
-#[test]
-fn ball_lens_caustic_energy_matches_reference() {
+/// The bound of one photon mode against the reference on one scene.
+struct Bound {
+    photon_mode: u32,
+    /// |relative total energy| of the caustic image.
+    energy: f64,
+    /// FLIP mean of the tonemapped caustic image.
+    flip: f32,
+}
+
+/// The caustic image of `image_space` (its frame minus the `direct` frame:
+/// L S+ D on diffuse receivers) on assets/scenes/`name`.toml at SIZE² and
+/// time 0, against the reference's L S+ D component (`photons` photons)
+/// with the same camera: relative total energy and FLIP mean of the two
+/// tonemapped images, for each photon mode in `bounds` (passed explicitly,
+/// so a change of the default keeps every mode measured). Only pixels whose
+/// camera ray meets a diffuse surface first are compared: through the
+/// glass `image_space` shows L S+ D S+ E paths, which the reference does
+/// not estimate (docs/ARCHITECTURE.md, "What the ground truth does not
+/// cover"); the others read 0 in both images and stay in the FLIP mean.
+fn caustics_match_reference(name: &str, photons: u64, bounds: &[Bound]) {
     use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
     use caustics::renderer::Renderer;
     let ctx = validated_context();
-    let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/ball_lens.toml");
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("assets/scenes")
+        .join(format!("{name}.toml"));
     let load = || Scene::load(&path).unwrap();
-    let frame = |name: &str, overrides: &[String]| {
+    let frame = |technique: &str, overrides: &[String]| {
         let params = Params::resolve(
-            name,
-            caustics::techniques::find(name).unwrap().params,
+            technique,
+            caustics::techniques::find(technique).unwrap().params,
             overrides,
         )
         .unwrap();
-        let mut r = Renderer::new(&ctx, load(), name, &params, SIZE, SIZE, 0.0).unwrap();
+        let mut r = Renderer::new(&ctx, load(), technique, &params, SIZE, SIZE, 0.0).unwrap();
         r.render_frame(0.0).unwrap();
         r.radiance().unwrap()
     };
-    // image_space also shows what the camera sees through the glass
-    // (L S+ D S+ E, which the reference does not estimate: see "What the
-    // ground truth does not cover" in docs/ARCHITECTURE.md): compare only
-    // pixels whose camera ray meets a diffuse surface first.
     let mask = diffuse_first_mask(&load());
     let masked = |img: Vec<f32>| -> Vec<f32> {
         img.chunks(4)
@@ -566,64 +609,407 @@ fn ball_lens_caustic_energy_matches_reference() {
             })
             .collect()
     };
-    let direct = masked(frame("direct", &[]));
-    let full = masked(frame("image_space", &[]));
-    let caustic: Vec<f32> = full.iter().zip(&direct).map(|(a, b)| a - b).collect();
     let mut reference =
         ReferenceRenderer::new(&ctx, load(), SIZE, SIZE, 0.0, ReferenceSettings::default())
             .unwrap();
-    reference.trace(PHOTONS_REFERENCE, |_, _| {}).unwrap();
+    // Two halves, to measure the reference's own noise in FLIP terms.
+    reference.trace(photons / 2, |_, _| {}).unwrap();
+    let half_a = masked(reference.resolve(Component::SurfaceCaustics).unwrap());
+    reference.trace(photons / 2, |_, _| {}).unwrap();
     let truth = masked(reference.resolve(Component::SurfaceCaustics).unwrap());
-    let (e, t) = (energy(&caustic), energy(&truth));
-    let rel = (e - t) / t;
+    let half_b: Vec<f32> = truth
+        .iter()
+        .zip(&half_a)
+        .map(|(t, a)| 2.0 * t - a)
+        .collect();
+    let (noise_flip, _) = flip(&tonemap(&half_b), &tonemap(&half_a), SIZE);
+    let truth_ldr = tonemap(&truth);
+    let t = energy(&truth);
+    let halves = (energy(&half_b) - energy(&half_a)) / t;
     println!(
-        "ball_lens caustic energy: image_space {e:.2}, reference L S+ D {t:.2} ({} M photons), relative {rel:+.4}",
+        "{name}: reference L S+ D energy {t:.2} ({} M photons); its two halves differ by {halves:+.4} in energy, {noise_flip:.4} in FLIP mean",
         reference.reference.photons / 1_000_000
     );
-    // Where the light lands: 8x8 block sums over the blocks holding at
-    // least 5% of the brightest block (printed, not asserted).
-    let block = |img: &[f32], bx: u32, by: u32| {
-        let mut sum = 0.0f64;
-        for y in by * 8..by * 8 + 8 {
-            for x in bx * 8..bx * 8 + 8 {
-                let i = ((y * SIZE + x) * 4) as usize;
-                sum += (img[i] + img[i + 1] + img[i + 2]) as f64;
+    assert!(t > 0.0, "{name}: the reference has no caustic");
+    drop(reference);
+    let direct = masked(frame("direct", &[]));
+    let mut failures = Vec::new();
+    for bound in bounds {
+        let mode = bound.photon_mode;
+        let full = masked(frame("image_space", &[format!("photon_mode={mode}")]));
+        assert_finite(&full);
+        let caustic: Vec<f32> = full.iter().zip(&direct).map(|(a, b)| a - b).collect();
+        let rel = (energy(&caustic) - t) / t;
+        let caustic_ldr = tonemap(&caustic);
+        let (flip_mean, flip_map) = flip(&caustic_ldr, &truth_ldr, SIZE);
+        println!(
+            "{name}, photon_mode={mode}: caustic energy {:.2}, relative {rel:+.4} (bound {}); FLIP mean {flip_mean:.4} (bound {})",
+            energy(&caustic),
+            bound.energy,
+            bound.flip
+        );
+        if rel.abs() >= bound.energy || flip_mean >= bound.flip {
+            let dir = write_comparison_pngs(
+                &format!("image_space_{name}_mode{mode}"),
+                SIZE,
+                &caustic_ldr,
+                &truth_ldr,
+                &flip_map,
+            );
+            failures.push(format!(
+                "photon_mode={mode}: relative energy {rel:+.4}, FLIP mean {flip_mean:.4} (images in {dir})"
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{name}: {}", failures.join("; "));
+    assert_validation_clean(&ctx);
+}
+
+// Bounds of the three comparisons: measured (see the file's header) plus a
+// margin: energy |measured| + 0.02, FLIP mean 1.25 x measured, each rounded
+// up to 0.005. The reference's seeds are fixed, so a rerun on lavapipe
+// repeats the measurement; the margin covers other drivers' rounding and
+// float-atomic order (the reference's two halves differ by up to 1% in
+// energy). Bounds far above the others record known defects (gemstone,
+// photon_modes 0 and 1), so that they cannot
+// grow unnoticed; fixing one should lower its bound.
+#[test]
+fn ball_lens_caustics_match_reference() {
+    caustics_match_reference(
+        "ball_lens",
+        PHOTONS_REFERENCE,
+        &[
+            Bound {
+                photon_mode: 0,
+                energy: 0.04,
+                flip: 0.036,
+            },
+            Bound {
+                photon_mode: 1,
+                energy: 0.03,
+                flip: 0.085,
+            },
+            Bound {
+                photon_mode: 2,
+                energy: 0.04,
+                flip: 0.036,
+            },
+        ],
+    );
+}
+
+#[test]
+fn ring_caustics_match_reference() {
+    caustics_match_reference(
+        "ring",
+        PHOTONS_REFERENCE,
+        &[
+            Bound {
+                photon_mode: 0,
+                energy: 0.03,
+                flip: 0.1,
+            },
+            Bound {
+                photon_mode: 1,
+                energy: 0.035,
+                flip: 0.095,
+            },
+        ],
+    );
+}
+
+#[test]
+fn gemstone_caustics_match_reference() {
+    caustics_match_reference(
+        "gemstone",
+        PHOTONS_REFERENCE,
+        &[
+            Bound {
+                photon_mode: 0,
+                energy: 0.635,
+                flip: 0.135,
+            },
+            Bound {
+                photon_mode: 1,
+                energy: 6.355,
+                flip: 0.205,
+            },
+        ],
+    );
+}
+
+/// `caustics_on_change=1` on assets/scenes/gemstone.toml (animated: the gem
+/// spins): a frame at an unchanged time skips the photon and splat passes
+/// and gives the same image as recomputing; a new animation time or a moved
+/// light recomputes, and matches a renderer that recomputes every frame.
+#[test]
+fn caustics_on_change_reuses_the_map_until_something_moves() {
+    use caustics::renderer::Renderer;
+    let ctx = validated_context();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/gemstone.toml");
+    let renderer = |on_change: u32| {
+        let overrides = [
+            "photon_buffer_size=128".to_string(),
+            "caustic_map_size=128".to_string(),
+            format!("caustics_on_change={on_change}"),
+        ];
+        let params = Params::resolve("image_space", PARAMS, &overrides).unwrap();
+        Renderer::new(
+            &ctx,
+            Scene::load(&path).unwrap(),
+            "image_space",
+            &params,
+            64,
+            64,
+            0.0,
+        )
+        .unwrap()
+    };
+    let mut cached = renderer(1);
+    let mut every_frame = renderer(0);
+    // Renders both at `time`; checks whether `cached` shot photons and that
+    // its image equals the recomputed one; returns that image.
+    let frame = |cached: &mut Renderer,
+                 every_frame: &mut Renderer,
+                 time: f32,
+                 recomputes: bool,
+                 what: &str| {
+        let shot = |r: &mut Renderer| {
+            r.render_frame(time)
+                .unwrap()
+                .iter()
+                .any(|t| t.name == "caustic photons")
+        };
+        assert_eq!(
+            shot(cached),
+            recomputes,
+            "{what}: caustic photons recorded?"
+        );
+        assert!(shot(every_frame));
+        let (a, b) = (cached.radiance().unwrap(), every_frame.radiance().unwrap());
+        assert_finite(&a);
+        let worst = a
+            .iter()
+            .zip(&b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0f32, f32::max);
+        println!("{what}: photons shot {recomputes}, largest difference from recomputing {worst:e}, energy {:.4}", energy(&a));
+        assert_eq!(a, b, "{what}: image differs from a recomputed caustic map");
+        a
+    };
+    let first = frame(&mut cached, &mut every_frame, 0.0, true, "first frame");
+    frame(
+        &mut cached,
+        &mut every_frame,
+        0.0,
+        false,
+        "same time, nothing moved",
+    );
+    let rotated = frame(
+        &mut cached,
+        &mut every_frame,
+        0.5,
+        true,
+        "gem rotated (time 0.5 s)",
+    );
+    frame(&mut cached, &mut every_frame, 0.5, false, "same time again");
+    for r in [&mut cached, &mut every_frame] {
+        r.scene.lights[0].position += Vec3::new(0.4, 0.0, -0.3);
+        r.lights_changed(0.5).unwrap();
+    }
+    let moved = frame(&mut cached, &mut every_frame, 0.5, true, "light moved");
+    frame(
+        &mut cached,
+        &mut every_frame,
+        0.5,
+        false,
+        "after the move, nothing moved",
+    );
+    // The changes were visible, so a stale map would have failed above.
+    assert_ne!(first, rotated);
+    assert_ne!(rotated, moved);
+    assert_validation_clean(&ctx);
+}
+
+const RING_RADIUS: f64 = 1.0;
+const RING_HEIGHT: f64 = 0.5;
+const RING_REFLECTANCE: f32 = 0.9;
+/// Slope of the ring test's directional light: tan(elevation) = 1/2.
+const RING_LIGHT_SLOPE: f64 = 0.5;
+const RING_IRRADIANCE: f32 = 3.0;
+
+/// Expected flux reflected by the inside of an analytic open cylinder
+/// (radius R, height H, base on the floor, mirror reflectance rho) onto the
+/// floor inside it, for directional light along (1, -slope, 0) of irradiance
+/// E: every ray entering through the top disk (flux E sin(elevation) per unit
+/// area of the disk) is followed through its reflections (the horizontal
+/// direction mirrors about the wall's normal, the descent per horizontal
+/// metre stays `slope`) until it reaches the floor; it carries rho^k after k
+/// reflections and counts if k >= 1. Midpoint rule on an n x n grid.
+fn ring_reflected_flux(n: usize) -> f64 {
+    let (r, slope) = (RING_RADIUS, RING_LIGHT_SLOPE);
+    let sin_elev = slope / (1.0 + slope * slope).sqrt();
+    let cell = 2.0 * r / n as f64;
+    let mut flux = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            let (mut x, mut z) = (-r + (i as f64 + 0.5) * cell, -r + (j as f64 + 0.5) * cell);
+            if x * x + z * z >= r * r {
+                continue;
+            }
+            let (mut dx, mut dz, mut y, mut weight) = (1.0f64, 0.0f64, RING_HEIGHT, 1.0f64);
+            let mut reflections = 0;
+            loop {
+                // Horizontal distance to the wall along (dx, dz) from inside.
+                let b = x * dx + z * dz;
+                let l = -b + (b * b - (x * x + z * z - r * r)).sqrt();
+                let y_wall = y - l * slope;
+                if y_wall <= 0.0 {
+                    break; // lands on the floor before the wall
+                }
+                x += l * dx;
+                z += l * dz;
+                y = y_wall;
+                let (nx, nz) = (-x / r, -z / r);
+                let dn = dx * nx + dz * nz;
+                dx -= 2.0 * dn * nx;
+                dz -= 2.0 * dn * nz;
+                weight *= RING_REFLECTANCE as f64;
+                reflections += 1;
+            }
+            if reflections > 0 {
+                flux += weight;
             }
         }
-        sum
-    };
-    let nb = SIZE / 8;
-    let blocks: Vec<(f64, f64)> = (0..nb * nb)
-        .map(|k| {
-            (
-                block(&caustic, k % nb, k / nb),
-                block(&truth, k % nb, k / nb),
-            )
-        })
-        .collect();
-    let top = blocks.iter().map(|b| b.1).fold(0.0, f64::max);
-    let bright: Vec<f64> = blocks
-        .iter()
-        .filter(|b| b.1 > 0.05 * top)
-        .map(|b| (b.0 - b.1).abs() / b.1)
-        .collect();
-    println!(
-        "{} bright 8x8 blocks: mean relative difference {:.3}, worst {:.3}",
-        bright.len(),
-        bright.iter().sum::<f64>() / bright.len() as f64,
-        bright.iter().cloned().fold(0.0, f64::max)
-    );
-    assert!(rel.abs() < MAX_REFERENCE_ENERGY, "relative energy {rel}");
-    // The light-space (image-space) photon modes against the same truth.
-    for mode in [1, 2] {
-        let img = masked(frame("image_space", &[format!("photon_mode={mode}")]));
-        let c: f64 = energy(&img) - energy(&direct);
-        let rel_m = (c - t) / t;
-        println!("photon_mode={mode}: caustic energy {c:.2}, relative {rel_m:+.4}");
-        assert!(
-            rel_m.abs() < MAX_REFERENCE_ENERGY,
-            "photon_mode={mode}: {rel_m}"
-        );
     }
+    flux * RING_IRRADIANCE as f64 * sin_elev * cell * cell
+}
+
+/// A mirror ring (open cylinder, r = 1 m, 0.5 m tall, 128 segments,
+/// reflectance 0.9) on a 3 x 3 m floor under directional light at elevation
+/// atan(1/2) travelling along +x. Seen from above, parallel light reflected
+/// inside a circle forms a nephroid whose cusp is the paraxial focus of the
+/// concave mirror, R/2 from the wall, i.e. at (R/2, 0, 0). The wall is
+/// vertical, so reflection keeps the descent per horizontal metre: a ray
+/// meeting the wall at height h lands h / slope further on. The floor
+/// therefore shows the plan-view ray pattern wherever the landing distances
+/// reach it, and the cusp is on the floor if some paraxial ray meets the
+/// wall at h = slope R / 2 = 0.25 m: the wall is lit from the floor to its
+/// top (light passing over the near wall drops 2 R slope = 1 m by the far
+/// wall), so it is.
+#[test]
+fn mirror_ring_cardioid_cusp() {
+    let ctx = validated_context();
+    let mirror = caustics::scene::Material {
+        name: "chrome".into(),
+        kind: caustics::scene::MaterialKind::Mirror,
+        color: Vec3::splat(RING_REFLECTANCE),
+        ior: 1.0,
+        absorption: Vec3::ZERO,
+    };
+    let mut ring = caustics::scene::shapes::cylinder(
+        Vec3::ZERO,
+        Vec3::new(0.0, RING_HEIGHT as f32, 0.0),
+        RING_RADIUS as f32,
+        false,
+        128,
+    );
+    ring.materials = vec![1; ring.indices.len()];
+    let light_dir = Vec3::new(1.0, -RING_LIGHT_SLOPE as f32, 0.0);
+    let s = scene(
+        camera(Vec3::new(0.0, 4.0, 2.5), Vec3::ZERO, 40.0),
+        vec![directional_light(light_dir, RING_IRRADIANCE)],
+        vec![diffuse("floor", ALBEDO), mirror],
+        vec![
+            object("floor", floor_mesh(1.5, 0.0, 0)),
+            object("ring", ring),
+        ],
+    );
+    let splat = 3u32;
+    let f = render(
+        &ctx,
+        &s,
+        &[
+            "photon_buffer_size=512",
+            "caustic_map_size=512",
+            &format!("splat_size={splat}"),
+        ],
+    );
+
+    // Flux: the photons reflected onto the floor inside the ring carry
+    // rho^k of the flux entering through its top. Bound 1%: the 128-gon's
+    // opening is 0.04% smaller than the circle, and the photon grid (5.7 mm)
+    // resolves the aperture's rim and the rays' landing inside or beyond
+    // the wall to well under 1%.
+    let ph = photons(&f);
+    let n2 = ph.len() / 2;
+    let landed = |inside: bool| -> f64 {
+        ph[n2..]
+            .iter()
+            .filter(|p| p.position[3] == 1.0)
+            .filter(|p| (p.position[0].hypot(p.position[2]) < RING_RADIUS as f32) == inside)
+            .map(|p| p.flux[0] as f64)
+            .sum()
+    };
+    let (inside, outside) = (landed(true), landed(false));
+    let expected = ring_reflected_flux(2000);
+    let rel = (inside - expected) / expected;
+    println!(
+        "reflected flux landing inside the ring {inside:.4} W (outside, off the convex outer wall: {outside:.4} W), analytic {expected:.4} W, relative {rel:+.2e}"
+    );
+    assert!(
+        rel.abs() < 0.02,
+        "reflected flux inside the ring off by {rel}"
+    );
+
+    // The cusp: the brightest caustic-map texel (orthographic view, one
+    // layer), taken to the floor along the light.
+    let size = f.tech.caustics.map_size;
+    let view = f.tech.caustics.views(f.scene_gpu.sphere)[0];
+    let inv = glam::Mat4::from_cols_array_2d(&view.view_proj[0]).inverse();
+    let d = light_dir.normalize();
+    let to_floor = |tx: f32, ty: f32| {
+        let ndc = |t: f32| 2.0 * (t + 0.5) / size as f32 - 1.0;
+        let p = inv.project_point3(Vec3::new(ndc(tx), ndc(ty), 0.5));
+        p + d * (-p.y / d.y)
+    };
+    let texels = f.tech.caustics.map.download_layer_rgba32f(0).unwrap();
+    let (mut best, mut best_flux) = ((0, 0), 0.0f32);
+    for ty in 0..size {
+        for tx in 0..size {
+            let flux = texels[((ty * size + tx) * 4) as usize];
+            if flux > best_flux {
+                (best, best_flux) = ((tx, ty), flux);
+            }
+        }
+    }
+    let peak = to_floor(best.0 as f32, best.1 as f32);
+    // Tolerance: a splat blurs over (S/2) texels either side of a photon, and
+    // away from the cusp the irradiance falls off along the axis on both sides,
+    // so the blurred maximum lies within S/2 texels of it; plus half a texel
+    // for the texel grid. A texel's floor footprint, per axis, from its
+    // neighbours (the view is slanted: it stretches along x by 1/sin(elevation)).
+    let (u, v) = (
+        to_floor(1.0, 0.0) - to_floor(0.0, 0.0),
+        to_floor(0.0, 1.0) - to_floor(0.0, 0.0),
+    );
+    let reach = (splat as f32 + 1.0) / 2.0;
+    let tol_x = reach * (u.x.abs() + v.x.abs());
+    let tol_z = reach * (u.z.abs() + v.z.abs());
+    let cusp = Vec3::new(RING_RADIUS as f32 / 2.0, 0.0, 0.0);
+    println!(
+        "brightest caustic texel on the floor at ({:.4}, {:.4}); cusp (paraxial focus) at ({:.4}, 0): off by ({:+.4}, {:+.4}) m, tolerance ({tol_x:.4}, {tol_z:.4}) m",
+        peak.x,
+        peak.z,
+        cusp.x,
+        peak.x - cusp.x,
+        peak.z
+    );
+    assert!((peak.x - cusp.x).abs() < tol_x, "cusp x: {}", peak.x);
+    assert!(peak.z.abs() < tol_z, "cusp z: {}", peak.z);
+    assert!(
+        peak.x.hypot(peak.z) < RING_RADIUS as f32,
+        "caustic outside the ring"
+    );
     assert_validation_clean(&ctx);
 }

@@ -330,6 +330,22 @@ impl CausticMap {
             .collect()
     }
 
+    /// The scene's lights moved (same count and kinds): the next `record`
+    /// shoots from the new positions. False if the lights cannot be taken in
+    /// place (the technique is rebuilt then).
+    pub fn set_lights(&mut self, lights: &[Light]) -> bool {
+        if lights.len() != self.lights.len()
+            || lights
+                .iter()
+                .zip(&self.lights)
+                .any(|(a, b)| a.kind != b.kind)
+        {
+            return false;
+        }
+        self.lights.copy_from_slice(lights);
+        true
+    }
+
     pub fn light_count(&self) -> u32 {
         self.lights.len() as u32
     }

@@ -36,6 +36,9 @@ pub struct SceneGpu {
     pub stats: GeometryStats,
     /// Bounding sphere (centre, radius) of the scene at the uploaded time.
     pub sphere: (Vec3, f32),
+    /// Animation time of the uploaded geometry: techniques that cache
+    /// light-space results (`image_space` with `caustics_on_change`) compare it.
+    pub geometry_time: f32,
     pub triangle_count: u32,
     /// The path-type components techniques draw (`Component::mask` bits),
     /// written into the frame constants; all of them unless a caller narrows it.
@@ -148,6 +151,7 @@ impl SceneGpu {
             stats,
             sphere,
             components: Component::All.mask(),
+            geometry_time: time,
             bvh,
         })
     }
@@ -179,6 +183,7 @@ impl SceneGpu {
         self.bvh_nodes
             .upload(bytemuck::cast_slice(&self.bvh.nodes))?;
         self.sphere = scene.bounding_sphere(time);
+        self.geometry_time = time;
         Ok(())
     }
 

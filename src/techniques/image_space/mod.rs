@@ -26,6 +26,9 @@
 //! clear", per light ("caustic light view" in photon modes 1 and 2)
 //! "caustic photons" and "caustic splat"; "caustic apply"; "refractor
 //! gbuffer"; "refraction" (glsl/image_space/refraction.comp).
+//! With `caustics_on_change` = 1 the caustic clear, photon and splat passes
+//! run only when a light moved (`set_lights`) or the geometry's animation
+//! time changed; other frames reuse the last caustic map.
 //!
 //! Limits: two interfaces only (light inside the glass is never reflected
 //! again; the remedies stand in for TIR); rays that leave the view or the
@@ -129,6 +132,14 @@ pub const PARAMS: &[ParamSpec] = &[
         default: 32.0,
         integer: true,
     },
+    ParamSpec {
+        name: "caustics_on_change",
+        description: "1: recompute the caustic map only when a light moved or animated geometry changed, reusing the last one otherwise; 0: every frame (benchmarks)",
+        min: 0.0,
+        max: 1.0,
+        default: 0.0,
+        integer: true,
+    },
 ];
 
 pub struct ImageSpace {
@@ -142,6 +153,13 @@ pub struct ImageSpace {
     pub refraction: CameraRefraction,
     apply: ComputePipeline,
     set: DescriptorSet,
+    /// `caustics_on_change`: reuse the caustic map while nothing it depends
+    /// on moved (Wyman 2006, "Putting it Together": "we only update the
+    /// caustic map after changes to the light or scene geometry").
+    caustics_on_change: bool,
+    /// Geometry time the caustic map was computed for; `None` when it must
+    /// be recomputed (never computed, or a light moved).
+    caustics_geometry_time: Option<f32>,
     _layout: DescriptorSetLayout,
     _sampler: Sampler,
 }
@@ -227,6 +245,8 @@ impl ImageSpace {
             refraction,
             apply,
             set,
+            caustics_on_change: params.get("caustics_on_change") != 0.0,
+            caustics_geometry_time: None,
             _layout: layout,
             _sampler: sampler,
         })
@@ -245,7 +265,10 @@ impl Technique for ImageSpace {
         targets: &FrameTargets,
     ) -> VkResult<()> {
         self.direct.record(rec, scene, &self.opaque)?;
-        self.caustics.record(rec, scene)?;
+        if !self.caustics_on_change || self.caustics_geometry_time != Some(scene.geometry_time) {
+            self.caustics.record(rec, scene)?;
+            self.caustics_geometry_time = Some(scene.geometry_time);
+        }
         let ctx = rec.ctx().clone();
         let light_count = self.caustics.light_count();
         rec.pass("caustic apply", |cmd| {
@@ -278,5 +301,10 @@ impl Technique for ImageSpace {
             targets,
         );
         Ok(())
+    }
+
+    fn set_lights(&mut self, lights: &[crate::scene::Light]) -> bool {
+        self.caustics_geometry_time = None;
+        self.direct.set_lights(lights) && self.caustics.set_lights(lights)
     }
 }
