@@ -92,6 +92,8 @@ fn every_canonical_scene_loads() {
         "smoke",
         "mesh_glass",
         "diffuse_room",
+        "water_pool",
+        "ocean_large",
     ];
     for name in names {
         let path = manifest(&format!("assets/scenes/{name}.toml"));
@@ -186,6 +188,26 @@ fn canonical_scene_contents() {
         cone.medium.as_ref().map(|m| m.density.clone()),
         Some(Density::Constant(1.0))
     );
+
+    for (name, ior_of_water, min_extent) in
+        [("water_pool", 1.33, 6.0), ("ocean_large", 1.33, 400.0)]
+    {
+        let scene = Scene::load(&manifest(&format!("assets/scenes/{name}.toml"))).expect(name);
+        let water = scene
+            .objects
+            .iter()
+            .find_map(|o| o.water.as_ref())
+            .unwrap_or_else(|| panic!("{name}: no water"));
+        let m = &scene.materials[water.material as usize];
+        assert_eq!(
+            (m.kind, m.ior),
+            (MaterialKind::Dielectric, ior_of_water),
+            "{name}"
+        );
+        assert!(water.size.min_element() >= min_extent, "{name}");
+        assert!(water.waves.len() >= 3 && scene.is_animated(), "{name}");
+        assert_eq!(scene.lights[0].kind, LightKind::Directional, "{name}");
+    }
 
     let room = Scene::load(&manifest("assets/scenes/diffuse_room.toml")).expect("diffuse_room");
     assert!(room
