@@ -90,10 +90,17 @@ impl Water {
 
     /// Displaced position and unit normal (pointing up, +y side) of the rest
     /// point `rest` = (x, z) at `time` seconds: the Gerstner sum of the module
-    /// docs. glsl/common/water.glsl evaluates the same operations in the same order.
+    /// docs, normal = normalize(∂P/∂z × ∂P/∂x).
     pub fn surface_point(&self, rest: Vec2, time: f32) -> (Vec3, Vec3) {
+        let (position, d_dx, d_dz) = self.surface_derivatives(rest, time);
+        (position, d_dz.cross(d_dx).normalize())
+    }
+
+    /// Displaced position P and its partial derivatives ∂P/∂x, ∂P/∂z with
+    /// respect to the rest coordinates, at `rest` = (x, z) and `time`.
+    /// glsl/common/water.glsl evaluates the same operations in the same order.
+    pub fn surface_derivatives(&self, rest: Vec2, time: f32) -> (Vec3, Vec3, Vec3) {
         let mut position = Vec3::new(rest.x, self.base_height, rest.y);
-        // ∂P/∂x and ∂P/∂z of the rest coordinates.
         let mut d_dx = Vec3::X;
         let mut d_dz = Vec3::Z;
         for w in &self.waves {
@@ -117,7 +124,7 @@ impl Water {
                 -horizontal * d.y * d.y,
             );
         }
-        (position, d_dz.cross(d_dx).normalize())
+        (position, d_dx, d_dz)
     }
 
     /// The surface at `time` as a grid of smooth-shaded triangles, counter-
