@@ -281,12 +281,12 @@ mod tests {
                     let inside = finer.x.abs() < 1.0 - edge && finer.y.abs() < 1.0 - edge;
                     let outside = finer.x.abs() > 1.0 + edge || finer.y.abs() > 1.0 + edge;
                     assert!(
-                        !(inside && hit),
+                        !inside || !hit,
                         "{layout:?}: cascade {c} texel ({x}, {y}) covered by cascade {} yet dispatched",
                         c - 1
                     );
                     assert!(
-                        !(outside && !hit),
+                        hit || !outside,
                         "{layout:?}: cascade {c} texel ({x}, {y}) outside cascade {} yet not dispatched",
                         c - 1
                     );
