@@ -3,7 +3,7 @@
 //! agree without padding rules; the const assertions below pin sizes and
 //! offsets, and the GLSL side mirrors the same field order.
 
-use crate::scene::{Density, Light, LightKind, Material, MaterialKind, Medium, Triangle};
+use crate::scene::{Density, Light, LightKind, Material, MaterialKind, Medium, Triangle, Wave};
 use crate::shader_bindings as b;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3, Vec4};
@@ -97,7 +97,31 @@ pub struct GpuFrame {
     pub components: [u32; 4],
 }
 
+/// One Gerstner wave (glsl/common/water.glsl `Wave`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuWave {
+    /// xy: unit travel direction D as (x, z); z: k = 2π/λ (rad/m); w: ω = k·speed (rad/s).
+    pub direction_k_omega: [f32; 4],
+    /// x: amplitude (m); y: steepness Q; z: phase (rad); w: unused.
+    pub amplitude_steepness_phase: [f32; 4],
+}
+
+/// One evaluated water grid vertex (glsl/passes/water_surface.comp `WaterVertex`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuWaterVertex {
+    /// xyz world position; w = 1.
+    pub position: [f32; 4],
+    /// xyz unit normal (+y side); w = 0.
+    pub normal: [f32; 4],
+}
+
 const _: () = {
+    assert!(size_of::<GpuWave>() == 32);
+    assert!(offset_of!(GpuWave, amplitude_steepness_phase) == 16);
+    assert!(size_of::<GpuWaterVertex>() == 32);
+    assert!(offset_of!(GpuWaterVertex, normal) == 16);
     assert!(size_of::<GpuTriangle>() == 96);
     assert!(size_of::<GpuBvhNode>() == 32);
     assert!(offset_of!(GpuBvhNode, count) == 28);
@@ -110,6 +134,16 @@ const _: () = {
     assert!(offset_of!(GpuFrame, counts) == 304);
     assert!(offset_of!(GpuFrame, components) == 320);
 };
+
+impl GpuWave {
+    pub fn new(w: &Wave) -> Self {
+        let d = w.direction();
+        Self {
+            direction_k_omega: [d.x, d.y, w.wavenumber(), w.angular_frequency()],
+            amplitude_steepness_phase: [w.amplitude, w.steepness, w.phase, 0.0],
+        }
+    }
+}
 
 fn v4(v: Vec3, w: f32) -> [f32; 4] {
     [v.x, v.y, v.z, w]

@@ -3,6 +3,7 @@
 
 pub mod app;
 pub mod bvh;
+pub mod cascades;
 pub mod gpu;
 pub mod output;
 pub mod passes;

@@ -107,3 +107,9 @@ pub const REFRACTION_BINDING_FRONT_NORMAL: u32 = 3;
 pub const REFRACTION_BINDING_BACK_POSITION: u32 = 4;
 pub const REFRACTION_BINDING_BACK_NORMAL: u32 = 5;
 pub const REFRACTION_BINDING_RADIANCE: u32 = 6;
+
+// Water surface pass (src/passes/water_surface.rs, glsl/passes/water_surface.comp), set 0.
+pub const WATER_SURFACE_BINDING_WAVES: u32 = 0;
+pub const WATER_SURFACE_BINDING_VERTICES: u32 = 1;
+/// Workgroup side of the water surface pass (8 x 8 grid vertices).
+pub const WATER_SURFACE_GROUP_SIZE: u32 = 8;

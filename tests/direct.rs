@@ -60,6 +60,7 @@ fn plane() -> Object {
         },
         transform: Mat4::IDENTITY,
         animation: None,
+        water: None,
     }
 }
 
@@ -90,6 +91,7 @@ fn cuboid(lo: Vec3, hi: Vec3) -> Object {
         mesh,
         transform: Mat4::IDENTITY,
         animation: None,
+        water: None,
     }
 }
 

@@ -92,6 +92,8 @@ fn every_canonical_scene_loads() {
         "smoke",
         "mesh_glass",
         "diffuse_room",
+        "water_pool",
+        "ocean_large",
     ];
     for name in names {
         let path = manifest(&format!("assets/scenes/{name}.toml"));
@@ -186,6 +188,26 @@ fn canonical_scene_contents() {
         cone.medium.as_ref().map(|m| m.density.clone()),
         Some(Density::Constant(1.0))
     );
+
+    for (name, ior_of_water, min_extent) in
+        [("water_pool", 1.33, 6.0), ("ocean_large", 1.33, 400.0)]
+    {
+        let scene = Scene::load(&manifest(&format!("assets/scenes/{name}.toml"))).expect(name);
+        let water = scene
+            .objects
+            .iter()
+            .find_map(|o| o.water.as_ref())
+            .unwrap_or_else(|| panic!("{name}: no water"));
+        let m = &scene.materials[water.material as usize];
+        assert_eq!(
+            (m.kind, m.ior),
+            (MaterialKind::Dielectric, ior_of_water),
+            "{name}"
+        );
+        assert!(water.size.min_element() >= min_extent, "{name}");
+        assert!(water.waves.len() >= 3 && scene.is_animated(), "{name}");
+        assert_eq!(scene.lights[0].kind, LightKind::Directional, "{name}");
+    }
 
     let room = Scene::load(&manifest("assets/scenes/diffuse_room.toml")).expect("diffuse_room");
     assert!(room
@@ -615,19 +637,262 @@ fn at_most_eight_lights() {
     );
 }
 
+const WATER: &str = "[[object]]\nshape = \"water\"\nmaterial = \"white\"\ncenter = [1.0, 2.0]\nsize = [4.0, 3.0]\nresolution = [8, 6]\nbase_height = 0.25\n";
+
+/// A scene with a water object whose table ends with `extra` (its waves, or a bad field).
+fn with_water(extra: &str) -> String {
+    base(&format!("{WATER}{extra}"))
+}
+
 #[test]
-fn water_is_not_supported_yet() {
+fn water_loads_with_waves_and_defaults() {
+    let text = with_water(
+        "[[object.wave]]\namplitude = 0.1\nwavelength = 2.0\ndirection = 30\nsteepness = 0.5\nspeed = 1.5\nphase = 0.2\n[[object.wave]]\namplitude = 0.05\nwavelength = 1.0\n",
+    );
+    let scene = Scene::from_str(&text, Path::new("water.toml")).expect("water scene");
+    let o = &scene.objects[1];
+    let w = o.water.as_ref().expect("a water surface");
+    assert_eq!(w.center, glam::Vec2::new(1.0, 2.0));
+    assert_eq!(w.size, glam::Vec2::new(4.0, 3.0));
+    assert_eq!(w.resolution, [8, 6]);
+    assert_eq!(w.base_height, 0.25);
+    assert_eq!(w.waves.len(), 2);
+    assert_eq!(
+        w.waves[0],
+        Wave {
+            amplitude: 0.1,
+            wavelength: 2.0,
+            direction_deg: 30.0,
+            steepness: 0.5,
+            speed: 1.5,
+            phase: 0.2
+        }
+    );
+    // Defaults: direction 0, steepness 0, phase 0, deep-water speed sqrt(g λ / 2π).
+    let d = w.waves[1];
+    assert_eq!((d.direction_deg, d.steepness, d.phase), (0.0, 0.0, 0.0));
+    assert!((d.speed - (9.81f32 / std::f32::consts::TAU).sqrt()).abs() < 1e-6);
+    assert_eq!(o.mesh.indices.len(), 2 * 8 * 6);
+    assert_eq!(
+        scene.triangle_count(),
+        2 * 8 * 6 + scene.objects[0].mesh.indices.len()
+    );
+    // Animated: the triangles move with time, their count does not.
+    assert!(scene.is_animated());
+    let (a, b) = (scene.triangles(0.0), scene.triangles(0.8));
+    assert_eq!(a.len(), b.len());
+    assert_ne!(a.last().unwrap().positions, b.last().unwrap().positions);
+    // Heights stay within base_height ± the summed amplitudes.
+    for p in &o.mesh_at(0.8).positions {
+        assert!((p.y - 0.25).abs() <= 0.15 + 1e-5, "{p}");
+    }
+    // The bounds follow the moving surface (its far x edge, about 3 m).
+    let (_, hi) = scene.bounds(0.8);
+    assert!(hi.x > 2.9, "{hi}");
+
+    // Inline array of tables, no waves at all, and waves without speed are still water.
+    let inline = with_water(
+        "wave = [{ amplitude = 0.1, wavelength = 2.0 }, { amplitude = 0.0, wavelength = 1.0 }]\n",
+    );
+    let scene = Scene::from_str(&inline, Path::new("water.toml")).expect("inline waves");
+    assert_eq!(scene.objects[1].water.as_ref().unwrap().waves.len(), 2);
+    let calm = Scene::from_str(&with_water(""), Path::new("water.toml")).expect("flat water");
+    assert!(!calm.is_animated());
+    assert!(calm.objects[1].mesh.positions.iter().all(|p| p.y == 0.25));
+    let frozen = with_water("[[object.wave]]\namplitude = 0.1\nwavelength = 2.0\nspeed = 0\n");
+    assert!(!Scene::from_str(&frozen, Path::new("water.toml"))
+        .unwrap()
+        .is_animated());
+}
+
+#[test]
+fn water_values_are_checked() {
+    let wave = "[[object.wave]]\n";
+    for (extra, field, needle, message) in [
+        (
+            "size = [0.0, 1.0]\n",
+            "object[1].size[0]",
+            "size = [0.0",
+            "must be positive",
+        ),
+        (
+            "size = [2.0, -1.0]\n",
+            "object[1].size[1]",
+            "size = [2.0",
+            "must be positive",
+        ),
+        (
+            "resolution = [0, 4]\n",
+            "object[1].resolution[0]",
+            "resolution = [0",
+            "within [1, 4096], got 0",
+        ),
+        (
+            "resolution = [4, 5000]\n",
+            "object[1].resolution[1]",
+            "resolution = [4, 5000",
+            "within [1, 4096], got 5000",
+        ),
+        (
+            "resolution = [4096, 4096]\n",
+            "object[1].resolution",
+            "resolution = [4096",
+            "cells, at most 2097152",
+        ),
+        (
+            "resolution = [4.5, 4]\n",
+            "object[1].resolution[0]",
+            "resolution = [4.5",
+            "got 4.5",
+        ),
+        (
+            "resolution = 8\n",
+            "object[1].resolution",
+            "resolution = 8",
+            "array of 2 integers",
+        ),
+        (
+            "center = [1.0, nan]\n",
+            "object[1].center[1]",
+            "center = [1.0, nan",
+            "finite",
+        ),
+        (
+            "base_height = inf\n",
+            "object[1].base_height",
+            "base_height = inf",
+            "finite",
+        ),
+        (
+            "translate = [0.0, 1.0, 0.0]\n",
+            "object[1].translate",
+            "translate",
+            "unknown field `translate` in a water object",
+        ),
+        (
+            "animate = { spin = 1.0 }\n",
+            "object[1].animate",
+            "animate",
+            "unknown field `animate`",
+        ),
+        (
+            "waves = []\n",
+            "object[1].waves",
+            "waves",
+            "unknown field `waves`",
+        ),
+    ] {
+        // A later key of the same table overrides nothing in TOML: rebuild the table.
+        let text = base(&format!(
+            "[[object]]\nshape = \"water\"\nmaterial = \"white\"\n{}{extra}",
+            [
+                "center = [1.0, 2.0]\n",
+                "size = [4.0, 3.0]\n",
+                "resolution = [8, 6]\n"
+            ]
+            .iter()
+            .filter(|l| !extra.starts_with(&l[..l.find(' ').unwrap()]))
+            .copied()
+            .collect::<String>()
+        ));
+        rejects(&text, field, needle, message);
+    }
     rejects(
-        &base("[[object]]\nshape = \"water\"\nmaterial = \"white\"\n"),
-        "object[1].shape",
-        "\"water\"",
-        "not supported yet",
+        &base("[[object]] # water\nshape = \"water\"\nmaterial = \"white\"\nsize = [1.0, 1.0]\n"),
+        "object[1].resolution",
+        "# water",
+        "missing required field",
+    );
+    for (body, field, needle, message) in [
+        (
+            "amplitude = -0.1\nwavelength = 1.0\n",
+            "object[1].wave[0].amplitude",
+            "amplitude = -0.1",
+            "must not be negative",
+        ),
+        (
+            "amplitude = 0.1\nwavelength = 0.0\n",
+            "object[1].wave[0].wavelength",
+            "wavelength = 0.0",
+            "must be positive",
+        ),
+        (
+            "amplitude = 0.1\nwavelength = -2.0\n",
+            "object[1].wave[0].wavelength",
+            "wavelength = -2.0",
+            "must be positive",
+        ),
+        (
+            "amplitude = 0.1\n",
+            "object[1].wave[0].wavelength",
+            "[[object.wave]]",
+            "missing required field",
+        ),
+        (
+            "amplitude = 0.1\nwavelength = 1.0\nsteepness = 1.5\n",
+            "object[1].wave[0].steepness",
+            "steepness = 1.5",
+            "within [0, 1], got 1.5",
+        ),
+        (
+            "amplitude = 0.1\nwavelength = 1.0\nsteepness = -0.1\n",
+            "object[1].wave[0].steepness",
+            "steepness = -0.1",
+            "within [0, 1]",
+        ),
+        (
+            "amplitude = 0.1\nwavelength = 1.0\nspeed = -1\n",
+            "object[1].wave[0].speed",
+            "speed = -1",
+            "must not be negative",
+        ),
+        (
+            "amplitude = 0.1\nwavelength = 1.0\nphase = nan\n",
+            "object[1].wave[0].phase",
+            "phase = nan",
+            "finite",
+        ),
+        (
+            "amplitude = 0.1\nwavelength = 1.0\ndirection = \"north\"\n",
+            "object[1].wave[0].direction",
+            "direction = \"north\"",
+            "expected a number",
+        ),
+        (
+            "amplitude = 0.1\nwavelength = 1.0\nheight = 2\n",
+            "object[1].wave[0].height",
+            "height = 2",
+            "unknown field `height` in a wave",
+        ),
+    ] {
+        rejects(
+            &with_water(&format!("{wave}{body}")),
+            field,
+            needle,
+            message,
+        );
+    }
+    // Steep, high, short waves fold over: Σ Q k A = 1 · 2π · 0.4 / 2 > 1.
+    rejects(
+        &with_water("[[object.wave]]\namplitude = 0.4\nwavelength = 2.0\nsteepness = 1.0\n"),
+        "object[1].wave",
+        "[[object.wave]]",
+        "fold over themselves",
+    );
+    let many = (0..17)
+        .map(|i| format!("[[object.wave]] # wave {i}\namplitude = 0.001\nwavelength = 1.0\n"))
+        .collect::<String>();
+    rejects(
+        &with_water(&many),
+        "object[1].wave[16]",
+        "# wave 16",
+        "too many waves: 17, at most 16",
     );
     rejects(
         &base("[[object]]\nshape = \"cone\"\nmaterial = \"white\"\n"),
         "object[1].shape",
         "\"cone\"",
-        "unknown shape",
+        "unknown shape `cone`; expected sphere, plane, box, torus, cylinder, mesh or water",
     );
 }
 

@@ -6,3 +6,4 @@ pub mod gbuffer;
 pub mod shadow;
 pub mod specular_gbuffer;
 pub mod tonemap;
+pub mod water_surface;

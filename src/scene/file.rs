@@ -6,6 +6,7 @@ use super::node::{self, Node, Tbl, R};
 use super::obj;
 use super::shapes;
 use super::types::*;
+use super::water;
 use crate::shader_bindings::MAX_LIGHTS;
 use glam::{Mat4, Quat, Vec3};
 use std::path::Path;
@@ -345,17 +346,23 @@ fn object(
         "torus" => &["center", "axis", "radii", "segments"],
         "cylinder" => &["p0", "p1", "radius", "caps", "segments"],
         "mesh" => &["path"],
-        "water" => return Err(t.err("shape", "shape `water` is not supported yet")),
+        "water" => &[],
         other => {
             return Err(t.err(
                 "shape",
                 format!(
-                    "unknown shape `{other}`; expected sphere, plane, box, torus, cylinder or mesh"
+                    "unknown shape `{other}`; expected sphere, plane, box, torus, cylinder, mesh or water"
                 ),
             ))
         }
     };
-    let allowed: Vec<&str> = COMMON_OBJECT_KEYS.iter().chain(extra).copied().collect();
+    let allowed: Vec<&str> = if shape == "water" {
+        // Water lies in world space (its waves are world x/z functions), so it
+        // takes no transform or animation: `center` and `base_height` place it.
+        WATER_KEYS.to_vec()
+    } else {
+        COMMON_OBJECT_KEYS.iter().chain(extra).copied().collect()
+    };
     t.check_keys(&allowed, &format!("a {shape} object"))?;
 
     let name = t
@@ -444,6 +451,16 @@ fn object(
             let caps = t.opt_bool("caps")?.unwrap_or(true);
             shapes::cylinder(p0, p1, radius, caps, segments(t)?)
         }
+        "water" => {
+            let surface = water_surface(t, material.unwrap_or_default())?;
+            return Ok(Object {
+                name,
+                mesh: surface.mesh(0.0),
+                transform: Mat4::IDENTITY,
+                animation: None,
+                water: Some(surface),
+            });
+        }
         _ => return mesh_object(t, name, dir, material, materials, defined),
     };
     let material = material.unwrap_or_default();
@@ -453,11 +470,156 @@ fn object(
         mesh,
         transform: transform(t)?,
         animation: animation(t)?,
+        water: None,
+    })
+}
+
+const WATER_KEYS: [&str; 8] = [
+    "shape",
+    "name",
+    "material",
+    "center",
+    "size",
+    "resolution",
+    "base_height",
+    "wave",
+];
+
+fn water_surface(t: &Tbl, material: u32) -> R<Water> {
+    let center = match t.get("center") {
+        Some(_) => numbers2(t, "center", false)?,
+        None => [0.0; 2],
+    };
+    let size = size2(t, "size")?;
+    let resolution = water_resolution(t)?;
+    let base_height = t.f32_or("base_height", 0.0)?;
+    let wave_tables = t.tables("wave")?;
+    if wave_tables.len() > water::MAX_WAVES {
+        let extra = &wave_tables[water::MAX_WAVES];
+        return Err(t.src.err(
+            &extra.span,
+            &extra.path,
+            format!(
+                "too many waves: {}, at most {} are supported",
+                wave_tables.len(),
+                water::MAX_WAVES
+            ),
+        ));
+    }
+    let waves = wave_tables.iter().map(wave).collect::<R<Vec<_>>>()?;
+    let surface = Water {
+        center: center.into(),
+        size: size.into(),
+        resolution,
+        base_height,
+        material,
+        waves,
+    };
+    let fold = surface.fold_measure();
+    if fold >= 1.0 {
+        return Err(t.err(
+            "wave",
+            format!(
+                "the waves fold over themselves: the sum of steepness * 2 pi * amplitude / wavelength is {fold}, must be below 1"
+            ),
+        ));
+    }
+    Ok(surface)
+}
+
+/// `resolution = [nx, nz]`: cells per side within [1, MAX_RESOLUTION], at most MAX_CELLS in all.
+fn water_resolution(t: &Tbl) -> R<[u32; 2]> {
+    let n = t.req("resolution")?;
+    let field = t.field("resolution");
+    let items = match &n.node {
+        Node::Array(items) if items.len() == 2 => items,
+        other => {
+            return Err(t.err(
+                "resolution",
+                format!("expected an array of 2 integers, got {}", describe(other)),
+            ))
+        }
+    };
+    let mut out = [0u32; 2];
+    for (i, item) in items.iter().enumerate() {
+        out[i] = match item.node {
+            Node::Int(v) if (1..=water::MAX_RESOLUTION as i64).contains(&v) => v as u32,
+            ref other => {
+                return Err(t.src.err(
+                    &item.span,
+                    &format!("{field}[{i}]"),
+                    format!(
+                        "expected an integer within [1, {}], got {}",
+                        water::MAX_RESOLUTION,
+                        value_text(other)
+                    ),
+                ))
+            }
+        };
+    }
+    let cells = out[0] as u64 * out[1] as u64;
+    if cells > water::MAX_CELLS {
+        return Err(t.err(
+            "resolution",
+            format!(
+                "{} x {} = {cells} cells, at most {} are supported",
+                out[0],
+                out[1],
+                water::MAX_CELLS
+            ),
+        ));
+    }
+    Ok(out)
+}
+
+fn wave(t: &Tbl) -> R<Wave> {
+    t.check_keys(
+        &[
+            "amplitude",
+            "wavelength",
+            "direction",
+            "steepness",
+            "speed",
+            "phase",
+        ],
+        "a wave",
+    )?;
+    let amplitude = t.f32("amplitude")?;
+    if amplitude < 0.0 {
+        return Err(t.err(
+            "amplitude",
+            format!("must not be negative, got {amplitude}"),
+        ));
+    }
+    let wavelength = positive(t, "wavelength")?;
+    let steepness = t.f32_or("steepness", 0.0)?;
+    if !(0.0..=1.0).contains(&steepness) {
+        return Err(t.err(
+            "steepness",
+            format!("must be within [0, 1], got {steepness}"),
+        ));
+    }
+    let speed = t.f32_or("speed", Wave::deep_water_speed(wavelength))?;
+    if speed < 0.0 {
+        return Err(t.err("speed", format!("must not be negative, got {speed}")));
+    }
+    Ok(Wave {
+        amplitude,
+        wavelength,
+        direction_deg: t.f32_or("direction", 0.0)?,
+        steepness,
+        speed,
+        phase: t.f32_or("phase", 0.0)?,
     })
 }
 
 /// Two positive numbers `[a, b]`.
 fn size2(t: &Tbl, key: &str) -> R<[f32; 2]> {
+    numbers2(t, key, true)
+}
+
+/// Two numbers `[a, b]`, positive ones when `positive`.
+fn numbers2(t: &Tbl, key: &str, positive: bool) -> R<[f32; 2]> {
     let n = t.req(key)?;
     let field = t.field(key);
     let items = match &n.node {
@@ -472,7 +634,7 @@ fn size2(t: &Tbl, key: &str) -> R<[f32; 2]> {
     let mut out = [0.0; 2];
     for (i, item) in items.iter().enumerate() {
         out[i] = node::number(t.src, &format!("{field}[{i}]"), item)?;
-        if out[i] <= 0.0 {
+        if positive && out[i] <= 0.0 {
             return Err(t.src.err(
                 &item.span,
                 &format!("{field}[{i}]"),
@@ -562,6 +724,7 @@ fn mesh_object(
         mesh,
         transform: transform(t)?,
         animation: animation(t)?,
+        water: None,
     })
 }
 

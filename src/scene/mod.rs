@@ -4,6 +4,7 @@
 //! - `file.rs`: the schema and its validation (every error located `FILE:LINE:COL: FIELD`).
 //! - `node.rs`: the span-carrying TOML tree the schema reads from.
 //! - `shapes.rs`: procedural tessellation; `obj.rs`: OBJ/MTL through tobj.
+//! - `water.rs`: water surfaces (Gerstner waves), re-tessellated per time.
 //! - this file: loading, animation and world-space queries.
 
 mod error;
@@ -12,12 +13,14 @@ mod node;
 pub mod obj;
 pub mod shapes;
 mod types;
+pub mod water;
 
 pub use error::SceneError;
 pub use file::DEFAULT_FOV_Y_DEG;
 pub use types::*;
 
 use glam::{Mat3, Mat4, Quat, Vec3};
+use std::borrow::Cow;
 use std::path::Path;
 
 /// The scene the CLI and demo open when none is given.
@@ -53,11 +56,13 @@ impl Scene {
         self.objects.iter().map(|o| o.mesh.indices.len()).sum()
     }
 
-    /// Whether any object moves with time.
+    /// Whether any object moves with time (an `animate` block that moves,
+    /// or water with waves that have height and speed).
     pub fn is_animated(&self) -> bool {
-        self.objects
-            .iter()
-            .any(|o| o.animation.is_some_and(|a| a.is_moving()))
+        self.objects.iter().any(|o| {
+            o.animation.is_some_and(|a| a.is_moving())
+                || o.water.as_ref().is_some_and(Water::is_moving)
+        })
     }
 
     /// Local -> world transform of object `index` at `time` seconds:
@@ -92,19 +97,18 @@ impl Scene {
             let m = self.object_transform(oi, time);
             let n = Mat3::from_mat4(m).inverse().transpose();
             let flip = m.determinant() < 0.0;
-            let positions: Vec<Vec3> = o
-                .mesh
+            let mesh = o.mesh_at(time);
+            let positions: Vec<Vec3> = mesh
                 .positions
                 .iter()
                 .map(|&p| m.transform_point3(p))
                 .collect();
-            let normals: Vec<Vec3> = o
-                .mesh
+            let normals: Vec<Vec3> = mesh
                 .normals
                 .iter()
                 .map(|&v| (n * v).normalize_or_zero())
                 .collect();
-            for (t, &material) in o.mesh.indices.iter().zip(&o.mesh.materials) {
+            for (t, &material) in mesh.indices.iter().zip(&mesh.materials) {
                 let mut t = if flip { [t[0], t[2], t[1]] } else { *t };
                 // Renderers tell inside from outside by the winding (the
                 // geometric normal); where a file's normals disagree with its
@@ -132,7 +136,7 @@ impl Scene {
         let mut hi = Vec3::splat(f32::NEG_INFINITY);
         for (oi, o) in self.objects.iter().enumerate() {
             let m = self.object_transform(oi, time);
-            for &p in &o.mesh.positions {
+            for &p in &o.mesh_at(time).positions {
                 let w = m.transform_point3(p);
                 lo = lo.min(w);
                 hi = hi.max(w);
@@ -159,6 +163,17 @@ impl Scene {
             }
         }
         ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
+    }
+}
+
+impl Object {
+    /// The object's local-space mesh at `time`: water re-tessellated with its
+    /// waves at that time, anything else its static mesh.
+    pub fn mesh_at(&self, time: f32) -> Cow<'_, Mesh> {
+        match &self.water {
+            Some(w) => Cow::Owned(w.mesh(time)),
+            None => Cow::Borrowed(&self.mesh),
+        }
     }
 }
 

@@ -3,7 +3,7 @@
 //! (docs/SCENES.md, GUIDE §2): point/spot intensity in W/sr, directional
 //! irradiance in W/m^2, media coefficients in 1/m.
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 use std::path::PathBuf;
 
 #[derive(Clone, Debug)]
@@ -102,6 +102,46 @@ pub struct Object {
     /// Static placement (translate/rotate/scale from the file), local -> world.
     pub transform: Mat4,
     pub animation: Option<Animation>,
+    /// A `water` object's surface: `mesh` then holds its tessellation at
+    /// time 0, and `Scene::triangles(t)` re-tessellates it at `t`
+    /// (src/scene/water.rs). Water has no transform or animation of its own.
+    pub water: Option<Water>,
+}
+
+/// One Gerstner wave of a water surface (docs/SCENES.md, src/scene/water.rs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Wave {
+    /// Crest height above the still surface, m.
+    pub amplitude: f32,
+    /// Crest-to-crest distance, m (> 0).
+    pub wavelength: f32,
+    /// Travel direction in degrees, counter-clockwise seen from +y, 0 = +x,
+    /// 90 = -z (the `animate` orbit's convention).
+    pub direction_deg: f32,
+    /// Gerstner steepness Q in [0, 1]: horizontal displacement Q A D cos θ
+    /// (0: a plain sine wave).
+    pub steepness: f32,
+    /// Phase speed, m/s (>= 0): ω = 2π/λ · speed.
+    pub speed: f32,
+    /// Phase offset φ, radians.
+    pub phase: f32,
+}
+
+/// A heightfield of water over an x/z rectangle, displaced by a sum of
+/// Gerstner waves.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Water {
+    /// Middle of the rectangle, (x, z), m.
+    pub center: Vec2,
+    /// Extent along x and z, m (> 0).
+    pub size: Vec2,
+    /// Grid cells along x and z: (nx + 1)(nz + 1) vertices, 2 nx nz triangles.
+    pub resolution: [u32; 2],
+    /// Height (y) of the still surface, m.
+    pub base_height: f32,
+    /// Scene material index of every triangle.
+    pub material: u32,
+    pub waves: Vec<Wave>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

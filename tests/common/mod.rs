@@ -185,6 +185,7 @@ pub fn object(name: &str, mesh: Mesh) -> Object {
         mesh,
         transform: Mat4::IDENTITY,
         animation: None,
+        water: None,
     }
 }
 
