@@ -85,7 +85,11 @@ impl Component {
 pub struct ReferenceSettings {
     /// Photons per dispatch.
     pub batch: u32,
-    /// Longest path (specular bounces plus scattering events).
+    /// Longest path (specular bounces plus scattering events). Light
+    /// trapped in a faceted diamond takes long chains: on
+    /// assets/scenes/gemstone.toml a depth of 32 dropped 7% of the caustic
+    /// flux landing on the floor (10% of the L S+ D image's energy;
+    /// measured with the caustic map's traced photons), 128 drops 0.3%.
     pub max_depth: u32,
     /// Diffuse bounces photons continue through (0: direct and caustic light only).
     pub diffuse_bounces: u32,
@@ -95,7 +99,7 @@ impl Default for ReferenceSettings {
     fn default() -> Self {
         Self {
             batch: 1 << 18,
-            max_depth: 32,
+            max_depth: 128,
             diffuse_bounces: 0,
         }
     }
