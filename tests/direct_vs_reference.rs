@@ -180,12 +180,7 @@ fn direct_matches_reference_direct_component() {
         tonemap_diff <= 1,
         "CPU tonemap differs from the shader by {tonemap_diff}"
     );
-    // Second half = 2 * whole - first half (the resolve divides by the photon count).
-    let half_b: Vec<f32> = truth
-        .iter()
-        .zip(&half_a)
-        .map(|(t, a)| 2.0 * t - a)
-        .collect();
+    let half_b = second_half(&truth, &half_a);
     let (noise_flip, _) = flip(&tonemap(&half_b), &tonemap(&half_a), SIZE);
 
     let n = (SIZE * SIZE) as usize;

@@ -106,12 +106,11 @@ mod common;
 
 use caustics::passes::caustic_map::GpuPhoton;
 use caustics::radiometry::fresnel_dielectric;
-use caustics::renderer::{FrameTargets, SceneGpu};
 use caustics::scene::{Light, LightKind, Scene};
 use caustics::shader_bindings as b;
-use caustics::techniques::image_space::{ImageSpace, PARAMS};
-use caustics::techniques::{Params, Technique};
-use caustics::vk::{Context, Profiler};
+use caustics::techniques::image_space::PARAMS;
+use caustics::techniques::Params;
+use caustics::vk::Context;
 use common::*;
 use glam::{DVec3, Vec3};
 use std::f64::consts::PI;
@@ -145,28 +144,10 @@ fn ball_scene_lit(ior: Option<f32>, floor_y: f32, light: Light) -> Scene {
     )
 }
 
-struct Frame {
-    tech: ImageSpace,
-    scene_gpu: SceneGpu,
-    targets: FrameTargets,
-}
+type Frame = ImageSpaceFrame;
 
 fn render(ctx: &Arc<Context>, scene: &Scene, overrides: &[&str]) -> Frame {
-    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let params = Params::resolve("image_space", PARAMS, &overrides).unwrap();
-    let scene_gpu = SceneGpu::new(ctx, scene, 0.0).unwrap();
-    let targets = FrameTargets::new(ctx, SIZE, SIZE).unwrap();
-    let mut tech = ImageSpace::new(ctx, &params, scene, &scene_gpu, SIZE, SIZE).unwrap();
-    scene_gpu.update_frame(scene, SIZE, SIZE, 0.0, 0).unwrap();
-    let profiler = Profiler::new(ctx, 64).unwrap();
-    profiler
-        .frame(|rec| tech.record(rec, &scene_gpu, &targets))
-        .unwrap();
-    Frame {
-        tech,
-        scene_gpu,
-        targets,
-    }
+    render_image_space(ctx, scene, overrides, SIZE)
 }
 
 fn photons(f: &Frame) -> Vec<GpuPhoton> {
@@ -636,11 +617,7 @@ fn caustics_match_reference(name: &str, photons: u64, bounds: &[Bound]) {
     let half_a = masked(reference.resolve(Component::SurfaceCaustics).unwrap());
     reference.trace(photons / 2, |_, _| {}).unwrap();
     let truth = masked(reference.resolve(Component::SurfaceCaustics).unwrap());
-    let half_b: Vec<f32> = truth
-        .iter()
-        .zip(&half_a)
-        .map(|(t, a)| 2.0 * t - a)
-        .collect();
+    let half_b = second_half(&truth, &half_a);
     let (noise_flip, _) = flip(&tonemap(&half_b), &tonemap(&half_a), SIZE);
     let truth_ldr = tonemap(&truth);
     let t = energy(&truth);

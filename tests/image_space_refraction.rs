@@ -22,11 +22,10 @@
 mod common;
 
 use caustics::radiometry::fresnel_dielectric;
-use caustics::renderer::{FrameTargets, SceneGpu};
 use caustics::scene::{Camera, Scene};
 use caustics::techniques::image_space::{ImageSpace, PARAMS};
-use caustics::techniques::{Params, Technique};
-use caustics::vk::{Context, Profiler};
+use caustics::techniques::Params;
+use caustics::vk::Context;
 use common::*;
 use glam::Vec3;
 use std::sync::Arc;
@@ -39,19 +38,13 @@ struct Frame {
 }
 
 fn render(ctx: &Arc<Context>, scene: &Scene, overrides: &[&str]) -> Frame {
-    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let params = Params::resolve("image_space", PARAMS, &overrides).unwrap();
-    let scene_gpu = SceneGpu::new(ctx, scene, 0.0).unwrap();
-    let targets = FrameTargets::new(ctx, SIZE, SIZE).unwrap();
-    let mut tech = ImageSpace::new(ctx, &params, scene, &scene_gpu, SIZE, SIZE).unwrap();
-    scene_gpu.update_frame(scene, SIZE, SIZE, 0.0, 0).unwrap();
-    let profiler = Profiler::new(ctx, 64).unwrap();
-    profiler
-        .frame(|rec| tech.record(rec, &scene_gpu, &targets))
-        .unwrap();
-    let radiance = targets.radiance.download_rgba32f().unwrap();
+    let f = render_image_space(ctx, scene, overrides, SIZE);
+    let radiance = f.targets.radiance.download_rgba32f().unwrap();
     assert_finite(&radiance);
-    Frame { tech, radiance }
+    Frame {
+        tech: f.tech,
+        radiance,
+    }
 }
 
 /// The opaque frame (the scene without its specular surfaces) of `f`.

@@ -27,24 +27,25 @@ use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
 
-pub const PARAMS: &[ParamSpec] = &[
-    ParamSpec {
-        name: "shadow_map_size",
-        description: "shadow map resolution per view (texels per side)",
-        min: 64.0,
-        max: 4096.0,
-        default: 1024.0,
-        integer: true,
-    },
-    ParamSpec {
-        name: "pcf_radius",
-        description: "percentage-closer filter half-width in shadow texels (0: one tap)",
-        min: 0.0,
-        max: 4.0,
-        default: 1.0,
-        integer: true,
-    },
-];
+/// The shadow-map parameters, shared by every technique built on `Direct`.
+pub const SHADOW_MAP_SIZE: ParamSpec = ParamSpec {
+    name: "shadow_map_size",
+    description: "shadow map resolution per view (texels per side)",
+    min: 64.0,
+    max: 4096.0,
+    default: 1024.0,
+    integer: true,
+};
+pub const PCF_RADIUS: ParamSpec = ParamSpec {
+    name: "pcf_radius",
+    description: "percentage-closer filter half-width in shadow texels (0: one tap)",
+    min: 0.0,
+    max: 4.0,
+    default: 1.0,
+    integer: true,
+};
+
+pub const PARAMS: &[ParamSpec] = &[SHADOW_MAP_SIZE, PCF_RADIUS];
 
 /// Push constants of glsl/direct/lighting.comp.
 #[repr(C)]

@@ -312,3 +312,43 @@ pub fn write_comparison_pngs(
     );
     dir.display().to_string()
 }
+
+/// One `image_space` frame of `scene` at `size`², rendered straight
+/// through the technique (no tonemap), with its resources kept for reading.
+pub struct ImageSpaceFrame {
+    pub tech: caustics::techniques::image_space::ImageSpace,
+    pub scene_gpu: caustics::renderer::SceneGpu,
+    pub targets: caustics::renderer::FrameTargets,
+}
+
+pub fn render_image_space(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    overrides: &[&str],
+    size: u32,
+) -> ImageSpaceFrame {
+    use caustics::renderer::{FrameTargets, SceneGpu};
+    use caustics::techniques::image_space::{ImageSpace, PARAMS};
+    use caustics::techniques::{Params, Technique};
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let params = Params::resolve("image_space", PARAMS, &overrides).unwrap();
+    let scene_gpu = SceneGpu::new(ctx, scene, 0.0).unwrap();
+    let targets = FrameTargets::new(ctx, size, size).unwrap();
+    let mut tech = ImageSpace::new(ctx, &params, scene, &scene_gpu, size, size).unwrap();
+    scene_gpu.update_frame(scene, size, size, 0.0, 0).unwrap();
+    let profiler = caustics::vk::Profiler::new(ctx, 64).unwrap();
+    profiler
+        .frame(|rec| tech.record(rec, &scene_gpu, &targets))
+        .unwrap();
+    ImageSpaceFrame {
+        tech,
+        scene_gpu,
+        targets,
+    }
+}
+
+/// The second half of a reference rendered in two equal halves: the
+/// resolve divides by the photon count, so half_b = 2 whole - half_a.
+pub fn second_half(whole: &[f32], half_a: &[f32]) -> Vec<f32> {
+    whole.iter().zip(half_a).map(|(t, a)| 2.0 * t - a).collect()
+}

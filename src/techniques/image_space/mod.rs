@@ -45,7 +45,7 @@ mod refraction;
 
 pub use refraction::{CameraRefraction, RefractionPush};
 
-use super::direct::Direct;
+use super::direct::{self, Direct};
 use super::{ParamSpec, Params, Technique};
 use crate::passes::caustic_map::{CausticMap, PhotonPaths};
 use crate::passes::gbuffer::GBufferContents;
@@ -60,22 +60,8 @@ use ash::vk;
 use std::sync::Arc;
 
 pub const PARAMS: &[ParamSpec] = &[
-    ParamSpec {
-        name: "shadow_map_size",
-        description: "shadow map resolution per view (texels per side)",
-        min: 64.0,
-        max: 4096.0,
-        default: 1024.0,
-        integer: true,
-    },
-    ParamSpec {
-        name: "pcf_radius",
-        description: "percentage-closer filter half-width in shadow texels (0: one tap)",
-        min: 0.0,
-        max: 4.0,
-        default: 1.0,
-        integer: true,
-    },
+    direct::SHADOW_MAP_SIZE,
+    direct::PCF_RADIUS,
     ParamSpec {
         name: "photon_buffer_size",
         description: "photon buffer resolution (photons per side of the light view)",
