@@ -113,9 +113,12 @@ impl CascadeLayout {
             scale.is_finite() && scale > 1.0,
             "cascade scale factor must be above 1, got {scale}"
         );
-        // Eq. 6, rounded halves up (module docs).
-        let border =
-            size.map(|n| (n as f64 * (1.0 - 1.0 / scale as f64) * 0.5 + 0.5).floor() as u32);
+        // Eq. 6, rounded halves up (module docs); at most half the side, which
+        // an odd side would exceed for a scale so large that 1 - 1/s rounds
+        // to 1.
+        let border = size.map(|n| {
+            ((n as f64 * (1.0 - 1.0 / scale as f64) * 0.5 + 0.5).floor() as u32).min(n / 2)
+        });
         let layout = Self {
             size,
             levels,
@@ -340,6 +343,8 @@ mod tests {
         assert_eq!(half.border, [2, 2]);
         check(&half, false);
         assert_eq!(CascadeLayout::new([10, 6], 2, 5.0).unwrap().border, [4, 2]);
+        // 1 - 1/s rounds to 1: the ring stays within an odd side.
+        assert_eq!(CascadeLayout::new([5, 7], 2, 1e30).unwrap().border, [2, 3]);
     }
 
     #[test]

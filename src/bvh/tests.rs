@@ -559,7 +559,7 @@ fn mesh_triangles(mesh: &crate::scene::Mesh) -> Vec<Triangle> {
 fn normal_thickness(triangles: &[Triangle]) -> Vec<f32> {
     let bvh = Bvh::build(triangles);
     let mut gpu = bvh.gpu_triangles(triangles);
-    bvh.set_normal_thickness(&mut gpu, |_| true);
+    bvh.set_normal_thickness(&mut gpu, |_, _| true);
     gpu.iter()
         .flat_map(|t| [t.n0[3], t.n1[3], t.n2[3]])
         .collect()
@@ -608,7 +608,7 @@ fn normal_thickness_of_a_slab_is_its_thickness() {
     let extent = max - min;
     let bvh = Bvh::build(&tris);
     let mut gpu = bvh.gpu_triangles(&tris);
-    bvh.set_normal_thickness(&mut gpu, |_| true);
+    bvh.set_normal_thickness(&mut gpu, |_, _| true);
     for t in &gpu {
         for n in [t.n0, t.n1, t.n2] {
             let normal = Vec3::new(n[0], n[1], n[2]);
@@ -621,7 +621,7 @@ fn normal_thickness_of_a_slab_is_its_thickness() {
         }
     }
     // Not a refractor: 0.
-    bvh.set_normal_thickness(&mut gpu, |_| false);
+    bvh.set_normal_thickness(&mut gpu, |_, _| false);
     assert!(gpu
         .iter()
         .all(|t| t.n0[3] == 0.0 && t.n1[3] == 0.0 && t.n2[3] == 0.0));
@@ -645,7 +645,7 @@ fn normal_thickness_ignores_other_objects() {
     tris.extend(inner);
     let bvh = Bvh::build(&tris);
     let mut gpu = bvh.gpu_triangles(&tris);
-    bvh.set_normal_thickness(&mut gpu, |_| true);
+    bvh.set_normal_thickness(&mut gpu, |_, _| true);
     for t in &gpu {
         let expected = if t.p1[3].to_bits() == 0 { 2.0 } else { 0.4 };
         for d in [t.n0[3], t.n1[3], t.n2[3]] {

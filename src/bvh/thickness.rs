@@ -34,15 +34,15 @@ impl Bvh {
     pub fn set_normal_thickness(
         &self,
         tris: &mut [GpuTriangle],
-        is_refractor: impl Fn(u32) -> bool,
+        is_refractor: impl Fn(u32, u32) -> bool,
     ) {
         let thickness: Vec<[f32; 3]> = tris
             .iter()
             .map(|t| {
-                if !is_refractor(t.p0[3].to_bits()) {
+                let object = t.p1[3].to_bits();
+                if !is_refractor(t.p0[3].to_bits(), object) {
                     return [0.0; 3];
                 }
-                let object = t.p1[3].to_bits();
                 let centroid = (v3(t.p0) + v3(t.p1) + v3(t.p2)) / 3.0;
                 let corner = |p: [f32; 4], n: [f32; 4]| {
                     // Start a hair inside the triangle: a ray from the

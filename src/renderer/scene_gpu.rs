@@ -43,6 +43,9 @@ pub struct SceneGpu {
     /// The path-type components techniques draw (`Component::mask` bits),
     /// written into the frame constants; all of them unless a caller narrows it.
     pub components: u32,
+    /// Per uploaded triangle, the d_N of its three vertices (kept across
+    /// refits, see `update_geometry`).
+    normal_thickness: Vec<[f32; 3]>,
     bvh: Bvh,
 }
 
@@ -54,12 +57,19 @@ fn gpu_medium(scene: &Scene) -> GpuMedium {
         .unwrap_or_else(GpuMedium::none)
 }
 
-/// Dielectric materials get Wyman's per-vertex d_N (`Bvh::set_normal_thickness`).
-fn is_refractor(scene: &Scene, material: u32) -> bool {
-    scene
+/// Closed dielectric objects get Wyman's per-vertex d_N
+/// (`Bvh::set_normal_thickness`). Water is an open sheet: it has no far
+/// side, so its d_N stays 0 (the shaders then use d_V).
+fn is_refractor(scene: &Scene, material: u32, object: u32) -> bool {
+    let dielectric = scene
         .materials
         .get(material as usize)
-        .is_some_and(|m| m.kind == MaterialKind::Dielectric)
+        .is_some_and(|m| m.kind == MaterialKind::Dielectric);
+    let water = scene
+        .objects
+        .get(object as usize)
+        .is_some_and(|o| o.water.is_some());
+    dielectric && !water
 }
 
 /// View and projection for Vulkan: right-handed view, depth 0..1, y down in
@@ -91,6 +101,10 @@ impl SceneGpu {
         let triangles = scene.triangles(time);
         let bvh = Bvh::build(&triangles);
         let gpu_triangles = Self::gpu_triangles(scene, &bvh, &triangles);
+        let normal_thickness = gpu_triangles
+            .iter()
+            .map(|t| [t.n0[3], t.n1[3], t.n2[3]])
+            .collect();
         let stats = GeometryStats {
             triangles: triangles.len(),
             bvh_nodes: bvh.nodes.len(),
@@ -152,6 +166,7 @@ impl SceneGpu {
             sphere,
             components: Component::All.mask(),
             geometry_time: time,
+            normal_thickness,
             bvh,
         })
     }
@@ -160,7 +175,7 @@ impl SceneGpu {
     /// leaf order, with Wyman's per-vertex d_N on the dielectric ones.
     pub fn gpu_triangles(scene: &Scene, bvh: &Bvh, triangles: &[Triangle]) -> Vec<GpuTriangle> {
         let mut gpu = bvh.gpu_triangles(triangles);
-        bvh.set_normal_thickness(&mut gpu, |m| is_refractor(scene, m));
+        bvh.set_normal_thickness(&mut gpu, |m, o| is_refractor(scene, m, o));
         gpu
     }
 
@@ -175,9 +190,13 @@ impl SceneGpu {
     pub fn update_geometry(&mut self, scene: &Scene, time: f32) -> VkResult<()> {
         let triangles = scene.triangles(time);
         self.bvh.refit(&triangles);
-        // Deforming refractors (water) change their thickness: d_N is
-        // recomputed with the geometry (3 rays per refractor triangle).
-        let gpu_triangles = Self::gpu_triangles(scene, &self.bvh, &triangles);
+        // d_N is kept from the upload: the `animate` motions are rigid, which
+        // leaves every thickness unchanged, and water, the only geometry that
+        // deforms, has none. (A refit keeps the leaf order.)
+        let mut gpu_triangles = self.bvh.gpu_triangles(&triangles);
+        for (t, d) in gpu_triangles.iter_mut().zip(&self.normal_thickness) {
+            (t.n0[3], t.n1[3], t.n2[3]) = (d[0], d[1], d[2]);
+        }
         self.triangles
             .upload(bytemuck::cast_slice(&gpu_triangles))?;
         self.bvh_nodes
