@@ -14,8 +14,16 @@
 //! - tir_remedies_fill_and_differ: 2116 glass pixels, black pixels per
 //!   remedy [0, 0, 0] (bound 1% for remedies 1 and 2); pixels differing
 //!   between remedies 0-1: 958, 1-2: 1011, 0-2: 1035 (bound 10% each).
-//! - eq_6_3_2_fills_pixels_without_a_back_normal: 5866 sheet pixels, all
-//!   brighter with Eq. 6.3.2 than without, none darker (bound: over half).
+//! - eq_6_3_2_fills_pixels_without_a_back_normal: closed 8-segment ball,
+//!   1588 glass pixels, 4 brighter with Eq. 6.3.2 than without, none
+//!   darker (bound: at least one, none darker).
+//! - open_sheet_refracts_once: 2476 pixels through an open IOR 1.33
+//!   sheet, worst relative error against F 0 + (1 - F)/n^2 L_floor 4.4e-6
+//!   (L / L_floor 0.54065 at the worst pixel); L_floor 0.74852 (albedo/pi
+//!   (1 - F(0)) E = 0.74862); bound 1e-3.
+//! - opaque_object_in_front_of_glass_occludes_it: 2721 box pixels, 258 of
+//!   them in front of the ball, worst relative difference from the opaque
+//!   frame 0 (bound 1e-6).
 //! - mirror_reflects_the_floor: 1490 mirror pixels whose reflection meets
 //!   the visible floor, worst relative error 0 (bound 1e-3).
 
@@ -314,22 +322,26 @@ fn bad_refraction_parameters_are_rejected() {
 
 // --- Eq. 6.3.2 --------------------------------------------------------------
 
-/// An open dielectric sheet (a water surface without a bottom, IOR 1.33)
-/// above a lit floor: the back-face texture is empty under every pixel, so
-/// N2 always comes from Eq. 6.3.2 (d_V = d_N = 0, p2 = p1). With
-/// `eq_6_3_2=0` the transmitted light is dropped and only the Fresnel
-/// reflection (of the black sky) remains; with the default the pixels keep
-/// it: none darker, most brighter.
+/// A closed refractor (a coarse 8-segment ball, IOR 1.33, whose flat-ish
+/// facets make d~ overshoot past the back faces near its silhouette)
+/// above a lit floor: where the back-face texel at p2 is empty, N2 comes
+/// from Eq. 6.3.2. With `eq_6_3_2=0` the transmitted light of those pixels
+/// is dropped (only the Fresnel reflection remains); with the default they
+/// keep it: none darker, some brighter. Closed refractors rarely need it:
+/// measured 0 pixels for the 64-segment ball (IOR 1.33 and 2.4) and for
+/// boxes seen from four viewpoints, 4 here. (An open sheet is not this
+/// case: it has no back surface at all and is refracted once, see
+/// `open_sheet_refracts_once`.)
 #[test]
 fn eq_6_3_2_fills_pixels_without_a_back_normal() {
     let ctx = validated_context();
     let s = scene(
-        camera(Vec3::new(0.0, 3.0, 3.0), Vec3::new(0.0, 0.5, 0.0), 40.0),
+        camera(Vec3::new(0.0, 5.0, 7.0), Vec3::new(0.0, 1.2, 0.0), 40.0),
         vec![directional_light(Vec3::NEG_Y, 3.0)],
         vec![diffuse("floor", 0.8), dielectric("water", 1.33)],
         vec![
             object("floor", floor_mesh(5.0, 0.0, 0)),
-            object("water surface", floor_mesh(1.0, 1.0, 1)),
+            object("ball", sphere_mesh(CENTRE, RADIUS, 1, 8)),
         ],
     );
     let on = render(&ctx, &s, &[]);
@@ -350,11 +362,152 @@ fn eq_6_3_2_fills_pixels_without_a_back_normal() {
     let glass = cover.iter().filter(|&&c| c).count();
     println!("Eq. 6.3.2 on vs off: of {glass} glass pixels, {brighter} brighter, {darker} darker");
     assert!(glass > 1000);
-    assert!(
-        2 * brighter > glass,
-        "Eq. 6.3.2 applied to {brighter} pixels only"
-    );
+    assert!(brighter >= 1, "Eq. 6.3.2 applied to no pixel");
     assert_eq!(darker, 0);
+    assert_validation_clean(&ctx);
+}
+
+// --- open sheets: one interface ----------------------------------------------
+
+const SHEET_IOR: f32 = 1.33;
+const SHEET_Y: f32 = 1.0;
+
+/// A flat open dielectric sheet (a water surface with no bottom, IOR 1.33,
+/// no absorption, 2 m x 2 m at y = 1) over a diffuse floor lit straight
+/// down, seen from above. It has no back surface (empty back-face texture,
+/// d_N = 0), so the camera refracts once: the reflected ray heads up into
+/// the black environment and
+///   L = F(theta) * 0 + (1 - F(theta)) / n^2 * L_floor(x),
+/// x the floor point met along T1 (Snell at p1, computed here
+/// analytically), L_floor(x) the opaque frame's radiance at x's pixel
+/// (the floor under the sheet: albedo/pi (1 - F(0)) E through the caustic
+/// map). 1/n^2: radiance leaving water into air (basic radiance L/n^2 is
+/// conserved). Pixels whose p1 lies 5 cm inside the sheet's edge and whose
+/// x lies 15 cm inside the sheet's shadow (the caustic map's splat rim).
+/// Measured worst relative error 4.4e-6 (the floor under the sheet is
+/// uniform to float rounding there); bound 1e-3, for a search landing a
+/// pixel off x on a floor that varies by the caustic map's splats.
+#[test]
+fn open_sheet_refracts_once() {
+    let ctx = validated_context();
+    let s = scene(
+        camera(Vec3::new(0.0, 3.0, 3.0), Vec3::new(0.0, 0.5, 0.0), 40.0),
+        vec![directional_light(Vec3::NEG_Y, 3.0)],
+        vec![diffuse("floor", 0.8), dielectric("water", SHEET_IOR)],
+        vec![
+            object("floor", floor_mesh(5.0, 0.0, 0)),
+            object("water surface", floor_mesh(1.0, SHEET_Y, 1)),
+        ],
+    );
+    let f = render(&ctx, &s, &[]);
+    let behind = opaque(&f);
+    let cover = covered(&f);
+    let (view, proj) = caustics::renderer::camera_matrices(&s.camera, 1.0);
+    let eta = 1.0 / SHEET_IOR;
+    let (mut n, mut worst, mut floor_min, mut floor_max) = (0, 0.0f32, f32::MAX, 0.0f32);
+    let mut worst_ratio = (0.0f32, 0.0f32);
+    for py in 0..SIZE {
+        for px in 0..SIZE {
+            let (o, d) = pixel_ray(&s.camera, SIZE, SIZE, px, py);
+            if d.y >= 0.0 {
+                continue;
+            }
+            let p1 = o + d * ((SHEET_Y - o.y) / d.y);
+            if p1.x.abs() > 0.95 || p1.z.abs() > 0.95 {
+                continue;
+            }
+            let i = (py * SIZE + px) as usize;
+            assert!(cover[i], "sheet pixel ({px}, {py}) not covered");
+            let cos_i = -d.y;
+            let cos_t = (1.0 - eta * eta * (1.0 - cos_i * cos_i)).sqrt();
+            let t1 = eta * d + (eta * cos_i - cos_t) * Vec3::Y;
+            let x = p1 + t1 * (-p1.y / t1.y);
+            if x.x.abs() > 0.85 || x.z.abs() > 0.85 {
+                continue;
+            }
+            let ndc = (proj * view).project_point3(x);
+            let j = 4
+                * (((ndc.y * 0.5 + 0.5) * SIZE as f32) as u32 * SIZE
+                    + ((ndc.x * 0.5 + 0.5) * SIZE as f32) as u32) as usize;
+            let l_floor = behind[j];
+            floor_min = floor_min.min(l_floor);
+            floor_max = floor_max.max(l_floor);
+            let fr = fresnel_dielectric(cos_i, eta);
+            let expected = (1.0 - fr) / (SHEET_IOR * SHEET_IOR) * l_floor;
+            let err = (f.radiance[4 * i] - expected).abs() / expected;
+            if err > worst {
+                worst = err;
+                worst_ratio = (f.radiance[4 * i] / l_floor, expected / l_floor);
+            }
+            n += 1;
+        }
+    }
+    let e_under = 0.8 / std::f32::consts::PI * 3.0 * (1.0 - fresnel_dielectric(1.0, eta));
+    println!(
+        "open sheet: {n} pixels, worst relative error {worst:.2e} (L / L_floor {:.5} vs {:.5}); \
+         L_floor over the hits {floor_min:.5}..{floor_max:.5} (albedo/pi (1 - F0) E = {e_under:.5})",
+        worst_ratio.0, worst_ratio.1
+    );
+    assert!(n > 1000);
+    assert!(worst < 1e-3, "worst relative error {worst}");
+    assert_validation_clean(&ctx);
+}
+
+// --- occlusion: opaque objects in front of glass -----------------------------
+
+/// Distance along the ray (o, d) to the box [lo, hi], if it hits.
+fn ray_box(o: Vec3, d: Vec3, lo: Vec3, hi: Vec3) -> Option<f32> {
+    let inv = d.recip();
+    let (a, b) = ((lo - o) * inv, (hi - o) * inv);
+    let (near, far) = (a.min(b).max_element(), a.max(b).min_element());
+    (near <= far && far > 0.0).then_some(near)
+}
+
+/// A diffuse box partly in front of the glass ball (IOR 1.5): where the box
+/// is nearer, the camera sees the box, so the frame equals the opaque frame
+/// there (the specular G-buffer's front pass lets diffuse geometry occlude).
+/// Pixels whose ray hits the box shrunk by 5 cm (2 pixels at that depth:
+/// away from its silhouette); among them, those whose ray would meet the
+/// ball behind the box show the bug this guards against. Bound: 1e-6
+/// relative (the value is copied).
+#[test]
+fn opaque_object_in_front_of_glass_occludes_it() {
+    let ctx = validated_context();
+    let (lo, hi) = (Vec3::new(-1.5, 0.0, 1.2), Vec3::new(0.1, 1.4, 1.6));
+    let s = scene(
+        camera(Vec3::new(0.0, 2.5, 6.0), CENTRE, 40.0),
+        vec![point_light(LIGHT, 60.0)],
+        vec![diffuse("floor", 0.8), dielectric("glass", 1.5)],
+        vec![
+            object("floor", floor_mesh(5.0, 0.0, 0)),
+            object("box", box_mesh(lo, hi, 0)),
+            object("ball", sphere_mesh(CENTRE, RADIUS, 1, 64)),
+        ],
+    );
+    let f = render(&ctx, &s, &[]);
+    let behind = opaque(&f);
+    let margin = Vec3::splat(0.05);
+    let (mut n, mut n_over_ball, mut worst) = (0, 0, 0.0f32);
+    for py in 0..SIZE {
+        for px in 0..SIZE {
+            let (o, d) = pixel_ray(&s.camera, SIZE, SIZE, px, py);
+            if ray_box(o, d, lo + margin, hi - margin).is_none() {
+                continue;
+            }
+            let i = 4 * (py * SIZE + px) as usize;
+            for c in 0..3 {
+                let e = (f.radiance[i + c] - behind[i + c]).abs() / behind[i + c].max(1e-6);
+                worst = worst.max(e);
+            }
+            if miss_distance(o, d) < RADIUS {
+                n_over_ball += 1;
+            }
+            n += 1;
+        }
+    }
+    println!("occlusion: {n} box pixels, {n_over_ball} in front of the ball, worst relative difference {worst:.2e}");
+    assert!(n_over_ball > 200);
+    assert!(worst < 1e-6, "worst relative difference {worst}");
     assert_validation_clean(&ctx);
 }
 

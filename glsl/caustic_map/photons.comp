@@ -222,7 +222,21 @@ bool image_space_refraction(uvec2 id, vec3 p1, vec3 n1, vec3 d, uint m, float d_
     dir = vec3(0.0);
     float ior = materials[m].absorption_ior.w;
     vec4 bp = imageLoad(back_position, ivec2(id));
-    if (bp.w < 0.0) return false;
+    if (bp.w < 0.0) {
+        // No back face at this texel. With d_N > 0 the refractor is closed
+        // and its back face just missed (silhouette): dropped, as before.
+        // With d_N = 0 it has no back surface (an open sheet, e.g. water):
+        // one interface, as the camera does it (refraction.comp): refract
+        // once at p1 and land through the BVH, Beer-Lambert over the path
+        // to the landing point (flux crosses with 1 - F1 only, no n^2).
+        if (d_n > 0.0) return false;
+        vec3 t1;
+        if (!refract_dir(d, n1, 1.0 / ior, t1)) return false;
+        if (!land(p1, t1, p3)) return false;
+        w *= exp(-materials[m].absorption_ior.rgb * length(p3 - p1));
+        dir = t1;
+        return true;
+    }
     float d_v = length(bp.xyz - p1);
     if (pc.mode.x == PHOTON_MODE_IMAGE_SPACE) {
         TwoSidedExit e;

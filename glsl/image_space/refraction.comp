@@ -14,6 +14,17 @@
 // (Eq. 6.3.1, back-face normal texture, Eq. 6.3.2, TIR remedies). Radiance
 // entering glass is scaled by (n2/n1)^2 and leaving it by (n1/n2)^2: across
 // the two interfaces the factors cancel, so no n^2 appears here.
+// One interface (an open sheet such as a water surface: the back-face
+// texel is empty and the pixel's d_N is 0, so the refractor has no back
+// surface at all): L = F1 L(p1, R) + (1 - F1)/n^2 exp(-sigma_a t) L(x, T1),
+// T1 Snell at p1 and x the opaque surface met along it at distance t.
+// Derivation: basic radiance L/n^2 is conserved along a ray and across a
+// smooth interface up to the transmitted fraction 1 - F (F symmetric in
+// direction). The floor's radiance L(x, -T1) is radiance in the medium of
+// index n; crossing into air (index 1) it becomes (1 - F1) L (1/n)^2, and
+// Beer-Lambert attenuates it over the path t inside the medium. The
+// opaque frame holds L(x) as radiance of the surface (albedo/pi E), the
+// medium around the receiver being the refractor's.
 // Mirror at p1: L = reflectance * L(p1, R).
 // L(o, d): the image-space search of the opaque frame (below); a ray that
 // leaves the view or the scene's bounding sphere reads the environment,
@@ -123,7 +134,8 @@ float frustum_exit(vec3 o, vec3 d) {
 // exceeds one step plus the surface's depth change across a pixel is the
 // ray passing behind a nearer object, not meeting it: the march goes on. Past the frustum nothing can be found (the
 // frustum is convex, the ray never comes back): environment.
-vec3 search_opaque(vec3 o, vec3 d) {
+vec3 search_opaque_hit(vec3 o, vec3 d, out float t_hit) {
+    t_hit = -1.0;
     vec3 oc = o - frame.scene_sphere.xyz;
     float b = dot(oc, d);
     float disc = b * b - (dot(oc, oc) - frame.scene_sphere.w * frame.scene_sphere.w);
@@ -146,11 +158,19 @@ vec3 search_opaque(vec3 o, vec3 d) {
                 if (behind_opaque(o + mid * d, qm, gm)) hi = mid; else lo = mid;
             }
             behind_opaque(o + hi * d, q, gap);
-            if (gap <= step + pixel_depth_extent(q)) return imageLoad(opaque_radiance, q).rgb;
+            if (gap <= step + pixel_depth_extent(q)) {
+                t_hit = hi;
+                return imageLoad(opaque_radiance, q).rgb;
+            }
         }
         t_prev = t;
     }
     return ENVIRONMENT;
+}
+
+vec3 search_opaque(vec3 o, vec3 d) {
+    float t_hit;
+    return search_opaque_hit(o, d, t_hit);
 }
 
 void main() {
@@ -181,10 +201,25 @@ void main() {
     // d_V: front to the farthest back face along this pixel's ray; a sheet
     // with no back face here has no thickness.
     vec4 bp = imageLoad(back_position, p);
+    vec3 sigma_a = materials[m].absorption_ior.rgb;
+    if (bp.w < 0.0 && fp.w <= 0.0) {
+        // One interface (no back face here and no d_N: an open sheet, see
+        // the header). Eq. 6.3.2 stays for closed objects whose back-face
+        // texel at p2 is empty (d_N > 0 there).
+        vec3 t1;
+        if (refract_dir(v, n1, 1.0 / ior, t1)) {
+            float t;
+            vec3 behind = search_opaque_hit(p1, t1, t);
+            vec3 absorbed = exp(-sigma_a * max(t, 0.0));
+            l += (1.0 - f1) / (ior * ior) * absorbed * behind;
+        }
+        imageStore(radiance, p, vec4(l, 1.0));
+        return;
+    }
     float d_v = bp.w >= 0.0 ? max(length(bp.xyz - p1), 0.0) : 0.0;
     TwoSidedExit e;
     if (two_sided_refraction(v, p1, n1, ior, d_v, fp.w, pc.tir_remedy, pc.use_eq632 != 0u, e)) {
-        vec3 absorbed = exp(-materials[m].absorption_ior.rgb * e.dist);
+        vec3 absorbed = exp(-sigma_a * e.dist);
         l += (1.0 - f1) * e.transmit * absorbed * search_opaque(e.p2, e.dir);
     }
     imageStore(radiance, p, vec4(l, 1.0));

@@ -5,6 +5,14 @@
 // from the viewer (reversed depth, see the vertex stage). Stores world
 // position with the interpolated d_N in w (clear value -1: not covered) and
 // the smooth outward normal with the material index in w.
+// Diffuse geometry occludes in the front pass: it writes its depth and
+// marks the texel not covered (w = -1), so glass behind an opaque object
+// is not refracted over it (camera) and emits no photons from its shadow
+// (light view). The back pass ignores diffuse geometry: it wants the
+// refractor's own farthest back face, and an opaque object inside or
+// behind the refractor must not replace it (back texels are read at the
+// projection of p2, inside the refractor, where its own back face is the
+// one wanted even where something opaque hides it from the viewer).
 #include "scene.glsl"
 
 layout(push_constant) uniform Push {
@@ -23,8 +31,13 @@ layout(location = 1) out vec4 out_normal;
 
 void main() {
     uint kind = material_kind(v_material);
-    if (kind == MATERIAL_DIFFUSE) discard;
     bool back_pass = floatBitsToUint(pc.forward.w) == SPECULAR_GBUFFER_BACK;
+    if (kind == MATERIAL_DIFFUSE) {
+        if (back_pass) discard;
+        out_position = vec4(0.0, 0.0, 0.0, -1.0); // NOT_COVERED
+        out_normal = vec4(0.0);
+        return;
+    }
     uint view = floatBitsToUint(pc.origin.w);
     vec3 ray = view == SHADOW_PLANAR ? pc.forward.xyz
              : v_position - (view == SPECULAR_VIEW_CAMERA ? frame.eye.xyz : pc.origin.xyz);

@@ -6,9 +6,12 @@
 //! - front: the nearest dielectric face turned toward the viewer, or the
 //!   nearest mirror face; position with the interpolated per-vertex d_N
 //!   (`Bvh::set_normal_thickness`) in w, normal with the material in w;
+//!   diffuse geometry writes depth here and marks its texels not covered,
+//!   so a refractor behind an opaque object is hidden by it;
 //! - back: the farthest dielectric face turned away from the viewer
 //!   (Wyman's preferred second interface for non-convex refractors: "the
-//!   surface farthest from the eye"), position and normal.
+//!   surface farthest from the eye"), position and normal; diffuse
+//!   geometry is ignored (it must not replace the refractor's back face).
 //!
 //! Layout (RGBA32F each, storage + colour attachment): position xyz, w =
 //! d_N (front) or 0 (back), -1 where nothing covers the texel; normal xyz

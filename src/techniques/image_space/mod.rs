@@ -39,7 +39,17 @@
 //! a pixel's depth footprint) is taken for a ray passing behind a nearer
 //! object; glass seen through
 //! glass (nested or overlapping refractors) is not refracted twice: the
-//! opaque frame has no specular surfaces.
+//! opaque frame has no specular surfaces. Open sheets (water: a dielectric
+//! with no back surface, i.e. an empty back-face texel and d_N = 0) are one
+//! interface: Snell once at p1, L = F1 L_reflected + (1 - F1)/n^2
+//! exp(-sigma_a t) L_behind (radiance leaving the medium into air), and
+//! photon modes 1 and 2 refract such photons once and land them through
+//! the BVH; a camera below the sheet sees it as a back face, not refracted
+//! (the opaque frame). Diffuse geometry occludes in the specular G-buffer's
+//! front pass, so glass behind an opaque object is not drawn over it; the
+//! back pass ignores diffuse geometry and keeps the farthest back face of
+//! any refractor, so two refractors one behind the other (with or without
+//! an opaque object between) share one back-face texture.
 
 mod refraction;
 
