@@ -243,7 +243,11 @@ fn slab_head_on_transmits_fresnel_and_beer_lambert() {
 /// top. Remedies 1 (clamp: tangent to the side, still downward) and 2
 /// (reflect off the side: still downward) send those rays on to the lit
 /// floor, so their pixels must be finite and not black; the three remedies
-/// must differ where TIR happens.
+/// must differ where TIR happens. No remedy may create light: a glass pixel
+/// is F1 L_reflected + (1 - F1)(1 - F2) L_behind (a remedy keeps T2's
+/// weight at most 1) with both radiances read from the opaque frame (or the
+/// black environment), so it cannot exceed the opaque frame's brightest
+/// pixel, channel by channel.
 #[test]
 fn tir_remedies_fill_and_differ() {
     let ctx = validated_context();
@@ -301,6 +305,26 @@ fn tir_remedies_fill_and_differ() {
             d as f64 > 0.1 * glass.len() as f64,
             "remedies differ in {d} pixels only"
         );
+    }
+    for (r, f) in frames.iter().enumerate() {
+        let behind = opaque(f);
+        for c in 0..3 {
+            let brightest = behind
+                .iter()
+                .skip(c)
+                .step_by(4)
+                .cloned()
+                .fold(0.0f32, f32::max);
+            let worst = glass
+                .iter()
+                .map(|&i| f.radiance[4 * i + c])
+                .fold(0.0f32, f32::max);
+            println!("remedy {r}, channel {c}: brightest glass pixel {worst:.5}, brightest opaque pixel {brightest:.5}");
+            assert!(
+                worst <= brightest * (1.0 + 1e-5),
+                "remedy {r}: a glass pixel ({worst}) is brighter than anything behind it ({brightest})"
+            );
+        }
     }
     assert_validation_clean(&ctx);
 }
