@@ -709,3 +709,43 @@ fn l_min_is_the_dimmest_light_irradiance() {
     assert!((l(vec![sun, far_point, near_point]).x - 0.5).abs() < 1e-4);
     assert_eq!(l(vec![]), Vec3::ZERO);
 }
+
+/// `DENOISE_PARAMS` through `Params::resolve`: the kinds map to the
+/// configurations, and out-of-range values are refused naming the parameter.
+#[test]
+fn params_select_the_denoiser() {
+    use caustics::techniques::water_photons_denoise::DENOISE_PARAMS;
+    use caustics::techniques::Params;
+    let config = |overrides: &[&str]| {
+        let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        Params::resolve("water_photons", DENOISE_PARAMS, &o).map(|p| DenoiseConfig::from_params(&p))
+    };
+    assert_eq!(config(&[]).unwrap(), Some(adaptive(1)));
+    assert_eq!(config(&["denoise=0"]).unwrap(), None);
+    assert_eq!(
+        config(&["denoise=2", "denoise_passes=10", "denoise_radius=7"]).unwrap(),
+        Some(fixed(10, 7))
+    );
+    for (bad, name) in [
+        ("denoise=3", "denoise"),
+        ("denoise_passes=0", "denoise_passes"),
+        ("denoise_radius=1.5", "denoise_radius"),
+    ] {
+        let err = config(&[bad]).unwrap_err().to_string();
+        assert!(err.contains(name), "{bad}: {err}");
+    }
+}
+
+/// Everything the denoiser creates is released: the context shuts down with
+/// no object holding it and no validation error (leaks included).
+#[test]
+fn resources_are_released() {
+    let ctx = validated_context();
+    {
+        let position = gbuffer(|_, _| Some(1.0));
+        let out = denoise(&ctx, adaptive(2), &photons(0.05, 3), &position, L_MIN);
+        common::assert_finite(&out);
+    }
+    let counts = Context::shutdown(ctx).expect("nothing still holds the context");
+    assert_eq!(counts.errors, 0);
+}
