@@ -113,3 +113,19 @@ pub const WATER_SURFACE_BINDING_WAVES: u32 = 0;
 pub const WATER_SURFACE_BINDING_VERTICES: u32 = 1;
 /// Workgroup side of the water surface pass (8 x 8 grid vertices).
 pub const WATER_SURFACE_GROUP_SIZE: u32 = 8;
+
+// water_photons caustics denoiser (src/techniques/water_photons/denoise.rs,
+// glsl/water_photons/denoise.comp), descriptor set 0.
+pub const DENOISE_BINDING_INPUT: u32 = 0;
+pub const DENOISE_BINDING_OUTPUT: u32 = 1;
+pub const DENOISE_BINDING_POSITION: u32 = 2;
+/// Kernel radius choice (Kougianos 2021 Sect. 3.3): per pixel by Eqs. 26-28,
+/// or one constant radius (the filter of their refs [6, 10]).
+pub const DENOISE_KIND_ADAPTIVE: u32 = 1;
+pub const DENOISE_KIND_FIXED: u32 = 2;
+/// Sub-pass axis: neighbours along x (the paper's "column-wise" sub-pass,
+/// Algorithm 4 line 18), then along y.
+pub const DENOISE_AXIS_X: u32 = 0;
+pub const DENOISE_AXIS_Y: u32 = 1;
+/// Workgroup side of the denoise sub-passes (8 x 8 pixels).
+pub const DENOISE_GROUP_SIZE: u32 = 8;

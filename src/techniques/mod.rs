@@ -5,6 +5,8 @@
 
 pub mod direct;
 pub mod image_space;
+#[path = "water_photons/denoise.rs"]
+pub mod water_photons_denoise;
 
 use crate::reference::Component;
 use crate::renderer::{FrameTargets, SceneGpu};
