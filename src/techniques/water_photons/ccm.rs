@@ -59,8 +59,9 @@ impl Ccm {
             format,
             usage,
         };
-        let position = Image::new(ctx, "ccm position", desc(CCM_FORMAT, usage))?;
-        let normal = Image::new(ctx, "ccm normal", desc(CCM_FORMAT, usage))?;
+        // Array views even for one cascade: the trace reads image2DArray.
+        let position = Image::new_array(ctx, "ccm position", desc(CCM_FORMAT, usage))?;
+        let normal = Image::new_array(ctx, "ccm normal", desc(CCM_FORMAT, usage))?;
         let depth = Image::new(
             ctx,
             "ccm depth",

@@ -66,7 +66,7 @@ pub use trace::{GpuWaterPhoton, PhotonCounts, Trace, GUARD_PHOTONS, GUARD_WORD};
 use super::direct::{self, Direct};
 use super::image_space::{CameraRefraction, RefractionPush};
 use super::{ParamSpec, Params, Technique};
-use crate::cascades::{light_view, CascadeLayout, LightRange};
+use crate::cascades::{light_position, CascadeLayout, LightRange};
 use crate::passes::gbuffer::GBufferContents;
 use crate::renderer::{FrameTargets, SceneGpu};
 use crate::scene::{Light, LightKind, Scene, Water};
@@ -244,7 +244,11 @@ impl CascadeFrame {
             .map(|c| -(*c - origin).dot(dir))
             .fold(0.0f32, f32::max);
         let back = behind + 1.0;
-        let view = light_view(origin, dir, 0.0, back);
+        // `cascades::light_view` keeps +y up, which turns the texel grid
+        // against the water's x/z grid under a high sun; up = +z (or +y for
+        // a low sun) lines the two up, so the water fills the map.
+        let up = if dir.y.abs() > 0.5 { Vec3::Z } else { Vec3::Y };
+        let view = Mat4::look_to_rh(light_position(origin, dir, 0.0, back), dir, up);
         let local: Vec<Vec3> = corners.iter().map(|c| view.transform_point3(*c)).collect();
         // View space looks down −z: depth = −z.
         let near = local.iter().map(|p| -p.z).fold(f32::MAX, f32::min) - 0.5;

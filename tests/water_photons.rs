@@ -1,0 +1,484 @@
+//! `water_photons` (Kougianos & Moustakas 2021) on lavapipe, validation on.
+//!
+//! - Algorithm 1 in the trace shader maps threads exactly as the CPU
+//!   (`CascadeLayout::texel_of`).
+//! - Flat water: every photon differential keeps its area (σ = 1 within
+//!   1%), and the caustic on a floor parallel to the water is the analytic
+//!   E cos θ_i (1 − F) (within 1% where the splats tile).
+//! - A long Gerstner crest focuses: σ < 1 under the crest, matching the
+//!   paraxial prediction σ = sqrt(1 − d A k² (n − 1)/n) within 5%.
+//! - The photon count equals a CPU replay of the trace (CPU BVH, rays from
+//!   the CCM read back).
+//! - A tiny photon capacity: the overflow is counted and reported, nothing
+//!   is written past the capacity (guard words intact), the draw's instance
+//!   count is the capacity.
+//! - water_pool seen from a camera below the surface (module docs of
+//!   `water_photons`): the surface-caustics energy within 10% of the
+//!   reference's L S+ D component. A camera above the water sees the floor
+//!   through the surface, an L S D S E path the reference (a light tracer
+//!   connecting diffuse hits to the camera) cannot connect: it renders that
+//!   floor black, so the comparison needs the camera under water.
+
+mod common;
+
+use caustics::cascades::CascadeLayout;
+use caustics::gpu::GpuTriangle;
+use caustics::renderer::{FrameTargets, SceneGpu};
+use caustics::scene::{MaterialKind, Scene, Water, Wave};
+use caustics::shader_bindings as b;
+use caustics::techniques::water_photons::{
+    GpuWaterPhoton, WaterPhotons, GUARD_PHOTONS, GUARD_WORD, PARAMS,
+};
+use caustics::techniques::{Params, Technique};
+use caustics::vk::{
+    BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    Profiler,
+};
+use common::*;
+use glam::{Vec2, Vec3};
+use std::sync::Arc;
+
+const SIZE: u32 = 128;
+
+struct Run {
+    technique: WaterPhotons,
+    scene_gpu: SceneGpu,
+    /// Kept alive with the technique, whose sets point at it.
+    _targets: FrameTargets,
+}
+
+fn render(ctx: &Arc<Context>, scene: &Scene, overrides: &[&str], size: u32) -> Run {
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let params = Params::resolve("water_photons", PARAMS, &overrides).unwrap();
+    let scene_gpu = SceneGpu::new(ctx, scene, 0.0).unwrap();
+    scene_gpu.update_frame(scene, size, size, 0.0, 0).unwrap();
+    let targets = FrameTargets::new(ctx, size, size).unwrap();
+    let mut technique = WaterPhotons::new(ctx, &params, scene, &scene_gpu, size, size).unwrap();
+    let profiler = Profiler::new(ctx, 32).unwrap();
+    profiler
+        .frame(|rec| technique.record(rec, &scene_gpu, &targets))
+        .unwrap();
+    Run {
+        technique,
+        scene_gpu,
+        _targets: targets,
+    }
+}
+
+fn photons(run: &Run) -> Vec<GpuWaterPhoton> {
+    let counts = run.technique.photon_counts().unwrap();
+    let all: Vec<GpuWaterPhoton> = run.technique.trace.photons.download_pod().unwrap();
+    all[..counts.written as usize].to_vec()
+}
+
+fn water(size: Vec2, resolution: [u32; 2], base_height: f32, waves: Vec<Wave>) -> Water {
+    Water {
+        center: Vec2::ZERO,
+        size,
+        resolution,
+        base_height,
+        material: 1,
+        waves,
+    }
+}
+
+/// A 40 m floor at y = 0 (material 0), water (material 1, IOR 1.33) above.
+fn water_scene(water: Water, light_dir: Vec3, eye: Vec3) -> Scene {
+    let mut w = object("water", water.mesh(0.0));
+    w.water = Some(water);
+    scene(
+        camera(eye, Vec3::ZERO, 50.0),
+        vec![directional_light(light_dir, 1000.0)],
+        vec![diffuse("floor", 0.8), dielectric("water", 1.33)],
+        vec![object("floor", floor_mesh(20.0, 0.0, 0)), w],
+    )
+}
+
+#[test]
+fn algorithm_1_on_the_gpu_matches_the_cpu() {
+    let ctx = validated_context();
+    let set_layout =
+        DescriptorSetLayout::new(&ctx, &[(b::PROBE_BINDING_RESULTS, BindingKind::Storage)])
+            .unwrap();
+    let pipeline =
+        ComputePipeline::new(&ctx, "tests/ccm_distribution.comp", &[&set_layout], 32).unwrap();
+    for (size, levels, scale) in [
+        ([64, 64], 1, 2.0),
+        ([64, 64], 4, 2.0),
+        ([128, 128], 3, 4.0),
+        ([60, 34], 3, 3.0),
+        ([7, 6], 2, 2.0),
+        ([257, 129], 2, 1.7),
+    ] {
+        let layout = CascadeLayout::new(size, levels, scale).unwrap();
+        // A few threads past the end too: they must map to nothing.
+        let threads = layout.total_threads() as u32 + 70;
+        let results =
+            Buffer::new(&ctx, "probe", threads as u64 * 16, BufferUsage::Storage).unwrap();
+        let set = DescriptorSet::new(&ctx, &set_layout).unwrap();
+        set.write_buffer(b::PROBE_BINDING_RESULTS, &results);
+        let push: [u32; 8] = [
+            size[0],
+            size[1],
+            levels,
+            threads,
+            layout.border[0],
+            layout.border[1],
+            0,
+            0,
+        ];
+        ctx.submit_and_wait(|cmd| {
+            pipeline.dispatch(
+                cmd,
+                &[&set],
+                bytemuck::bytes_of(&push),
+                [threads.div_ceil(64), 1, 1],
+            )
+        })
+        .unwrap();
+        let gpu: Vec<[u32; 4]> = results.download_pod().unwrap();
+        for (thread, g) in gpu.iter().enumerate().take(threads as usize) {
+            let cpu = layout
+                .texel_of(thread as u64)
+                .map(|([x, y], c)| [x, y, c, 1])
+                .unwrap_or([0; 4]);
+            assert_eq!(*g, cpu, "{layout:?}: thread {thread}");
+        }
+    }
+    assert_validation_clean(&ctx);
+}
+
+#[test]
+fn flat_water_gives_a_uniform_caustic() {
+    let ctx = validated_context();
+    let light = Vec3::new(0.3, -1.0, 0.2).normalize();
+    let s = water_scene(
+        water(Vec2::new(4.0, 4.0), [16, 16], 1.0, vec![]),
+        light,
+        Vec3::new(0.0, 1.0, 0.0) - light * 5.0,
+    );
+    let run = render(&ctx, &s, &["ccm_size=64", "cascades=1"], SIZE);
+    let p = photons(&run);
+    let refracted: Vec<_> = p
+        .iter()
+        .filter(|p| p.axis_u[3] == b::WP_RAY_REFRACTED as f32)
+        .collect();
+    assert!(
+        refracted.len() > 1000,
+        "{} refracted photons",
+        refracted.len()
+    );
+    let (lo, hi) = refracted.iter().fold((f32::MAX, f32::MIN), |(lo, hi), p| {
+        (lo.min(p.normal[3]), hi.max(p.normal[3]))
+    });
+    println!(
+        "flat water: {} refracted photons, σ in [{lo:.5}, {hi:.5}]",
+        refracted.len()
+    );
+    assert!(
+        (lo - 1.0).abs() < 0.01 && (hi - 1.0).abs() < 0.01,
+        "σ in [{lo}, {hi}]"
+    );
+    // Reflected photons leave upward: nothing above to land on.
+    assert_eq!(refracted.len(), p.len());
+
+    // E = E_light cos θ_i (1 − F) on the floor, away from the beam's edges
+    // (where the last row of tents fades out).
+    let cos_i = -light.y as f64;
+    let eta = 1.0 / 1.33f64;
+    let sin_t2 = eta * eta * (1.0 - cos_i * cos_i);
+    let cos_t = (1.0 - sin_t2).sqrt();
+    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    let f = 0.5 * (rs * rs + rp * rp);
+    let expected = 1000.0 * cos_i * (1.0 - f);
+    let caustics = run.technique.splat.caustics.download_rgba32f().unwrap();
+    let position = run
+        .technique
+        .direct
+        .gbuffer
+        .position
+        .download_rgba32f()
+        .unwrap();
+    // Where the refracted beam's centre lands: the water's centre moved along the refracted ray.
+    let t_dir = {
+        let l = light.as_dvec3();
+        let n = glam::DVec3::Y;
+        (eta * l + (eta * cos_i - cos_t) * n).normalize()
+    };
+    let centre = (glam::DVec3::new(0.0, 1.0, 0.0) + t_dir * (1.0 / -t_dir.y)).as_vec3();
+    let (mut n, mut worst) = (0, 0.0f64);
+    for i in 0..(SIZE * SIZE) as usize {
+        let x = Vec3::from_slice(&position[4 * i..4 * i + 3]);
+        if position[4 * i + 3] == 0.0 || x.y.abs() > 1e-3 {
+            continue;
+        }
+        let d = x - centre;
+        if d.x.abs() > 1.5 || d.z.abs() > 1.5 {
+            continue;
+        }
+        let e = caustics[4 * i] as f64;
+        worst = worst.max((e - expected).abs() / expected);
+        n += 1;
+    }
+    println!("flat water: {n} floor pixels, E expected {expected:.3} W/m², worst relative error {worst:.5}");
+    assert!(n > 500, "{n} pixels checked");
+    assert!(worst < 0.01, "worst relative error {worst}");
+    assert_validation_clean(&ctx);
+}
+
+/// The focusing scene: an 8 x 2 m strip of water at 2 m over the floor,
+/// one long wave along x (A = 0.3 m, λ = 4 m, no steepness), the sun
+/// straight down.
+const CREST_A: f32 = 0.3;
+const CREST_LAMBDA: f32 = 4.0;
+const CREST_BASE: f32 = 2.0;
+
+fn crest_scene() -> Scene {
+    let wave = Wave {
+        amplitude: CREST_A,
+        wavelength: CREST_LAMBDA,
+        direction_deg: 0.0,
+        steepness: 0.0,
+        speed: 0.0,
+        phase: 0.0,
+    };
+    water_scene(
+        water(Vec2::new(8.0, 2.0), [256, 8], CREST_BASE, vec![wave]),
+        Vec3::NEG_Y,
+        Vec3::new(0.5, 8.0, 3.0),
+    )
+}
+
+#[test]
+fn a_crest_focuses_as_a_lens() {
+    let ctx = validated_context();
+    let run = render(&ctx, &crest_scene(), &["ccm_size=128", "cascades=1"], SIZE);
+    let p = photons(&run);
+    let refracted: Vec<_> = p
+        .iter()
+        .filter(|p| p.axis_u[3] == b::WP_RAY_REFRACTED as f32)
+        .collect();
+    // Paraxial: under the crest (slope 0, curvature κ = A k²) a ray at
+    // offset δ leaves tilted by (1 − 1/n) κ δ toward the axis, so after the
+    // depth d to the floor the strip δ shrinks to δ (1 − d κ (n − 1)/n);
+    // along the crest nothing changes, so σ² = A'/A is that factor.
+    let k = std::f32::consts::TAU / CREST_LAMBDA;
+    let d = CREST_BASE + CREST_A;
+    let n = 1.33;
+    let predicted = (1.0 - d * CREST_A * k * k * (n - 1.0) / n).sqrt();
+    let min = refracted
+        .iter()
+        .map(|p| p.normal[3])
+        .fold(f32::MAX, f32::min);
+    let max = refracted
+        .iter()
+        .map(|p| p.normal[3])
+        .fold(f32::MIN, f32::max);
+    println!(
+        "crest: {} refracted photons, σ in [{min:.4}, {max:.4}], paraxial crest σ {predicted:.4}",
+        refracted.len()
+    );
+    assert!(
+        (min - predicted).abs() < 0.05 * predicted,
+        "min σ {min}, predicted {predicted}"
+    );
+    // Troughs spread the light.
+    assert!(max > 1.1, "max σ {max}");
+    // The crests: sin(k x) = 1 at x = 1 and x = −3.
+    for p in refracted.iter().filter(|p| p.normal[3] < 0.85) {
+        let x = p.position[0];
+        assert!(
+            (x - 1.0).abs() < 0.8 || (x + 3.0).abs() < 0.8,
+            "focused photon (σ {}) at x = {x}, not under a crest",
+            p.normal[3]
+        );
+    }
+    assert_validation_clean(&ctx);
+}
+
+fn offset(x: Vec3, n: Vec3) -> Vec3 {
+    x + n * (1e-4 * x.abs().max_element().max(1.0))
+}
+
+/// The trace replayed on the CPU: rays from the CCM texels read back
+/// (Algorithm 1's threads), the CPU BVH, the same acceptance (water texel
+/// with a neighbour along each axis, lit, front face of a diffuse receiver).
+fn cpu_photon_count(run: &Run, s: &Scene) -> u64 {
+    let tech = &run.technique;
+    let layout = tech.frame.layout;
+    let [w, h] = layout.size;
+    let read = |img: &caustics::vk::Image| -> Vec<Vec<f32>> {
+        (0..layout.levels)
+            .map(|c| img.download_layer_rgba32f(c).unwrap())
+            .collect()
+    };
+    let (pos, nrm) = (read(&tech.ccm.position), read(&tech.ccm.normal));
+    let fetch = |x: i64, y: i64, c: usize| -> Option<(Vec3, Vec3)> {
+        if x < 0 || y < 0 || x >= w as i64 || y >= h as i64 {
+            return None;
+        }
+        let i = 4 * (y as usize * w as usize + x as usize);
+        (pos[c][i + 3] != 0.0).then(|| {
+            (
+                Vec3::from_slice(&pos[c][i..i + 3]),
+                Vec3::from_slice(&nrm[c][i..i + 3]).normalize(),
+            )
+        })
+    };
+    let bvh = run.scene_gpu.bvh();
+    let tris: Vec<GpuTriangle> = SceneGpu::gpu_triangles(s, bvh, &s.triangles(0.0));
+    let l = s.lights[0].direction.normalize();
+    let water = s.objects.iter().find_map(|o| o.water.as_ref()).unwrap();
+    let eta = 1.0 / s.materials[water.material as usize].ior;
+    let mut count = 0;
+    for thread in 0..layout.total_threads() {
+        let ([x, y], c) = layout.texel_of(thread).unwrap();
+        let (x, y, c) = (x as i64, y as i64, c as usize);
+        let Some((x00, n00)) = fetch(x, y, c) else {
+            continue;
+        };
+        let has_u = fetch(x + 1, y, c).or_else(|| fetch(x - 1, y, c)).is_some();
+        let has_v = fetch(x, y + 1, c).or_else(|| fetch(x, y - 1, c)).is_some();
+        if !has_u || !has_v || bvh.occluded(&tris, offset(x00, -l), -l, 0.0, 1e30) {
+            continue;
+        }
+        let n = if l.dot(n00) < 0.0 { n00 } else { -n00 };
+        let cos_i = -l.dot(n);
+        let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+        let refracted = (eta * l + (eta * cos_i - (1.0 - sin2_t).sqrt()) * n).normalize();
+        for (dir, side) in [(l - 2.0 * l.dot(n) * n, n), (refracted, -n)] {
+            let origin = offset(x00, side);
+            let Some(hit) = bvh.intersect(&tris, origin, dir, 0.0, 1e30) else {
+                continue;
+            };
+            let t = tris[hit.triangle as usize];
+            let m = t.p0[3].to_bits() as usize;
+            if s.materials[m].kind != MaterialKind::Diffuse {
+                continue;
+            }
+            let p0 = Vec3::from_slice(&t.p0[..3]);
+            let ng = (Vec3::from_slice(&t.p1[..3]) - p0).cross(Vec3::from_slice(&t.p2[..3]) - p0);
+            if (-dir).dot(ng) > 0.0 {
+                count += 1;
+            }
+        }
+    }
+    count
+}
+
+fn pool() -> Scene {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/water_pool.toml");
+    Scene::load(&path).unwrap()
+}
+
+#[test]
+fn photon_count_matches_a_cpu_replay() {
+    let ctx = validated_context();
+    let s = pool();
+    let run = render(&ctx, &s, &["ccm_size=96", "cascades=2"], 64);
+    let counts = run.technique.photon_counts().unwrap();
+    let cpu = cpu_photon_count(&run, &s);
+    println!("water_pool: GPU {counts:?}, CPU replay {cpu}");
+    assert_eq!(counts.overflow(), 0);
+    // Rays grazing a triangle edge may fall either way between the two
+    // traversals' roundings: a handful at most.
+    let diff = (counts.written as i64 - cpu as i64).unsigned_abs();
+    assert!(cpu > 3000, "{cpu} photons");
+    assert!(
+        diff <= 2 + cpu / 2000,
+        "GPU {} vs CPU {cpu}",
+        counts.written
+    );
+    assert_validation_clean(&ctx);
+}
+
+#[test]
+fn overflow_is_counted_and_nothing_is_written_past_the_buffer() {
+    let ctx = validated_context();
+    let light = Vec3::new(0.3, -1.0, 0.2).normalize();
+    let s = water_scene(
+        water(Vec2::new(4.0, 4.0), [16, 16], 1.0, vec![]),
+        light,
+        Vec3::new(0.0, 1.0, 0.0) - light * 5.0,
+    );
+    let run = render(
+        &ctx,
+        &s,
+        &["ccm_size=64", "cascades=1", "photon_capacity=100"],
+        64,
+    );
+    let counts = run.technique.photon_counts().unwrap();
+    println!("tiny buffer: {counts:?}");
+    assert_eq!(counts.capacity, 100);
+    assert_eq!(counts.written, 100);
+    assert!(counts.requested > 3000, "{counts:?}");
+    assert_eq!(counts.overflow(), counts.requested - 100);
+    let words: Vec<u32> = run.technique.trace.photons.download_pod().unwrap();
+    let per = std::mem::size_of::<GpuWaterPhoton>() / 4;
+    assert_eq!(words.len(), (100 + GUARD_PHOTONS as usize) * per);
+    assert!(
+        words[100 * per..].iter().all(|&w| w == GUARD_WORD),
+        "guard overwritten"
+    );
+    assert!(
+        words[..100 * per].iter().all(|&w| w != GUARD_WORD),
+        "a slot left unwritten"
+    );
+    // The draw's instance count is what was written.
+    let draw: Vec<u32> = run.technique.trace.draw.download_pod().unwrap();
+    assert_eq!(&draw[..5], &[4, 100, 0, 0, counts.requested]);
+    assert_validation_clean(&ctx);
+}
+
+/// rgb summed over the image.
+fn energy(img: &[f32]) -> f64 {
+    img.chunks(4).map(|p| (p[0] + p[1] + p[2]) as f64).sum()
+}
+
+#[test]
+fn pool_caustics_from_below_match_the_reference() {
+    use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
+    use caustics::renderer::Renderer;
+    let ctx = validated_context();
+    let below = || {
+        let mut s = pool();
+        // Under the surface (1.2 m), looking down the pool at the floor.
+        s.camera = camera(Vec3::new(0.5, 0.9, 2.6), Vec3::new(-0.3, 0.0, -1.0), 60.0);
+        s
+    };
+    let params = Params::resolve("water_photons", PARAMS, &["ccm_size=256".to_string()]).unwrap();
+    let mut r = Renderer::new(&ctx, below(), "water_photons", &params, SIZE, SIZE, 0.0).unwrap();
+    r.scene_gpu.components = Component::SurfaceCaustics.mask();
+    r.render_frame(0.0).unwrap();
+    let ours = r.radiance().unwrap();
+    assert_finite(&ours);
+    drop(r);
+    let mut reference =
+        ReferenceRenderer::new(&ctx, below(), SIZE, SIZE, 0.0, ReferenceSettings::default())
+            .unwrap();
+    reference.trace(4_000_000, |_, _| {}).unwrap();
+    let truth = reference.resolve(Component::SurfaceCaustics).unwrap();
+    let (e_ours, e_truth) = (energy(&ours), energy(&truth));
+    let rel = (e_ours - e_truth) / e_truth;
+    let (ours_ldr, truth_ldr) = (tonemap(&scaled(&ours)), tonemap(&scaled(&truth)));
+    let (flip_mean, flip_map) = flip(&ours_ldr, &truth_ldr, SIZE);
+    println!("pool from below: L S D energy {e_ours:.1} vs reference {e_truth:.1}: relative {rel:+.4}; FLIP mean {flip_mean:.4}");
+    if rel.abs() >= 0.1 {
+        let dir = write_comparison_pngs(
+            "water_photons_pool_below",
+            SIZE,
+            &ours_ldr,
+            &truth_ldr,
+            &flip_map,
+        );
+        panic!("relative energy {rel:+.4} (images in {dir})");
+    }
+    assert_validation_clean(&ctx);
+}
+
+/// The pool's exposure (assets/scenes/water_pool.toml) before the test tonemap.
+fn scaled(img: &[f32]) -> Vec<f32> {
+    img.iter().map(|v| v * 0.004).collect()
+}
