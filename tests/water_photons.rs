@@ -531,6 +531,10 @@ fn pool_caustics_from_below_match_the_reference() {
             "(ii) fixed splats, ccm 256, N 1",
             &["ccm_size=256", "cascades=1", "splat_mode=2"],
         ),
+        (
+            "(ii) differentials, ccm 256, N 1",
+            &["ccm_size=256", "cascades=1", "splat_mode=0"],
+        ),
     ];
     let mut flips = Vec::new();
     for (i, (name, overrides)) in variants.iter().enumerate() {
