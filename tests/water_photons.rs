@@ -673,3 +673,75 @@ fn paper_splats_and_intensity() {
     }
     assert_validation_clean(&ctx);
 }
+
+/// `caustics render --technique water_photons` on a scene it cannot render,
+/// or with a bad parameter: a message naming the cause, exit code 1.
+#[test]
+fn unusable_scenes_and_parameters_are_refused() {
+    let run = |scene: &str, params: &[&str]| {
+        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_caustics"));
+        c.env(
+            "VK_DRIVER_FILES",
+            "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json",
+        )
+        .args([
+            "render",
+            "--technique",
+            "water_photons",
+            "--width",
+            "32",
+            "--height",
+            "32",
+        ])
+        .args(["--scene", scene, "--out"])
+        .arg(std::env::temp_dir().join("water_photons_refused.png"));
+        for p in params {
+            c.args(["--param", p]);
+        }
+        let out = c.output().unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).to_string(),
+        )
+    };
+    let assets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes");
+    // ball_lens: no water, and a point light.
+    let (code, err) = run(assets.join("ball_lens.toml").to_str().unwrap(), &[]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("water_photons needs a `water` object"),
+        "{err}"
+    );
+    let pool = assets.join("water_pool.toml");
+    let (code, err) = run(pool.to_str().unwrap(), &["cascades=5"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("--param cascades=5: must be a whole number in [1, 4]"),
+        "{err}"
+    );
+    let (code, err) = run(
+        pool.to_str().unwrap(),
+        &["cascade_scale=1.01", "ccm_size=16"],
+    );
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("cascade_scale"), "{err}");
+
+    // Water under a point light only.
+    let ctx = validated_context();
+    let mut s = water_scene(
+        water(Vec2::new(4.0, 4.0), [4, 4], 1.0, vec![]),
+        Vec3::NEG_Y,
+        Vec3::new(0.0, 5.0, 2.0),
+    );
+    s.lights = vec![point_light(Vec3::new(0.0, 5.0, 0.0), 100.0)];
+    let params = Params::resolve("water_photons", PARAMS, &[]).unwrap();
+    let scene_gpu = SceneGpu::new(&ctx, &s, 0.0).unwrap();
+    let err = WaterPhotons::new(&ctx, &params, &s, &scene_gpu, 32, 32)
+        .err()
+        .expect("refused");
+    assert!(
+        err.to_string().contains("needs a directional light"),
+        "{err}"
+    );
+    assert_validation_clean(&ctx);
+}

@@ -495,7 +495,7 @@ impl Technique for WaterPhotons {
         &mut self,
         rec: &mut FrameRecorder,
         scene: &SceneGpu,
-        _targets: &FrameTargets,
+        targets: &FrameTargets,
     ) -> VkResult<()> {
         // Last frame's counts (the renderer waited for it): report overflow.
         let counts = self.trace.counts()?;
@@ -535,7 +535,7 @@ impl Technique for WaterPhotons {
             scene,
             &self.opaque.radiance,
             &self.direct.gbuffer,
-            _targets,
+            targets,
         );
         Ok(())
     }
