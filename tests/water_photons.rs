@@ -745,3 +745,36 @@ fn unusable_scenes_and_parameters_are_refused() {
     );
     assert_validation_clean(&ctx);
 }
+
+/// `ccm_precision` sizes the cascades by Eq. 3 from the derived range.
+#[test]
+fn eq_3_sizes_the_cascades_from_the_precision() {
+    let ctx = validated_context();
+    let s = water_scene(
+        water(Vec2::new(4.0, 4.0), [4, 4], 1.0, vec![]),
+        Vec3::NEG_Y,
+        Vec3::new(0.0, 5.0, 2.0),
+    );
+    let scene_gpu = SceneGpu::new(&ctx, &s, 0.0).unwrap();
+    for (precision, cascades, size) in [(0.05, 1, 256), (0.01, 1, 1024), (0.01, 2, 512)] {
+        let overrides = [
+            format!("ccm_precision={precision}"),
+            format!("cascades={cascades}"),
+        ];
+        let params = Params::resolve("water_photons", PARAMS, &overrides).unwrap();
+        let t = WaterPhotons::new(&ctx, &params, &s, &scene_gpu, 32, 32).unwrap();
+        let r = t.frame.range;
+        // The camera is 2 m off the water's centre along z: cascade N − 1 spans
+        // 2 × (2 + 2) m (+0.1%), cascade 0 that / 2^(N − 1).
+        assert!(
+            (r.width - 8.008 / 2f32.powi(cascades - 1)).abs() < 1e-3,
+            "{r:?}"
+        );
+        assert_eq!(
+            t.frame.layout.size,
+            [size, size],
+            "p = {precision}, N = {cascades}"
+        );
+    }
+    assert_validation_clean(&ctx);
+}

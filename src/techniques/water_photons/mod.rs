@@ -66,7 +66,7 @@ pub use trace::{GpuWaterPhoton, PhotonCounts, Trace, GUARD_PHOTONS, GUARD_WORD};
 use super::direct::{self, Direct};
 use super::image_space::{CameraRefraction, RefractionPush};
 use super::{ParamSpec, Params, Technique};
-use crate::cascades::{light_position, CascadeLayout, LightRange};
+use crate::cascades::{inner_cascade_size, light_position, CascadeLayout, LightRange};
 use crate::passes::gbuffer::GBufferContents;
 use crate::renderer::{FrameTargets, SceneGpu};
 use crate::scene::{Light, LightKind, Scene, Water};
@@ -104,6 +104,14 @@ pub const PARAMS: &[ParamSpec] = &[
         max: 2048.0,
         default: 512.0,
         integer: true,
+    },
+    ParamSpec {
+        name: "ccm_precision",
+        description: "p of Eq. 3 in metres per texel: ccm_0 is then the smallest of 256, 512, 1024, 2048 covering the range; 0: ccm_size decides",
+        min: 0.0,
+        max: 1000.0,
+        default: 0.0,
+        integer: false,
     },
     ParamSpec {
         name: "light_range",
@@ -341,10 +349,25 @@ impl WaterPhotons {
             .context("water_photons needs a `water` object in the scene")?;
         let light = *first_directional(&scene.lights)
             .context("water_photons needs a directional light (the paper's sun)")?;
-        let size = params.get("ccm_size") as u32;
         let levels = params.get("cascades") as u32;
-        let layout = CascadeLayout::new([size, size], levels, params.get("cascade_scale"))?;
+        let scale = params.get("cascade_scale");
         let range_param = params.get("light_range");
+        let precision = params.get("ccm_precision");
+        let size = if precision > 0.0 {
+            // Eq. 3 from the range, which does not depend on ccm_0.
+            let probe = CascadeLayout::new([256, 256], levels, scale)?;
+            let frame = CascadeFrame::new(
+                &water,
+                scene.camera.eye,
+                light.direction,
+                probe,
+                range_param,
+            );
+            inner_cascade_size(&frame.range, precision)
+        } else {
+            params.get("ccm_size") as u32
+        };
+        let layout = CascadeLayout::new([size, size], levels, scale)?;
         let frame = CascadeFrame::new(
             &water,
             scene.camera.eye,
@@ -352,14 +375,27 @@ impl WaterPhotons {
             layout,
             range_param,
         );
+        // The photon buffer is one storage-buffer binding: the device's
+        // maxStorageBufferRange bounds it (128 MiB on lavapipe: 1.4M photons).
+        let photon_bytes = size_of::<GpuWaterPhoton>() as u64;
+        let device_max =
+            ctx.limits.max_storage_buffer_range as u64 / photon_bytes - GUARD_PHOTONS as u64;
         let capacity = match params.get("photon_capacity") as u64 {
-            0 => 2 * layout.total_threads(),
+            0 => {
+                let wanted = 2 * layout.total_threads();
+                if wanted > device_max {
+                    log::warn!(
+                        "water_photons: {wanted} photon slots (2 per thread of {levels} cascades of {size}²) exceed the device's storage buffer range; using {device_max}, overflow is possible"
+                    );
+                }
+                wanted.min(device_max)
+            }
             n => n,
         };
         anyhow::ensure!(
-            capacity <= 33_554_432,
-            "photon_capacity: {capacity} photons ({} x {size}² x 2 threads) exceeds the 33554432 limit; lower ccm_size or cascades",
-            levels
+            capacity <= device_max,
+            "photon_capacity={capacity}: the device binds at most {device_max} photons ({} bytes each) in one storage buffer",
+            photon_bytes
         );
         let capacity = capacity as u32;
         let direct = Direct::with_contents(

@@ -66,7 +66,7 @@ pub struct PhotonCounts {
 
 impl PhotonCounts {
     pub fn overflow(&self) -> u32 {
-        self.requested - self.written
+        self.requested.saturating_sub(self.written)
     }
 }
 
@@ -112,10 +112,11 @@ impl Trace {
             size_of::<DrawCounters>() as u64,
             BufferUsage::StorageIndirect,
         )?;
-        let readback = Buffer::new(
+        // Zero counts until the first trace lands.
+        let readback = Buffer::with_data(
             ctx,
             "water photon counts",
-            size_of::<DrawCounters>() as u64,
+            &[DrawCounters::zeroed()],
             BufferUsage::Readback,
         )?;
         let layout = DescriptorSetLayout::new(
