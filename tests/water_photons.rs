@@ -719,6 +719,9 @@ fn unusable_scenes_and_parameters_are_refused() {
         err.contains("--param cascades=5: must be a whole number in [1, 4]"),
         "{err}"
     );
+    let (code, err) = run(pool.to_str().unwrap(), &["photon_capacity=33554432"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("the device binds at most"), "{err}");
     let (code, err) = run(
         pool.to_str().unwrap(),
         &["cascade_scale=1.01", "ccm_size=16"],
