@@ -46,6 +46,15 @@
 //! so that the outermost cascade covers the whole water seen from Eq. 1's
 //! origin; the depth range spans the water's bounds.
 //!
+//! Deviations from the paper: the light view's up vector is +z under a
+//! high sun (`CascadeFrame::new`), so the texel grid lines up with the
+//! water's; Eq. 16's grid pitch is r / ccm_0 (the printed r / (ccm_0 − 1)
+//! would leave q_0 = 2 tents overlapping); the neighbours' rays of
+//! Algorithm 2 meet the receiver's tangent plane instead of stopping at t'
+//! (the same on a plane parallel to flat water, exact on any plane); the
+//! kernel is a tent normalised over the quad where the paper scales a
+//! shaded quad by Eq. 20 (the tent's mean is Eq. 20's I).
+//!
 //! Limits: one specular bounce (L S D): photons whose ray meets another
 //! specular surface first are dropped, so light reflected back under the
 //! water by total internal reflection is missing; photons whose
