@@ -5,7 +5,6 @@
 //! Cascade c's view-projection is Eq. 2 (`CascadeLayout::projection`) times
 //! the shared light view of Eq. 1 (`cascades::light_view`).
 
-use crate::gpu::GpuWaterVertex;
 use crate::passes::water_surface::WaterSurface;
 use crate::scene::Water;
 use crate::shader_bindings as b;
@@ -79,10 +78,6 @@ impl Ccm {
         desc.depth_write = true;
         desc.push_size = size_of::<CcmPush>() as u32;
         let pipeline = GraphicsPipeline::new(ctx, &desc, &[&layout])?;
-        debug_assert_eq!(
-            water.vertex_count() * size_of::<GpuWaterVertex>(),
-            surface.vertices.size as usize
-        );
         Ok(Self {
             surface,
             position,
