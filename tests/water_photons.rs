@@ -7,6 +7,8 @@
 //!   E cos θ_i (1 − F) (within 1% where the splats tile).
 //! - A long Gerstner crest focuses: σ < 1 under the crest, matching the
 //!   paraxial prediction σ = sqrt(1 − d A k² (n − 1)/n) within 5%.
+//! - Through the crest's focusing, every splat mode deposits the landed
+//!   photons' flux (the irradiance integrated over the floor's pixels).
 //! - The photon count equals a CPU replay of the trace (CPU BVH, rays from
 //!   the CCM read back).
 //! - A tiny photon capacity: the overflow is counted and reported, nothing
@@ -785,6 +787,54 @@ fn eq_3_sizes_the_cascades_from_the_precision() {
             [size, size],
             "p = {precision}, N = {cascades}"
         );
+    }
+    assert_validation_clean(&ctx);
+}
+
+/// Flux conservation through focusing: the caustic irradiance integrated
+/// over the floor (pixel footprints from the G-buffer's positions) equals
+/// the flux of the photons that landed there, for the differential splats
+/// and both rectangle modes (each quad deposits its photon's flux, whatever
+/// its size).
+#[test]
+fn splats_conserve_the_flux_of_a_focusing_crest() {
+    let ctx = validated_context();
+    let mut s = crest_scene();
+    s.camera = camera(Vec3::new(0.0, 10.0, 3.0), Vec3::ZERO, 70.0);
+    const PX: u32 = 256;
+    for mode in [0, 1, 2] {
+        let run = render(
+            &ctx,
+            &s,
+            &["ccm_size=128", "cascades=1", &format!("splat_mode={mode}")],
+            PX,
+        );
+        let flux: f64 = photons(&run).iter().map(|p| p.flux[0] as f64).sum();
+        let e = run.technique.splat.caustics.download_rgba32f().unwrap();
+        let pos = run
+            .technique
+            .direct
+            .gbuffer
+            .position
+            .download_rgba32f()
+            .unwrap();
+        let at = |x: u32, y: u32| {
+            let i = 4 * (y * PX + x) as usize;
+            (pos[i + 3] != 0.0).then(|| Vec3::from_slice(&pos[i..i + 3]))
+        };
+        let mut integral = 0.0f64;
+        for y in 0..PX - 1 {
+            for x in 0..PX - 1 {
+                let (Some(p), Some(px), Some(py)) = (at(x, y), at(x + 1, y), at(x, y + 1)) else {
+                    continue;
+                };
+                let area = (px - p).cross(py - p).length() as f64;
+                integral += e[4 * (y * PX + x) as usize] as f64 * area;
+            }
+        }
+        let rel = integral / flux - 1.0;
+        println!("crest, splat_mode={mode}: photon flux {flux:.2} W, integrated irradiance {integral:.2} W ({rel:+.4})");
+        assert!(rel.abs() < 0.02, "splat_mode={mode}: {rel:+.4}");
     }
     assert_validation_clean(&ctx);
 }
