@@ -9,6 +9,8 @@
 //!   paraxial prediction σ = sqrt(1 − d A k² (n − 1)/n) within 5%.
 //! - Through the crest's focusing, every splat mode deposits the landed
 //!   photons' flux (the irradiance integrated over the floor's pixels).
+//! - Water of IOR 1: the whole frame (shadowed direct light + caustic +
+//!   camera refraction) gives back the `direct` frame without the water.
 //! - The photon count equals a CPU replay of the trace (CPU BVH, rays from
 //!   the CCM read back).
 //! - A tiny photon capacity: the overflow is counted and reported, nothing
@@ -836,5 +838,75 @@ fn splats_conserve_the_flux_of_a_focusing_crest() {
         println!("crest, splat_mode={mode}: photon flux {flux:.2} W, integrated irradiance {integral:.2} W ({rel:+.4})");
         assert!(rel.abs() < 0.02, "splat_mode={mode}: {rel:+.4}");
     }
+    assert_validation_clean(&ctx);
+}
+
+/// Water of IOR 1 bends nothing and reflects nothing: the whole frame
+/// (direct light, whose shadow maps hold the water, + the caustic the water
+/// sends, seen through the surface by the camera refraction) equals the
+/// `direct` frame of the scene without the water, on the floor under the
+/// water's middle; with the surface-caustics component off, that floor is
+/// dark (the water's shadow).
+#[test]
+fn ior_one_water_gives_back_the_direct_frame() {
+    use caustics::reference::Component;
+    use caustics::renderer::Renderer;
+    let ctx = validated_context();
+    let light = Vec3::new(0.3, -1.0, 0.2).normalize();
+    let eye = Vec3::new(0.5, 5.0, 3.0);
+    let mut with_water = water_scene(water(Vec2::new(4.0, 4.0), [8, 8], 1.0, vec![]), light, eye);
+    with_water.materials[1].ior = 1.0;
+    let mut without = with_water.clone();
+    without.objects.truncate(1);
+    let frame = |s: &Scene, technique: &str, overrides: &[String], mask: u32| {
+        let params = Params::resolve(
+            technique,
+            caustics::techniques::find(technique).unwrap().params,
+            overrides,
+        )
+        .unwrap();
+        let mut r = Renderer::new(&ctx, s.clone(), technique, &params, SIZE, SIZE, 0.0).unwrap();
+        r.scene_gpu.components = mask;
+        r.render_frame(0.0).unwrap();
+        r.radiance().unwrap()
+    };
+    let ours = frame(
+        &with_water,
+        "water_photons",
+        &["ccm_size=128".into(), "cascades=1".into()],
+        Component::All.mask(),
+    );
+    let dark = frame(
+        &with_water,
+        "water_photons",
+        &["ccm_size=128".into(), "cascades=1".into()],
+        Component::Direct.mask(),
+    );
+    let truth = frame(&without, "direct", &[], Component::All.mask());
+    // Floor points whose light came through the water's middle: (x, 0, z)
+    // with (x, 0, z) − l t at the water's height inside ±1.2 m, found per
+    // pixel by the camera ray.
+    let (mut n, mut worst, mut darkest) = (0, 0.0f32, 0.0f32);
+    for py in 0..SIZE {
+        for px in 0..SIZE {
+            let (o, d) = pixel_ray(&with_water.camera, SIZE, SIZE, px, py);
+            if d.y >= 0.0 {
+                continue;
+            }
+            let floor = o + d * (-o.y / d.y);
+            let at_water = floor - light * (1.0 / -light.y);
+            if at_water.x.abs() > 1.2 || at_water.z.abs() > 1.2 {
+                continue;
+            }
+            let i = 4 * (py * SIZE + px) as usize;
+            worst = worst.max((ours[i] - truth[i]).abs() / truth[i]);
+            darkest = darkest.max(dark[i] / truth[i]);
+            n += 1;
+        }
+    }
+    println!("IOR 1: {n} floor pixels, worst relative difference {worst:.5}, direct-only at most {darkest:.5} of the lit floor");
+    assert!(n > 1000, "{n}");
+    assert!(worst < 0.01, "worst {worst}");
+    assert!(darkest < 0.01, "direct only {darkest}");
     assert_validation_clean(&ctx);
 }
