@@ -145,8 +145,6 @@ void main() {
         vec3 ng = hit_geometric_normal(h);
         // Line 33: front faces only.
         if (dot(-dir, ng) <= 0.0) continue;
-        vec3 nh = hit_normal(h);
-        if (dot(nh, ng) < 0.0) nh = -nh;
 
         // Algorithm 2: the neighbours' rays, with their own normals.
         vec3 nu_s = dot(l, nu) < 0.0 ? nu : -nu;

@@ -53,7 +53,9 @@
 //! Algorithm 2 meet the receiver's tangent plane instead of stopping at t'
 //! (the same on a plane parallel to flat water, exact on any plane); the
 //! kernel is a tent normalised over the quad where the paper scales a
-//! shaded quad by Eq. 20 (the tent's mean is Eq. 20's I).
+//! shaded quad by Eq. 20 (the tent's mean is Eq. 20's I); Algorithm 3
+//! line 24 prints reflect(LDir, n10), we reflect about the photon's own
+//! normal n00 (n10 belongs to the right neighbour's ray, Algorithm 2).
 //!
 //! Limits: one specular bounce (L S D): photons whose ray meets another
 //! specular surface first are dropped, so light reflected back under the
@@ -173,7 +175,7 @@ pub const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "fresnel_exp",
         description: "F_exp of Eq. 14 (intensity_mode 1)",
-        min: 0.0,
+        min: 0.1,
         max: 16.0,
         default: 5.0,
         integer: false,
