@@ -47,8 +47,8 @@ const SIZE: u32 = 128;
 struct Run {
     technique: WaterPhotons,
     scene_gpu: SceneGpu,
-    /// Kept alive with the technique, whose sets point at it.
-    _targets: FrameTargets,
+    /// The frame targets the technique records into.
+    targets: FrameTargets,
 }
 
 fn render(ctx: &Arc<Context>, scene: &Scene, overrides: &[&str], size: u32) -> Run {
@@ -70,7 +70,7 @@ fn render_at(ctx: &Arc<Context>, scene: &Scene, overrides: &[&str], size: u32, t
     Run {
         technique,
         scene_gpu,
-        _targets: targets,
+        targets,
     }
 }
 
@@ -908,5 +908,33 @@ fn ior_one_water_gives_back_the_direct_frame() {
     assert!(n > 1000, "{n}");
     assert!(worst < 0.01, "worst {worst}");
     assert!(darkest < 0.01, "direct only {darkest}");
+    assert_validation_clean(&ctx);
+}
+
+/// Eq. 1: the light view is centred on the camera, frame by frame (the
+/// camera's position lies on the light's axis through the cascades' centre).
+#[test]
+fn the_cascades_follow_the_camera() {
+    let ctx = validated_context();
+    let light = Vec3::new(0.3, -1.0, 0.2).normalize();
+    let mut s = water_scene(
+        water(Vec2::new(4.0, 4.0), [8, 8], 1.0, vec![]),
+        light,
+        Vec3::new(0.5, 5.0, 3.0),
+    );
+    let mut run = render(&ctx, &s, &["ccm_size=64", "cascades=2"], 64);
+    let profiler = Profiler::new(&ctx, 32).unwrap();
+    for eye in [Vec3::new(0.5, 5.0, 3.0), Vec3::new(-2.0, 3.0, 1.0)] {
+        s.camera.eye = eye;
+        run.scene_gpu.update_frame(&s, 64, 64, 0.0, 1).unwrap();
+        profiler
+            .frame(|rec| run.technique.record(rec, &run.scene_gpu, &run.targets))
+            .unwrap();
+        let local = run.technique.frame.view.transform_point3(eye);
+        assert!(
+            local.x.abs() < 1e-4 && local.y.abs() < 1e-4,
+            "{eye}: {local}"
+        );
+    }
     assert_validation_clean(&ctx);
 }

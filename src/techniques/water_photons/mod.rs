@@ -5,7 +5,7 @@
 //!    evaluated on the GPU and rasterised from the directional light into
 //!    the cascaded caustic maps: N cascades of ccm_0² texels, scale s, one
 //!    orthographic projection each (Eq. 2) from one light view (Eq. 1,
-//!    centred on the camera's position at construction), layer c of a 2D
+//!    centred on the camera's position, followed frame by frame), layer c of a 2D
 //!    array holding world position and normal (src/cascades.rs).
 //! 2. "photon trace" (`trace`, glsl/water_photons/trace.comp): Algorithm 1
 //!    maps each thread to (texel, cascade); Algorithm 3 traces a shadow ray,
@@ -62,9 +62,7 @@
 //! water by total internal reflection is missing; photons whose
 //! neighbours (both sides along u or v) hold no water have no footprint
 //! and are dropped (texels on the water's rim); splats overlapping a
-//! depth edge spill onto the surface behind; the cascades follow the camera
-//! position given at construction (Eq. 1), not the camera moving in the
-//! demo. The denoiser (Eqs. 21-28) is a separate module.
+//! depth edge spill onto the surface behind. The denoiser (Eqs. 21-28) is a separate module.
 
 mod ccm;
 mod splat;
@@ -78,6 +76,7 @@ use super::direct::{self, Direct};
 use super::image_space::{CameraRefraction, RefractionPush};
 use super::{ParamSpec, Params, Technique};
 use crate::cascades::{inner_cascade_size, light_position, CascadeLayout, LightRange};
+use crate::gpu::GpuFrame;
 use crate::passes::gbuffer::GBufferContents;
 use crate::renderer::{FrameTargets, SceneGpu};
 use crate::scene::{Light, LightKind, Scene, Water};
@@ -335,7 +334,9 @@ pub struct WaterPhotons {
     params: WpParamsBuffer,
     gpu_params: GpuWpParams,
     water_material: u32,
+    /// Eq. 1's origin o: the camera position the cascades were placed for.
     camera_origin: Vec3,
+    light: Light,
     range_param: f32,
     water: Water,
 }
@@ -503,6 +504,7 @@ impl WaterPhotons {
             gpu_params,
             water_material: water.material,
             camera_origin: scene.camera.eye,
+            light,
             range_param,
             water,
         };
@@ -511,6 +513,7 @@ impl WaterPhotons {
     }
 
     fn set_light(&mut self, light: &Light) {
+        self.light = *light;
         self.frame = CascadeFrame::new(
             &self.water,
             self.camera_origin,
@@ -553,6 +556,15 @@ impl Technique for WaterPhotons {
                 counts.requested,
                 counts.capacity
             );
+        }
+        // Eq. 1 follows the camera: the frame constants (host-visible,
+        // written before recording) hold this frame's eye.
+        let constants: Vec<GpuFrame> = scene.frame.download_pod()?;
+        let eye = Vec3::from_slice(&constants[0].eye[..3]);
+        if eye != self.camera_origin {
+            self.camera_origin = eye;
+            let light = self.light;
+            self.set_light(&light);
         }
         // Host write while recording: no earlier frame is still in flight.
         self.params.0.upload(bytemuck::bytes_of(&self.gpu_params))?;
