@@ -3,16 +3,18 @@
 # device (set VK_DRIVER_FILES to pick lavapipe). JSON goes to out/bench/.
 #   scripts/bench.sh               every section below
 #   scripts/bench.sh SECTION...    only those: direct, reference, geometry,
-#                                  image_space
+#                                  image_space, water_photons
 # direct: the base frame per pass at 512^2 and 1024^2; reference: photons per
 # second; geometry: BVH build time and size per canonical scene; image_space:
 # caustic-map passes over photon buffers 64^2/256^2/1024^2, caustic maps
 # 128^2/512^2 and screens 512^2/1024^2 on ball_lens (Wyman's Figs. 6.3.7-8
-# sweep). FRAMES (10) and PHOTONS (2e7) set the effort.
+# sweep); water_photons: the per-pass split of Kougianos & Moustakas'
+# Fig. 14 on water_pool over ccm_0 and cascade counts. FRAMES (10) and
+# PHOTONS (2e7) set the effort.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 sections=("$@")
-[ ${#sections[@]} -eq 0 ] && sections=(direct reference geometry image_space)
+[ ${#sections[@]} -eq 0 ] && sections=(direct reference geometry image_space water_photons)
 wants() { [[ " ${sections[*]} " == *" $1 "* ]]; }
 cargo build --release --quiet
 bin=target/release/caustics
@@ -70,5 +72,35 @@ print(f"| {b['width']}x{b['height']} | {p}² | {m}² | " + " | ".join(cells)
 PY
       done
     done
+  done
+fi
+
+if wants water_photons; then
+  # Fig. 14's split: CCM raster (with the GPU water surface), tracing,
+  # splat, composite (the denoiser is not in this branch), and the rest of
+  # the frame (direct passes, camera refraction, tonemap).
+  echo "| screen | ccm_0 | N | splat | trace threads | water surface + ccm raster | photon trace | photon splat | caustic composite | rest | frame |"
+  echo "| --- | ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+  for run in "256 1 0" "512 1 0" "512 2 0" "512 4 0" "1024 1 0" "512 1 2"; do
+    set -- $run
+    json=out/bench/water_photons_pool_c$1_n$2_s$3.json
+    $bin bench --scene assets/scenes/water_pool.toml --technique water_photons \
+      --param ccm_size=$1 --param cascades=$2 --param splat_mode=$3 \
+      --width 256 --height 256 --frames ${FRAMES:-10} --warmup 2 --json $json \
+      > ${json%.json}.log 2>&1 || { cat ${json%.json}.log; exit 1; }
+    python3 - $json <<'PY'
+import json, sys
+b = json.load(open(sys.argv[1]))
+ms = {p["name"]: p["ms"] for p in b["passes_ms"]}
+p = b["params"]
+own = ["water surface", "ccm raster", "photon trace", "photon splat", "caustic composite"]
+rest = sum(v for k, v in ms.items() if k not in own)
+splat = ["differential", "paper", "fixed"][int(p["splat_mode"])]
+layout = int(p["ccm_size"]), int(p["cascades"])
+threads = layout[0] ** 2 * (1 + 0.75 * (layout[1] - 1))
+print(f"| {b['width']}x{b['height']} | {layout[0]}² | {layout[1]} | {splat} | {int(threads)}"
+      + f" | {ms['water surface'] + ms['ccm raster']:.1f} | {ms['photon trace']:.1f} | {ms['photon splat']:.1f}"
+      + f" | {ms['caustic composite']:.1f} | {rest:.1f} | {b['frame_ms']:.1f} |")
+PY
   done
 fi

@@ -129,3 +129,31 @@ pub const DENOISE_AXIS_X: u32 = 0;
 pub const DENOISE_AXIS_Y: u32 = 1;
 /// Workgroup side of the denoise sub-passes (8 x 8 pixels).
 pub const DENOISE_GROUP_SIZE: u32 = 8;
+// water_photons (src/techniques/water_photons/, glsl/water_photons/),
+// descriptor set 1 of each pass.
+pub const WP_BINDING_PARAMS: u32 = 0;
+pub const WP_BINDING_WATER_VERTICES: u32 = 1;
+pub const WP_BINDING_CCM_POSITION: u32 = 2;
+pub const WP_BINDING_CCM_NORMAL: u32 = 3;
+pub const WP_BINDING_PHOTONS: u32 = 4;
+pub const WP_BINDING_DRAW: u32 = 5;
+pub const WP_BINDING_CAUSTICS: u32 = 6;
+pub const WP_BINDING_GBUFFER_POSITION: u32 = 7;
+pub const WP_BINDING_GBUFFER_NORMAL: u32 = 8;
+pub const WP_BINDING_RADIANCE: u32 = 9;
+/// Most cascades of a cascaded caustic map (Kougianos & Moustakas 2021 use 1-4).
+pub const WP_MAX_CASCADES: u32 = 4;
+/// Trace threads per workgroup, and workgroups per dispatch row.
+pub const WP_TRACE_GROUP_SIZE: u32 = 64;
+pub const WP_TRACE_GROUPS_PER_ROW: u32 = 1024;
+/// Intensity modes: exact Fresnel, flux per photon (physical); Eqs. 13-14 (paper).
+pub const WP_INTENSITY_PHYSICAL: u32 = 0;
+pub const WP_INTENSITY_PAPER: u32 = 1;
+/// Splat modes: the photon differential's footprint; Eqs. 16-19's quad with
+/// σ from the differentials; the same quad with σ = s^c (fixed splats).
+pub const WP_SPLAT_DIFFERENTIAL: u32 = 0;
+pub const WP_SPLAT_PAPER: u32 = 1;
+pub const WP_SPLAT_FIXED: u32 = 2;
+/// Ray types of a photon (Algorithm 3 line 37).
+pub const WP_RAY_REFLECTED: u32 = 0;
+pub const WP_RAY_REFRACTED: u32 = 1;

@@ -9,7 +9,7 @@
 mod common;
 
 use caustics::scene::Camera;
-use caustics::techniques::water_photons_denoise::{
+use caustics::techniques::water_photons::denoise::{
     adaptive_vs_fixed, c_scene, DenoiseConfig, DenoiseKind, Denoiser,
 };
 use caustics::vk::{
@@ -129,7 +129,15 @@ fn denoise(
     let profiler = Profiler::new(ctx, 2 * config.passes).unwrap();
     profiler
         .frame(|rec| {
-            denoiser.record(rec, &caustics, &position, &camera(), l_min);
+            let cam = camera();
+            denoiser.record(
+                rec,
+                &caustics,
+                &position,
+                cam.eye,
+                (cam.target - cam.eye).normalize(),
+                l_min,
+            );
             Ok(())
         })
         .unwrap();
@@ -208,7 +216,7 @@ fn total(img: &[f32], mask: impl Fn(u32, u32) -> bool) -> f64 {
     for y in 0..SIZE {
         for x in 0..SIZE {
             if mask(x, y) {
-                s += caustics::techniques::water_photons_denoise::luminance(px(img, x, y)) as f64;
+                s += caustics::techniques::water_photons::denoise::luminance(px(img, x, y)) as f64;
             }
         }
     }
@@ -220,7 +228,7 @@ fn mse(img: &[f32]) -> f64 {
     let mut s = 0.0;
     for y in 0..SIZE {
         for x in 0..SIZE {
-            let lum = caustics::techniques::water_photons_denoise::luminance;
+            let lum = caustics::techniques::water_photons::denoise::luminance;
             let e = (lum(px(img, x, y)) - lum(smooth_mean(x, y))) as f64;
             s += e * e;
         }
@@ -278,7 +286,7 @@ fn constant_input_stays_constant() {
 }
 
 fn common_lum(c: Vec3) -> f32 {
-    caustics::techniques::water_photons_denoise::luminance(c)
+    caustics::techniques::water_photons::denoise::luminance(c)
 }
 
 /// Zero stays exactly zero; huge isolated photons next to depth edges and
@@ -590,7 +598,7 @@ fn real_gbuffer_edges() {
         .filter(|i| on_box(i % SIZE, i / SIZE))
         .count();
     assert!(background > 100 && box_pixels > 300, "scene framing");
-    let l_min = caustics::techniques::water_photons_denoise::scene_l_min(&scene, 0.0);
+    let l_min = caustics::techniques::water_photons::denoise::scene_l_min(&scene, 0.0);
     let c = c_scene(l_min);
 
     let caustics = Image::new(
@@ -645,7 +653,14 @@ fn real_gbuffer_edges() {
                         )
                     };
                 });
-                denoiser.record(rec, &caustics, &gbuffer.position, &scene.camera, l_min);
+                denoiser.record(
+                    rec,
+                    &caustics,
+                    &gbuffer.position,
+                    scene.camera.eye,
+                    (scene.camera.target - scene.camera.eye).normalize(),
+                    l_min,
+                );
                 Ok(())
             })
             .unwrap();
@@ -689,7 +704,7 @@ fn real_gbuffer_edges() {
 /// inside; the dimmest by luminance wins; no lights give zero.
 #[test]
 fn l_min_is_the_dimmest_light_irradiance() {
-    use caustics::techniques::water_photons_denoise::scene_l_min;
+    use caustics::techniques::water_photons::denoise::scene_l_min;
     let floor = common::object("floor", common::floor_mesh(1.0, 0.0, 0));
     let cam = common::camera(Vec3::new(0.0, 2.0, 2.0), Vec3::ZERO, 45.0);
     let mats = vec![common::diffuse("floor", 0.5)];
@@ -714,7 +729,7 @@ fn l_min_is_the_dimmest_light_irradiance() {
 /// configurations, and out-of-range values are refused naming the parameter.
 #[test]
 fn params_select_the_denoiser() {
-    use caustics::techniques::water_photons_denoise::DENOISE_PARAMS;
+    use caustics::techniques::water_photons::denoise::DENOISE_PARAMS;
     use caustics::techniques::Params;
     let config = |overrides: &[&str]| {
         let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();

@@ -5,8 +5,7 @@
 
 pub mod direct;
 pub mod image_space;
-#[path = "water_photons/denoise.rs"]
-pub mod water_photons_denoise;
+pub mod water_photons;
 
 use crate::reference::Component;
 use crate::renderer::{FrameTargets, SceneGpu};
@@ -132,6 +131,11 @@ pub const TECHNIQUES: &[TechniqueInfo] = &[TechniqueInfo {
     description: "Wyman 2005-06: two-sided image-space refraction of what the camera sees through glass (and in mirrors), and caustic maps (photons through the specular objects, Gaussian splats, projected onto diffuse receivers)",
     params: image_space::PARAMS,
     components: &[Component::Direct, Component::SurfaceCaustics],
+}, TechniqueInfo {
+    name: "water_photons",
+    description: "Kougianos & Moustakas 2021: cascaded caustic maps of the water from the sun, photon differentials traced through the BVH, splats drawn indirect into a screen-space caustic buffer",
+    params: water_photons::PARAMS,
+    components: &[Component::Direct, Component::SurfaceCaustics],
 }];
 
 pub fn find(name: &str) -> anyhow::Result<&'static TechniqueInfo> {
@@ -174,6 +178,9 @@ pub fn create(
             ctx, params, scene, scene_gpu, width, height,
         )?),
         "image_space" => Box::new(image_space::ImageSpace::new(
+            ctx, params, scene, scene_gpu, width, height,
+        )?),
+        "water_photons" => Box::new(water_photons::WaterPhotons::new(
             ctx, params, scene, scene_gpu, width, height,
         )?),
         other => {

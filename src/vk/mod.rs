@@ -17,8 +17,8 @@ mod sync;
 
 pub use context::{Context, ContextOptions, DeviceInfo, RequiredFeature, ValidationCounts};
 pub use pipeline::{
-    begin_rendering, end_rendering, BindingKind, ComputePipeline, DescriptorSet,
-    DescriptorSetLayout, GraphicsPipeline, GraphicsPipelineDesc, Sampler,
+    begin_rendering, begin_rendering_with_depth, end_rendering, BindingKind, ComputePipeline,
+    DescriptorSet, DescriptorSetLayout, GraphicsPipeline, GraphicsPipelineDesc, Sampler,
 };
 pub use profiler::{FrameRecorder, PassTiming, Profiler, TimingSource};
 pub use resources::{Buffer, BufferUsage, Image, ImageDesc};

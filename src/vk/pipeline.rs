@@ -511,6 +511,18 @@ pub fn begin_rendering(
     colors: &[(vk::ImageView, Option<[f32; 4]>)],
     depth: Option<vk::ImageView>,
 ) {
+    begin_rendering_with_depth(ctx, cmd, extent, colors, depth.map(|v| (v, true)));
+}
+
+/// As `begin_rendering`, with the depth image `(view, clear)`: cleared to 1
+/// when `clear`, else loaded (a depth test against an earlier pass's depth).
+pub fn begin_rendering_with_depth(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    extent: vk::Extent2D,
+    colors: &[(vk::ImageView, Option<[f32; 4]>)],
+    depth: Option<(vk::ImageView, bool)>,
+) {
     let color_attachments: Vec<_> = colors
         .iter()
         .map(|&(view, clear)| {
@@ -530,11 +542,15 @@ pub fn begin_rendering(
                 })
         })
         .collect();
-    let depth_attachment = depth.map(|view| {
+    let depth_attachment = depth.map(|(view, clear)| {
         vk::RenderingAttachmentInfo::default()
             .image_view(view)
             .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .load_op(if clear {
+                vk::AttachmentLoadOp::CLEAR
+            } else {
+                vk::AttachmentLoadOp::LOAD
+            })
             .store_op(vk::AttachmentStoreOp::STORE)
             .clear_value(vk::ClearValue {
                 depth_stencil: vk::ClearDepthStencilValue {

@@ -254,6 +254,16 @@ pub struct Image {
 
 impl Image {
     pub fn new(ctx: &Arc<Context>, name: &str, desc: ImageDesc) -> VkResult<Image> {
+        Self::create(ctx, name, desc, false)
+    }
+
+    /// As `new`, but the full view is a 2D array even with one layer (for
+    /// shaders that declare `image2DArray` whatever the layer count).
+    pub fn new_array(ctx: &Arc<Context>, name: &str, desc: ImageDesc) -> VkResult<Image> {
+        Self::create(ctx, name, desc, true)
+    }
+
+    fn create(ctx: &Arc<Context>, name: &str, desc: ImageDesc, array: bool) -> VkResult<Image> {
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(desc.format)
@@ -305,7 +315,7 @@ impl Image {
                 });
             unsafe { ctx.device.create_image_view(&info, None) }
         };
-        let ty = if desc.layers > 1 {
+        let ty = if desc.layers > 1 || array {
             vk::ImageViewType::TYPE_2D_ARRAY
         } else {
             vk::ImageViewType::TYPE_2D

@@ -45,7 +45,7 @@
 //! sparse photon image (an adaptive kernel that gathers wide into dark
 //! pixels and narrow at bright ones adds energy around isolated photons).
 
-use crate::scene::{Camera, LightKind, Scene};
+use crate::scene::{Camera, Light, LightKind, Scene};
 use crate::shader_bindings as b;
 use crate::techniques::{ParamSpec, Params};
 use crate::vk::{
@@ -57,33 +57,35 @@ use ash::vk;
 use glam::Vec3;
 use std::sync::Arc;
 
-/// The denoiser's parameters; the `water_photons` technique concatenates them.
-pub const DENOISE_PARAMS: &[ParamSpec] = &[
-    ParamSpec {
-        name: "denoise",
-        description: "caustics denoiser: 0 none, 1 adaptive radius (Kougianos 2021 Eqs. 25-28), 2 fixed radius (refs [6, 10])",
-        min: 0.0,
-        max: 2.0,
-        default: 1.0,
-        integer: true,
-    },
-    ParamSpec {
-        name: "denoise_passes",
-        description: "denoise passes, each a sub-pass along x then along y",
-        min: 1.0,
-        max: 16.0,
-        default: 1.0,
-        integer: true,
-    },
-    ParamSpec {
-        name: "denoise_radius",
-        description: "kernel radius in pixels of the fixed-radius denoiser",
-        min: 1.0,
-        max: 32.0,
-        default: 5.0,
-        integer: true,
-    },
-];
+/// `denoise`: which denoiser runs (0 none, 1 adaptive, 2 fixed).
+pub const DENOISE: ParamSpec = ParamSpec {
+    name: "denoise",
+    description: "caustics denoiser: 0 none, 1 adaptive radius (Kougianos 2021 Eqs. 25-28), 2 fixed radius (refs [6, 10])",
+    min: 0.0,
+    max: 2.0,
+    default: 1.0,
+    integer: true,
+};
+/// `denoise_passes`: passes, each a sub-pass along x then along y.
+pub const DENOISE_PASSES: ParamSpec = ParamSpec {
+    name: "denoise_passes",
+    description: "denoise passes, each a sub-pass along x then along y",
+    min: 1.0,
+    max: 16.0,
+    default: 1.0,
+    integer: true,
+};
+/// `denoise_radius`: the fixed-radius denoiser's kernel radius.
+pub const DENOISE_RADIUS: ParamSpec = ParamSpec {
+    name: "denoise_radius",
+    description: "kernel radius in pixels of the fixed-radius denoiser",
+    min: 1.0,
+    max: 32.0,
+    default: 5.0,
+    integer: true,
+};
+/// The denoiser's parameters (the `water_photons` technique lists them).
+pub const DENOISE_PARAMS: &[ParamSpec] = &[DENOISE, DENOISE_PASSES, DENOISE_RADIUS];
 
 /// Eq. 25's experimentally defined constant.
 pub const C_SCENE_FACTOR: f32 = 0.114;
@@ -165,8 +167,13 @@ pub fn c_scene(l_min: Vec3) -> f32 {
 /// makes every caustic pixel "bright" (the smallest kernel).
 pub fn scene_l_min(scene: &Scene, time: f32) -> Vec3 {
     let (centre, radius) = scene.bounding_sphere(time);
-    scene
-        .lights
+    lights_l_min(&scene.lights, centre, radius)
+}
+
+/// `scene_l_min` for `lights` around a scene bounded by the sphere
+/// (`centre`, `radius`).
+pub fn lights_l_min(lights: &[Light], centre: Vec3, radius: f32) -> Vec3 {
+    lights
         .iter()
         .map(|light| match light.kind {
             LightKind::Directional => light.intensity,
@@ -297,15 +304,16 @@ impl Denoiser {
     }
 
     /// Records `passes` x 2 timed sub-passes ("denoise <kind> <k> x|y")
-    /// filtering `caustics` in place. `camera` gives the view-space depth of
-    /// Eq. 22; `l_min` is Eq. 25's L_min (W/m², e.g. [`scene_l_min`]).
+    /// filtering `caustics` in place. The camera's `eye` and unit `forward`
+    /// give the view-space depth of Eq. 22; `l_min` is Eq. 25's L_min (W/m², e.g. [`scene_l_min`]).
     /// Afterwards `caustics`' last access is a compute write.
     pub fn record(
         &self,
         rec: &mut FrameRecorder,
         caustics: &Image,
         position: &Image,
-        camera: &Camera,
+        eye: Vec3,
+        forward: Vec3,
         l_min: Vec3,
     ) {
         assert!(
@@ -313,9 +321,8 @@ impl Denoiser {
             "Denoiser::record: not the caustics and position images it was built for"
         );
         let ctx = rec.ctx().clone();
-        let forward = (camera.target - camera.eye).normalize();
         let push = |axis: u32| Push {
-            eye_c_scene: camera.eye.extend(c_scene(l_min)).to_array(),
+            eye_c_scene: eye.extend(c_scene(l_min)).to_array(),
             forward_epsilon: forward.extend(DEPTH_EPSILON).to_array(),
             mode: [axis, self.config.kind.code(), self.config.fixed_radius, 0],
         };
@@ -461,7 +468,14 @@ pub fn adaptive_vs_fixed(
                         )
                     };
                 });
-                denoiser.record(rec, &work, position, camera, l_min);
+                denoiser.record(
+                    rec,
+                    &work,
+                    position,
+                    camera.eye,
+                    (camera.target - camera.eye).normalize(),
+                    l_min,
+                );
                 Ok(())
             })?;
             // Frame 0 pays pipeline compilation (GUIDE §8): not timed.

@@ -1,0 +1,644 @@
+//! `water_photons`: Kougianos & Moustakas 2021, "Large-scale ray traced
+//! water caustics in real-time using cascaded caustic maps" (§3, Fig. 1):
+//!
+//! 1. "water surface" + "ccm raster" (`ccm`): the water's Gerstner surface
+//!    evaluated on the GPU and rasterised from the directional light into
+//!    the cascaded caustic maps: N cascades of ccm_0² texels, scale s, one
+//!    orthographic projection each (Eq. 2) from one light view (Eq. 1,
+//!    centred on the camera's position, followed frame by frame), layer c of a 2D
+//!    array holding world position and normal (src/cascades.rs).
+//! 2. "photon trace" (`trace`, glsl/water_photons/trace.comp): Algorithm 1
+//!    maps each thread to (texel, cascade); Algorithm 3 traces a shadow ray,
+//!    then the reflected and refracted rays through the BVH; a front-facing
+//!    diffuse hit appends a photon with its differential (Eq. 10, Algorithm
+//!    2: the footprint ∂x'/∂u, ∂x'/∂v on the receiver's tangent plane and
+//!    σ of Eq. 11) through an atomic counter that is also the indirect
+//!    draw's instance count, clamped to the capacity (overflow reported).
+//! 3. "photon splat" (`splat`): one instanced quad per photon by
+//!    vkCmdDrawIndirect, on the tangent plane, depth-tested against the
+//!    camera's depth, additive into the screen-space caustic buffer of
+//!    irradiance E (W/m²).
+//! 4. "denoise <kind> <k> x|y" (`denoise`, glsl/water_photons/denoise.comp):
+//!    the adaptive-radius cross-bilateral filter of §3.3 (Eqs. 21-28,
+//!    Algorithm 4) or the fixed-radius one it improves on, `denoise_passes`
+//!    times, in place on the caustic buffer (`denoise` 0 skips it).
+//! 5. "caustic composite": L += albedo/π · E on the diffuse receivers of
+//!    the opaque frame (`direct` over a G-buffer without the water), then
+//!    image_space's `CameraRefraction` draws the water itself: the camera
+//!    above sees the floor (with its caustics) refracted through the surface.
+//!
+//! Radiometry. Physical mode (`intensity_mode` 0, default): a texel of
+//! cascade c covers A_⊥ = (r_w s^c / ccm_0)(r_h s^c / ccm_0) across the
+//! beam (Eq. 7's s^(2c) is the ratio to cascade 0), so its photon leaves
+//! the water with Φ = E_light A_⊥ times the exact Fresnel F (reflected) or
+//! 1 − F and the water's Beer-Lambert absorption (refracted). The splat
+//! deposits exactly Φ: E(x) = Φ k(x) / |U × V| with the tent kernel k over
+//! the quad x = x' + a U + b V, whose integral is |U × V| (Eq. 20's
+//! I = R / (a q²) is this quad's mean). On a regular lattice of photons
+//! (flat water) the tents tile exactly, so the caustic is uniform:
+//! E = E_light cos θ_i (1 − F) on a floor parallel to the water. Paper mode
+//! (1): R = L I_att F of Eqs. 12-15 (attenuation γ, t_max; stylised Fresnel
+//! F_frac, F_exp) in place of the flux, same splat.
+//! Splat shapes (`splat_mode`): 0, the differential's own parallelogram
+//! (U, V = ∂x'/∂u, ∂x'/∂v); 1, Eqs. 16-19's rectangle (size q from σ,
+//! stretched by a along the projected ray); 2, fixed splats: that rectangle
+//! with σ = s^c, no differentials (the paper's comparison).
+//!
+//! Light: the scene's first directional light (the paper's sun); a scene
+//! without one, or without a water object, is refused. The first water
+//! object is the one traced. The light range (`light_range` 0) is derived
+//! so that the outermost cascade covers the whole water seen from Eq. 1's
+//! origin; the depth range spans the water's bounds.
+//!
+//! Deviations from the paper: the light view's up vector is +z under a
+//! high sun (`CascadeFrame::new`), so the texel grid lines up with the
+//! water's; Eq. 16's grid pitch is r / ccm_0 (the printed r / (ccm_0 − 1)
+//! would leave q_0 = 2 tents overlapping); the neighbours' rays of
+//! Algorithm 2 meet the receiver's tangent plane instead of stopping at t'
+//! (the same on a plane parallel to flat water, exact on any plane); the
+//! kernel is a tent normalised over the quad where the paper scales a
+//! shaded quad by Eq. 20 (the tent's mean is Eq. 20's I); Algorithm 3
+//! line 24 prints reflect(LDir, n10), we reflect about the photon's own
+//! normal n00 (n10 belongs to the right neighbour's ray, Algorithm 2).
+//!
+//! Limits: one specular bounce (L S D): photons whose ray meets another
+//! specular surface first are dropped, so light reflected back under the
+//! water by total internal reflection is missing; photons whose
+//! neighbours (both sides along u or v) hold no water have no footprint
+//! and are dropped (texels on the water's rim); splats overlapping a
+//! depth edge spill onto the surface behind.
+
+mod ccm;
+pub mod denoise;
+mod splat;
+mod trace;
+
+pub use ccm::Ccm;
+pub use denoise::{Denoiser, DENOISE, DENOISE_PASSES, DENOISE_RADIUS};
+pub use splat::{Composite, Splat};
+pub use trace::{GpuWaterPhoton, PhotonCounts, Trace, GUARD_PHOTONS, GUARD_WORD};
+
+use super::direct::{self, Direct};
+use super::image_space::{CameraRefraction, RefractionPush};
+use super::{ParamSpec, Params, Technique};
+use crate::cascades::{inner_cascade_size, light_position, CascadeLayout, LightRange};
+use crate::gpu::GpuFrame;
+use crate::passes::gbuffer::GBufferContents;
+use crate::renderer::{FrameTargets, SceneGpu};
+use crate::scene::{Light, LightKind, Scene, Water};
+use crate::shader_bindings as b;
+use crate::vk::{Buffer, BufferUsage, Context, FrameRecorder, VkResult};
+use anyhow::Context as _;
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3};
+use std::mem::size_of;
+use std::sync::Arc;
+
+pub const PARAMS: &[ParamSpec] = &[
+    direct::SHADOW_MAP_SIZE,
+    direct::PCF_RADIUS,
+    ParamSpec {
+        name: "cascades",
+        description: "N, the number of cascaded caustic maps (Eqs. 4-5)",
+        min: 1.0,
+        max: b::WP_MAX_CASCADES as f32,
+        default: 2.0,
+        integer: true,
+    },
+    ParamSpec {
+        name: "cascade_scale",
+        description: "s, each cascade covers s times the extent of the previous one (Eq. 2)",
+        min: 1.25,
+        max: 8.0,
+        default: 2.0,
+        integer: false,
+    },
+    ParamSpec {
+        name: "ccm_size",
+        description: "ccm_0, texels per side of every cascade (Eq. 3 picks 256-2048 from range / precision)",
+        min: 16.0,
+        max: 2048.0,
+        default: 512.0,
+        integer: true,
+    },
+    ParamSpec {
+        name: "ccm_precision",
+        description: "p of Eq. 3 in metres per texel: ccm_0 is then the smallest of 256, 512, 1024, 2048 covering the range; 0: ccm_size decides",
+        min: 0.0,
+        max: 1000.0,
+        default: 0.0,
+        integer: false,
+    },
+    ParamSpec {
+        name: "light_range",
+        description: "width (= height) r of the innermost cascade in metres; 0: the outermost cascade just covers the water",
+        min: 0.0,
+        max: 100000.0,
+        default: 0.0,
+        integer: false,
+    },
+    ParamSpec {
+        name: "photon_capacity",
+        description: "photon buffer size; 0: twice the threads of Eq. 5 (a reflected and a refracted photon each, never overflows)",
+        min: 0.0,
+        max: 33554432.0,
+        default: 0.0,
+        integer: true,
+    },
+    ParamSpec {
+        name: "splat_mode",
+        description: "0: the photon differential's footprint (exact flux density); 1: Eqs. 16-19's quad sized by σ; 2: fixed splats (Eqs. 16-19 with σ = s^c, no differentials)",
+        min: 0.0,
+        max: 2.0,
+        default: 0.0,
+        integer: true,
+    },
+    ParamSpec {
+        name: "intensity_mode",
+        description: "0: physical (exact Fresnel, photon flux = E x texel area, absorption); 1: the paper's Eqs. 12-15 (attenuation, stylised Fresnel)",
+        min: 0.0,
+        max: 1.0,
+        default: 0.0,
+        integer: true,
+    },
+    ParamSpec {
+        name: "quad_size",
+        description: "q_0 of Eq. 16 in texel pitches (splat modes 1, 2); 2 makes tent kernels tile a flat surface",
+        min: 0.25,
+        max: 16.0,
+        default: 2.0,
+        integer: false,
+    },
+    ParamSpec {
+        name: "fresnel_frac",
+        description: "F_frac of Eq. 14 (intensity_mode 1)",
+        min: 0.0,
+        max: 1.0,
+        default: 0.02,
+        integer: false,
+    },
+    ParamSpec {
+        name: "fresnel_exp",
+        description: "F_exp of Eq. 14 (intensity_mode 1)",
+        min: 0.1,
+        max: 16.0,
+        default: 5.0,
+        integer: false,
+    },
+    ParamSpec {
+        name: "attenuation_gamma",
+        description: "γ of Eq. 13, the focus bias (intensity_mode 1)",
+        min: 0.01,
+        max: 0.99,
+        default: 0.95,
+        integer: false,
+    },
+    ParamSpec {
+        name: "attenuation_t_max",
+        description: "t_max of Eq. 13 in metres (intensity_mode 1)",
+        min: 0.01,
+        max: 100000.0,
+        default: 20.0,
+        integer: false,
+    },
+    ParamSpec {
+        name: "depth_bias",
+        description: "splats move toward the camera by this fraction of their distance before the depth test (along the view ray: the image does not move); 0.001 lets ocean_large's far seabed reject its own splats",
+        min: 0.0,
+        max: 0.1,
+        default: 0.01,
+        integer: false,
+    },
+    DENOISE,
+    DENOISE_PASSES,
+    DENOISE_RADIUS,
+    ParamSpec {
+        name: "search_steps",
+        description: "linear steps of the camera refraction's image-space search (image_space)",
+        min: 4.0,
+        max: 256.0,
+        default: 32.0,
+        integer: true,
+    },
+];
+
+/// The uniform block `WpParams` of glsl/water_photons/common.glsl (std140).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuWpParams {
+    pub light_view: [[f32; 4]; 4],
+    pub light_dir: [f32; 4],
+    pub irradiance: [f32; 4],
+    pub range: [f32; 4],
+    pub size: [u32; 4],
+    pub modes: [u32; 4],
+    pub cascade: [f32; 4],
+    pub paper: [f32; 4],
+    pub water: [u32; 4],
+}
+const _: () = assert!(size_of::<GpuWpParams>() == 192);
+
+/// The uniform buffer holding `GpuWpParams`, shared by the passes.
+pub struct WpParamsBuffer(pub Buffer);
+
+/// Light view and cascades of one directional light over one water surface.
+#[derive(Clone, Copy, Debug)]
+pub struct CascadeFrame {
+    pub view: Mat4,
+    pub range: LightRange,
+    pub layout: CascadeLayout,
+}
+
+impl CascadeFrame {
+    /// Eq. 1's light view from `origin` (the camera position) along the
+    /// light `dir`, far enough back that the whole water lies ahead; depth
+    /// range over the water's bounds; cascade 0 `range` metres wide, or
+    /// (range 0) so wide that cascade N − 1 covers the water.
+    pub fn new(water: &Water, origin: Vec3, dir: Vec3, layout: CascadeLayout, range: f32) -> Self {
+        let dir = dir.normalize();
+        let (lo, hi) = water_bounds(water);
+        let corners: Vec<Vec3> = (0..8)
+            .map(|i| {
+                Vec3::new(
+                    if i & 1 == 0 { lo.x } else { hi.x },
+                    if i & 2 == 0 { lo.y } else { hi.y },
+                    if i & 4 == 0 { lo.z } else { hi.z },
+                )
+            })
+            .collect();
+        let behind = corners
+            .iter()
+            .map(|c| -(*c - origin).dot(dir))
+            .fold(0.0f32, f32::max);
+        let back = behind + 1.0;
+        // `cascades::light_view` keeps +y up, which turns the texel grid
+        // against the water's x/z grid under a high sun; up = +z (or +y for
+        // a low sun) lines the two up, so the water fills the map.
+        let up = if dir.y.abs() > 0.5 { Vec3::Z } else { Vec3::Y };
+        let view = Mat4::look_to_rh(light_position(origin, dir, 0.0, back), dir, up);
+        let local: Vec<Vec3> = corners.iter().map(|c| view.transform_point3(*c)).collect();
+        // View space looks down −z: depth = −z.
+        let near = local.iter().map(|p| -p.z).fold(f32::MAX, f32::min) - 0.5;
+        let far = local.iter().map(|p| -p.z).fold(f32::MIN, f32::max) + 0.5;
+        let half = local
+            .iter()
+            .map(|p| p.x.abs().max(p.y.abs()))
+            .fold(0.0f32, f32::max)
+            * 1.001;
+        let width = if range > 0.0 {
+            range
+        } else {
+            2.0 * half / layout.scale.powi(layout.levels as i32 - 1)
+        };
+        Self {
+            view,
+            range: LightRange {
+                width,
+                height: width,
+                near: near.max(1e-3),
+                far,
+            },
+            layout,
+        }
+    }
+
+    /// Cascade c's world → clip (Eq. 2 × Eq. 1).
+    pub fn view_proj(&self, c: u32) -> Mat4 {
+        self.layout.projection(&self.range, c) * self.view
+    }
+}
+
+/// Axis-aligned bounds of a water surface over all times: the rest
+/// rectangle grown by the waves' horizontal and vertical reach.
+pub fn water_bounds(water: &Water) -> (Vec3, Vec3) {
+    let vertical: f32 = water.waves.iter().map(|w| w.amplitude).sum();
+    let horizontal: f32 = water.waves.iter().map(|w| w.amplitude * w.steepness).sum();
+    let half = water.size * 0.5 + glam::Vec2::splat(horizontal);
+    (
+        Vec3::new(
+            water.center.x - half.x,
+            water.base_height - vertical,
+            water.center.y - half.y,
+        ),
+        Vec3::new(
+            water.center.x + half.x,
+            water.base_height + vertical,
+            water.center.y + half.y,
+        ),
+    )
+}
+
+pub struct WaterPhotons {
+    /// Direct light on the scene without the water (it still casts shadows).
+    pub direct: Direct,
+    /// Direct light + surface caustics without the water: what the camera
+    /// refraction looks up.
+    pub opaque: FrameTargets,
+    pub ccm: Ccm,
+    pub trace: Trace,
+    pub splat: Splat,
+    /// `None` when `denoise` = 0.
+    pub denoiser: Option<Denoiser>,
+    /// Eq. 25's L_min (W/m²) from the scene's lights.
+    l_min: Vec3,
+    /// The scene's bounding sphere, for `l_min` when lights change.
+    scene_sphere: (Vec3, f32),
+    composite: Composite,
+    refraction: CameraRefraction,
+    pub frame: CascadeFrame,
+    params: WpParamsBuffer,
+    gpu_params: GpuWpParams,
+    water_material: u32,
+    /// Eq. 1's origin o: the camera position the cascades were placed for.
+    camera_origin: Vec3,
+    light: Light,
+    range_param: f32,
+    water: Water,
+}
+
+fn first_directional(lights: &[Light]) -> Option<&Light> {
+    lights.iter().find(|l| l.kind == LightKind::Directional)
+}
+
+impl WaterPhotons {
+    pub fn new(
+        ctx: &Arc<Context>,
+        params: &Params,
+        scene: &Scene,
+        scene_gpu: &SceneGpu,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<Self> {
+        let water = scene
+            .objects
+            .iter()
+            .find_map(|o| o.water.clone())
+            .context("water_photons needs a `water` object in the scene")?;
+        let light = *first_directional(&scene.lights)
+            .context("water_photons needs a directional light (the paper's sun)")?;
+        let levels = params.get("cascades") as u32;
+        let scale = params.get("cascade_scale");
+        let range_param = params.get("light_range");
+        let precision = params.get("ccm_precision");
+        let size = if precision > 0.0 {
+            // Eq. 3 from the range, which does not depend on ccm_0.
+            let probe = CascadeLayout::new([256, 256], levels, scale)?;
+            let frame = CascadeFrame::new(
+                &water,
+                scene.camera.eye,
+                light.direction,
+                probe,
+                range_param,
+            );
+            inner_cascade_size(&frame.range, precision)
+        } else {
+            params.get("ccm_size") as u32
+        };
+        let layout = CascadeLayout::new([size, size], levels, scale)?;
+        let frame = CascadeFrame::new(
+            &water,
+            scene.camera.eye,
+            light.direction,
+            layout,
+            range_param,
+        );
+        // The photon buffer is one storage-buffer binding: the device's
+        // maxStorageBufferRange bounds it (128 MiB on lavapipe: 1.4M photons).
+        let photon_bytes = size_of::<GpuWaterPhoton>() as u64;
+        let device_max =
+            ctx.limits.max_storage_buffer_range as u64 / photon_bytes - GUARD_PHOTONS as u64;
+        let capacity = match params.get("photon_capacity") as u64 {
+            0 => {
+                let wanted = 2 * layout.total_threads();
+                if wanted > device_max {
+                    log::warn!(
+                        "water_photons: {wanted} photon slots (2 per thread of {levels} cascades of {size}²) exceed the device's storage buffer range; using {device_max}, overflow is possible"
+                    );
+                }
+                wanted.min(device_max)
+            }
+            n => n,
+        };
+        anyhow::ensure!(
+            capacity <= device_max,
+            "photon_capacity={capacity}: the device binds at most {device_max} photons ({} bytes each) in one storage buffer",
+            photon_bytes
+        );
+        let capacity = capacity as u32;
+        let direct = Direct::with_contents(
+            ctx,
+            params,
+            scene,
+            scene_gpu,
+            width,
+            height,
+            GBufferContents::Opaque,
+        )?;
+        let opaque = FrameTargets::new(ctx, width, height)?;
+        let params_buffer = WpParamsBuffer(Buffer::new(
+            ctx,
+            "water_photons params",
+            size_of::<GpuWpParams>() as u64,
+            BufferUsage::Uniform,
+        )?);
+        let ccm = Ccm::new(ctx, &water, size, levels)?;
+        let trace = Trace::new(
+            ctx,
+            scene_gpu,
+            &params_buffer,
+            &ccm.position,
+            &ccm.normal,
+            &layout,
+            capacity,
+        )?;
+        let splat = Splat::new(
+            ctx,
+            scene_gpu,
+            &params_buffer,
+            &trace.photons,
+            width,
+            height,
+        )?;
+        let denoiser =
+            Denoiser::from_params(ctx, params, &splat.caustics, &direct.gbuffer.position)?;
+        let scene_sphere = scene.bounding_sphere(0.0);
+        // The composite reads the splat's caustic buffer (denoised in place).
+        let composite = Composite::new(
+            ctx,
+            scene_gpu,
+            &splat.caustics,
+            &direct.gbuffer,
+            &opaque.radiance,
+        )?;
+        let refraction = CameraRefraction::new(
+            ctx,
+            scene_gpu,
+            &opaque.radiance,
+            &direct.gbuffer,
+            RefractionPush {
+                tir_remedy: b::TIR_CLAMP_CRITICAL,
+                use_eq632: 1,
+                search_steps: params.get("search_steps") as u32,
+                pad: 0,
+            },
+        )?;
+        let gpu_params = GpuWpParams {
+            light_view: Mat4::IDENTITY.to_cols_array_2d(),
+            light_dir: [0.0; 4],
+            irradiance: [0.0; 4],
+            range: [0.0; 4],
+            size: [size, size, levels, capacity],
+            modes: [
+                layout.border[0],
+                layout.border[1],
+                params.get("intensity_mode") as u32,
+                params.get("splat_mode") as u32,
+            ],
+            cascade: [
+                layout.scale,
+                params.get("quad_size"),
+                params.get("fresnel_frac"),
+                params.get("fresnel_exp"),
+            ],
+            paper: [
+                params.get("attenuation_gamma"),
+                params.get("attenuation_t_max"),
+                // ε of Eq. 19.
+                1e-3,
+                params.get("depth_bias"),
+            ],
+            water: [water.material, 0, 0, 0],
+        };
+        let mut technique = Self {
+            direct,
+            opaque,
+            ccm,
+            trace,
+            splat,
+            denoiser,
+            l_min: denoise::lights_l_min(&scene.lights, scene_sphere.0, scene_sphere.1),
+            scene_sphere,
+            composite,
+            refraction,
+            frame,
+            params: params_buffer,
+            gpu_params,
+            water_material: water.material,
+            camera_origin: scene.camera.eye,
+            light,
+            range_param,
+            water,
+        };
+        technique.set_light(&light);
+        Ok(technique)
+    }
+
+    fn set_light(&mut self, light: &Light) {
+        self.light = *light;
+        self.frame = CascadeFrame::new(
+            &self.water,
+            self.camera_origin,
+            light.direction,
+            self.frame.layout,
+            self.range_param,
+        );
+        let p = &mut self.gpu_params;
+        p.light_view = self.frame.view.to_cols_array_2d();
+        p.light_dir = light.direction.normalize().extend(0.0).to_array();
+        p.irradiance = light.intensity.extend(0.0).to_array();
+        let r = self.frame.range;
+        p.range = [r.width, r.height, r.near, r.far];
+        p.water = [self.water_material, 0, 0, 0];
+    }
+
+    /// Photons written and requested in the last frame.
+    pub fn photon_counts(&self) -> VkResult<PhotonCounts> {
+        self.trace.counts()
+    }
+}
+
+impl Technique for WaterPhotons {
+    fn name(&self) -> &'static str {
+        "water_photons"
+    }
+
+    fn record(
+        &mut self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        targets: &FrameTargets,
+    ) -> VkResult<()> {
+        // Last frame's counts (the renderer waited for it): report overflow.
+        let counts = self.trace.counts()?;
+        if counts.overflow() > 0 {
+            log::warn!(
+                "water_photons: {} of {} photons did not fit the buffer of {} (raise photon_capacity)",
+                counts.overflow(),
+                counts.requested,
+                counts.capacity
+            );
+        }
+        // Eq. 1 follows the camera: the frame constants (host-visible,
+        // written before recording) hold this frame's eye.
+        let constants: Vec<GpuFrame> = scene.frame.download_pod()?;
+        let eye = Vec3::from_slice(&constants[0].eye[..3]);
+        // View space looks down -z: the camera's forward is -(third row of the view).
+        let view = Mat4::from_cols_array_2d(&constants[0].view);
+        let forward = -view.row(2).truncate();
+        if eye != self.camera_origin {
+            self.camera_origin = eye;
+            let light = self.light;
+            self.set_light(&light);
+        }
+        // Host write while recording: no earlier frame is still in flight.
+        self.params.0.upload(bytemuck::bytes_of(&self.gpu_params))?;
+        self.direct.record(rec, scene, &self.opaque)?;
+        let view_projs: Vec<Mat4> = (0..self.frame.layout.levels)
+            .map(|c| self.frame.view_proj(c))
+            .collect();
+        self.ccm.record(rec, scene.geometry_time, &view_projs);
+        self.trace
+            .record(rec, scene, &self.ccm.position, &self.ccm.normal);
+        self.splat.record(
+            rec,
+            scene,
+            &self.direct.gbuffer,
+            &self.trace.photons,
+            &self.trace.draw,
+        );
+        if let Some(denoiser) = &self.denoiser {
+            denoiser.record(
+                rec,
+                &self.splat.caustics,
+                &self.direct.gbuffer.position,
+                eye,
+                forward,
+                self.l_min,
+            );
+        }
+        self.composite.record(
+            rec,
+            scene,
+            &self.splat.caustics,
+            &self.direct.gbuffer,
+            &self.opaque.radiance,
+        );
+        self.refraction.record(
+            rec,
+            scene,
+            &self.opaque.radiance,
+            &self.direct.gbuffer,
+            targets,
+        );
+        Ok(())
+    }
+
+    fn set_lights(&mut self, lights: &[Light]) -> bool {
+        let Some(light) = first_directional(lights).copied() else {
+            return false;
+        };
+        self.set_light(&light);
+        self.l_min = denoise::lights_l_min(lights, self.scene_sphere.0, self.scene_sphere.1);
+        self.direct.set_lights(lights)
+    }
+}

@@ -1,0 +1,198 @@
+//! Splatting and composite (Kougianos & Moustakas 2021 §3.2, Eqs. 16-20).
+//!
+//! "photon splat": `vkCmdDrawIndirect` with the trace's draw buffer, one
+//! instanced 4-vertex strip per photon (glsl/water_photons/splat.*), depth
+//! tested (not written) against the camera G-buffer's depth, added into the
+//! screen-space caustic buffer: RGBA32F, rgb the caustic irradiance E
+//! (W/m²) on the visible receiver, a the sum of kernel weights.
+//! "caustic composite" (glsl/water_photons/composite.comp): L += albedo/π · E
+//! on diffuse pixels, reading whichever image `Composite::new` was given
+//! (the caustic buffer, or a denoised copy of it).
+
+use super::WpParamsBuffer;
+use crate::passes::gbuffer::{GBuffer, DEPTH_FORMAT};
+use crate::renderer::SceneGpu;
+use crate::shader_bindings as b;
+use crate::vk::{
+    barrier, begin_rendering_with_depth, end_rendering, Access, BindingKind, Buffer, BufferAccess,
+    ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
+    GraphicsPipelineDesc, Image, ImageAccess, ImageDesc, VkResult,
+};
+use ash::vk;
+use std::sync::Arc;
+
+pub const CAUSTIC_BUFFER_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+
+pub struct Splat {
+    /// Screen-space caustic irradiance (rgb, W/m²) and kernel weight sum (a).
+    pub caustics: Image,
+    pipeline: GraphicsPipeline,
+    set: DescriptorSet,
+    _layout: DescriptorSetLayout,
+}
+
+impl Splat {
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene_gpu: &SceneGpu,
+        params: &WpParamsBuffer,
+        photons: &Buffer,
+        width: u32,
+        height: u32,
+    ) -> VkResult<Self> {
+        let caustics = Image::new(
+            ctx,
+            "caustic buffer",
+            ImageDesc::new_2d(
+                width,
+                height,
+                CAUSTIC_BUFFER_FORMAT,
+                vk::ImageUsageFlags::COLOR_ATTACHMENT
+                    | vk::ImageUsageFlags::STORAGE
+                    | vk::ImageUsageFlags::SAMPLED,
+            ),
+        )?;
+        let layout = DescriptorSetLayout::new(
+            ctx,
+            &[
+                (b::WP_BINDING_PARAMS, BindingKind::Uniform),
+                (b::WP_BINDING_PHOTONS, BindingKind::Storage),
+            ],
+        )?;
+        let set = DescriptorSet::new(ctx, &layout)?;
+        set.write_buffer(b::WP_BINDING_PARAMS, &params.0)
+            .write_buffer(b::WP_BINDING_PHOTONS, photons);
+        let mut desc =
+            GraphicsPipelineDesc::new("water_photons/splat.vert", "water_photons/splat.frag");
+        desc.color_formats = vec![CAUSTIC_BUFFER_FORMAT];
+        desc.depth_format = Some(DEPTH_FORMAT);
+        desc.depth_test = true;
+        desc.depth_write = false;
+        desc.additive = true;
+        desc.topology = vk::PrimitiveTopology::TRIANGLE_STRIP;
+        let pipeline = GraphicsPipeline::new(ctx, &desc, &[&scene_gpu.layout, &layout])?;
+        Ok(Self {
+            caustics,
+            pipeline,
+            set,
+            _layout: layout,
+        })
+    }
+
+    /// Records "photon splat": clears the caustic buffer and draws
+    /// `draw`'s instance count of quads.
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        gbuffer: &GBuffer,
+        photons: &Buffer,
+        draw: &Buffer,
+    ) {
+        let ctx = rec.ctx().clone();
+        rec.pass("photon splat", |cmd| {
+            // The trace's atomics (instanceCount) must be visible to the
+            // indirect read, its photon writes to the vertex shader; the
+            // G-buffer's depth is tested (read), the caustic buffer
+            // overwritten after last frame's composite read it.
+            barrier(
+                &ctx,
+                cmd,
+                &[
+                    ImageAccess::discard(&self.caustics, Access::ColorAttachment),
+                    ImageAccess::new(&gbuffer.depth, Access::DepthAttachment),
+                ],
+                &[
+                    BufferAccess::new(draw, Access::IndirectRead),
+                    BufferAccess::new(photons, Access::VertexRead),
+                ],
+            );
+            let extent = self.caustics.extent();
+            begin_rendering_with_depth(
+                &ctx,
+                cmd,
+                extent,
+                &[(self.caustics.view, Some([0.0; 4]))],
+                Some((gbuffer.depth.view, false)),
+            );
+            self.pipeline
+                .bind(cmd, &[&scene.set, &self.set], &[], extent);
+            unsafe { ctx.device.cmd_draw_indirect(cmd, draw.raw, 0, 1, 0) };
+            end_rendering(&ctx, cmd);
+        });
+    }
+}
+
+/// L += albedo/π · E_caustic on the diffuse receivers of a G-buffer.
+pub struct Composite {
+    pipeline: ComputePipeline,
+    set: DescriptorSet,
+    _layout: DescriptorSetLayout,
+}
+
+impl Composite {
+    /// Reads the caustic irradiance from `caustics`, adds into `radiance`.
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene_gpu: &SceneGpu,
+        caustics: &Image,
+        gbuffer: &GBuffer,
+        radiance: &Image,
+    ) -> VkResult<Self> {
+        let layout = DescriptorSetLayout::new(
+            ctx,
+            &[
+                (b::WP_BINDING_CAUSTICS, BindingKind::StorageImage),
+                (b::WP_BINDING_GBUFFER_POSITION, BindingKind::StorageImage),
+                (b::WP_BINDING_GBUFFER_NORMAL, BindingKind::StorageImage),
+                (b::WP_BINDING_RADIANCE, BindingKind::StorageImage),
+            ],
+        )?;
+        let set = DescriptorSet::new(ctx, &layout)?;
+        set.write_storage_image(b::WP_BINDING_CAUSTICS, caustics)
+            .write_storage_image(b::WP_BINDING_GBUFFER_POSITION, &gbuffer.position)
+            .write_storage_image(b::WP_BINDING_GBUFFER_NORMAL, &gbuffer.normal)
+            .write_storage_image(b::WP_BINDING_RADIANCE, radiance);
+        let pipeline = ComputePipeline::new(
+            ctx,
+            "water_photons/composite.comp",
+            &[&scene_gpu.layout, &layout],
+            0,
+        )?;
+        Ok(Self {
+            pipeline,
+            set,
+            _layout: layout,
+        })
+    }
+
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        caustics: &Image,
+        gbuffer: &GBuffer,
+        radiance: &Image,
+    ) {
+        let ctx = rec.ctx().clone();
+        rec.pass("caustic composite", |cmd| {
+            // The splat's attachment writes and the direct pass's radiance
+            // writes before this read-modify-write.
+            barrier(
+                &ctx,
+                cmd,
+                &[
+                    ImageAccess::new(caustics, Access::ComputeRead),
+                    ImageAccess::new(&gbuffer.position, Access::ComputeRead),
+                    ImageAccess::new(&gbuffer.normal, Access::ComputeRead),
+                    ImageAccess::new(radiance, Access::ComputeWrite),
+                ],
+                &[],
+            );
+            let e = radiance.extent();
+            let groups = [e.width.div_ceil(8), e.height.div_ceil(8), 1];
+            self.pipeline
+                .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
+        });
+    }
+}

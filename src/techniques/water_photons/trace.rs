@@ -1,0 +1,250 @@
+//! Photon differential tracing (glsl/water_photons/trace.comp, Algorithms
+//! 1-3) into an append buffer of photons, and the synchronisation of its
+//! atomic counter (GUIDE §7: reset, atomic writes, indirect read, readback).
+//!
+//! The draw buffer holds a `VkDrawIndirectCommand` (4 vertices, instanceCount
+//! = photons written) followed by `requested` (photons the trace wanted to
+//! write). The shader writes a photon only into a slot below the capacity,
+//! so nothing lands past the buffer; requested − written is the overflow,
+//! copied to a host-visible buffer each frame and reported (a logged warning
+//! and [`PhotonCounts`]).
+
+use super::WpParamsBuffer;
+use crate::cascades::CascadeLayout;
+use crate::renderer::SceneGpu;
+use crate::shader_bindings as b;
+use crate::vk::{
+    barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline, Context,
+    DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageAccess, VkResult,
+};
+use ash::vk;
+use bytemuck::{Pod, Zeroable};
+use std::mem::size_of;
+use std::sync::Arc;
+
+/// One photon, mirrored by `Photon` in glsl/water_photons/common.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct GpuWaterPhoton {
+    /// xyz hit x'; w: cascade c.
+    pub position: [f32; 4],
+    /// xyz receiver normal facing the ray; w: sqrt(A'/A), Eq. 11 without s^c.
+    pub normal: [f32; 4],
+    /// xyz ∂x'/∂u on the receiver's tangent plane; w: ray type (`WP_RAY_*`).
+    pub axis_u: [f32; 4],
+    /// xyz ∂x'/∂v; w: hit distance t' (m).
+    pub axis_v: [f32; 4],
+    /// rgb flux Φ (W; paper mode: R of Eq. 12); w: surface parallelogram area A (m²).
+    pub flux: [f32; 4],
+    /// xyz ray direction; w: 0.
+    pub dir: [f32; 4],
+}
+const _: () = assert!(size_of::<GpuWaterPhoton>() == 96);
+
+/// The draw buffer: `VkDrawIndirectCommand` + the requested counter.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct DrawCounters {
+    vertex_count: u32,
+    instance_count: u32,
+    first_vertex: u32,
+    first_instance: u32,
+    requested: u32,
+    pad: [u32; 3],
+}
+const _: () = assert!(size_of::<DrawCounters>() == 32);
+
+/// Photons of the last traced frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PhotonCounts {
+    /// Written into the buffer (= the splat's instance count).
+    pub written: u32,
+    /// Front-facing receiver hits the trace wanted to store.
+    pub requested: u32,
+    pub capacity: u32,
+}
+
+impl PhotonCounts {
+    pub fn overflow(&self) -> u32 {
+        self.requested.saturating_sub(self.written)
+    }
+}
+
+/// Photons after the capacity, filled with this bit pattern at creation: a
+/// guard the trace must never touch (tests/water_photons.rs checks it).
+pub const GUARD_PHOTONS: u32 = 4;
+pub const GUARD_WORD: u32 = 0xDEAD_BEEF;
+
+pub struct Trace {
+    /// `capacity + GUARD_PHOTONS` photons.
+    pub photons: Buffer,
+    /// `DrawCounters`: indirect arguments and counters.
+    pub draw: Buffer,
+    /// Host-visible copy of `draw`, written at the end of each trace.
+    readback: Buffer,
+    pub capacity: u32,
+    threads: u64,
+    pipeline: ComputePipeline,
+    set: DescriptorSet,
+    _layout: DescriptorSetLayout,
+}
+
+impl Trace {
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene_gpu: &SceneGpu,
+        params: &WpParamsBuffer,
+        ccm_position: &Image,
+        ccm_normal: &Image,
+        layout_c: &CascadeLayout,
+        capacity: u32,
+    ) -> VkResult<Self> {
+        let words = (capacity as usize + GUARD_PHOTONS as usize) * size_of::<GpuWaterPhoton>() / 4;
+        let photons = Buffer::with_data(
+            ctx,
+            "water photons",
+            &vec![GUARD_WORD; words],
+            BufferUsage::Storage,
+        )?;
+        let draw = Buffer::new(
+            ctx,
+            "water photon draw",
+            size_of::<DrawCounters>() as u64,
+            BufferUsage::StorageIndirect,
+        )?;
+        // Zero counts until the first trace lands.
+        let readback = Buffer::with_data(
+            ctx,
+            "water photon counts",
+            &[DrawCounters::zeroed()],
+            BufferUsage::Readback,
+        )?;
+        let layout = DescriptorSetLayout::new(
+            ctx,
+            &[
+                (b::WP_BINDING_PARAMS, BindingKind::Uniform),
+                (b::WP_BINDING_CCM_POSITION, BindingKind::StorageImage),
+                (b::WP_BINDING_CCM_NORMAL, BindingKind::StorageImage),
+                (b::WP_BINDING_PHOTONS, BindingKind::Storage),
+                (b::WP_BINDING_DRAW, BindingKind::Storage),
+            ],
+        )?;
+        let set = DescriptorSet::new(ctx, &layout)?;
+        set.write_buffer(b::WP_BINDING_PARAMS, &params.0)
+            .write_storage_image(b::WP_BINDING_CCM_POSITION, ccm_position)
+            .write_storage_image(b::WP_BINDING_CCM_NORMAL, ccm_normal)
+            .write_buffer(b::WP_BINDING_PHOTONS, &photons)
+            .write_buffer(b::WP_BINDING_DRAW, &draw);
+        let pipeline = ComputePipeline::new(
+            ctx,
+            "water_photons/trace.comp",
+            &[&scene_gpu.layout, &layout],
+            0,
+        )?;
+        Ok(Self {
+            photons,
+            draw,
+            readback,
+            capacity,
+            threads: layout_c.total_threads(),
+            pipeline,
+            set,
+            _layout: layout,
+        })
+    }
+
+    /// The counts of the last completed frame (the renderer waits for each
+    /// frame, so the host-visible copy is current between frames).
+    pub fn counts(&self) -> VkResult<PhotonCounts> {
+        let c: Vec<DrawCounters> = self.readback.download_pod()?;
+        Ok(PhotonCounts {
+            written: c[0].instance_count,
+            requested: c[0].requested,
+            capacity: self.capacity,
+        })
+    }
+
+    /// Records "photon trace": counter reset, the trace, the counts' copy to
+    /// the host; afterwards `draw` is ready as indirect arguments and
+    /// `photons` for the vertex shader.
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        ccm_position: &Image,
+        ccm_normal: &Image,
+    ) {
+        let ctx = rec.ctx().clone();
+        rec.pass("photon trace", |cmd| {
+            // Reset by a transfer write, after last frame's indirect read
+            // and copy (write-after-read).
+            barrier(
+                &ctx,
+                cmd,
+                &[],
+                &[BufferAccess::new(&self.draw, Access::TransferWrite)],
+            );
+            let reset = DrawCounters {
+                vertex_count: 4,
+                ..Zeroable::zeroed()
+            };
+            unsafe {
+                ctx.device
+                    .cmd_update_buffer(cmd, self.draw.raw, 0, bytemuck::bytes_of(&reset))
+            };
+            // The reset before the atomics; the CCM attachments before the
+            // storage-image reads; the photon slots after last frame's
+            // vertex reads; the BVH after any refit.
+            barrier(
+                &ctx,
+                cmd,
+                &[
+                    ImageAccess::new(ccm_position, Access::ComputeRead),
+                    ImageAccess::new(ccm_normal, Access::ComputeRead),
+                ],
+                &[
+                    BufferAccess::new(&self.draw, Access::ComputeWrite),
+                    BufferAccess::new(&self.photons, Access::ComputeWrite),
+                    BufferAccess::new(&scene.triangles, Access::ComputeRead),
+                ],
+            );
+            let per_row = (b::WP_TRACE_GROUP_SIZE * b::WP_TRACE_GROUPS_PER_ROW) as u64;
+            let groups = if self.threads <= per_row {
+                [
+                    self.threads.div_ceil(b::WP_TRACE_GROUP_SIZE as u64) as u32,
+                    1,
+                    1,
+                ]
+            } else {
+                [
+                    b::WP_TRACE_GROUPS_PER_ROW,
+                    self.threads.div_ceil(per_row) as u32,
+                    1,
+                ]
+            };
+            self.pipeline
+                .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
+            // The atomics done, the counts go to the host...
+            barrier(
+                &ctx,
+                cmd,
+                &[],
+                &[
+                    BufferAccess::new(&self.draw, Access::TransferRead),
+                    BufferAccess::new(&self.readback, Access::TransferWrite),
+                ],
+            );
+            let region = vk::BufferCopy::default().size(self.draw.size);
+            unsafe {
+                ctx.device
+                    .cmd_copy_buffer(cmd, self.draw.raw, self.readback.raw, &[region])
+            };
+            barrier(
+                &ctx,
+                cmd,
+                &[],
+                &[BufferAccess::new(&self.readback, Access::HostRead)],
+            );
+        });
+    }
+}

@@ -1,0 +1,985 @@
+//! `water_photons` (Kougianos & Moustakas 2021) on lavapipe, validation on.
+//!
+//! - Algorithm 1 in the trace shader maps threads exactly as the CPU
+//!   (`CascadeLayout::texel_of`).
+//! - Flat water: every photon differential keeps its area (σ = 1 within
+//!   1%), and the caustic on a floor parallel to the water is the analytic
+//!   E cos θ_i (1 − F) (within 1% where the splats tile).
+//! - A long Gerstner crest focuses: σ < 1 under the crest, matching the
+//!   paraxial prediction σ = sqrt(1 − d A k² (n − 1)/n) within 5%.
+//! - Through the crest's focusing, every splat mode deposits the landed
+//!   photons' flux (the irradiance integrated over the floor's pixels).
+//! - Water of IOR 1: the whole frame (shadowed direct light + caustic +
+//!   camera refraction) gives back the `direct` frame without the water.
+//! - The photon count equals a CPU replay of the trace (CPU BVH, rays from
+//!   the CCM read back).
+//! - A tiny photon capacity: the overflow is counted and reported, nothing
+//!   is written past the capacity (guard words intact), the draw's instance
+//!   count is the capacity.
+//! - water_pool seen from a camera below the surface (module docs of
+//!   `water_photons`): the surface-caustics energy within 10% of the
+//!   reference's L S+ D component. A camera above the water sees the floor
+//!   through the surface, an L S D S E path the reference (a light tracer
+//!   connecting diffuse hits to the camera) cannot connect: it renders that
+//!   floor black, so the comparison needs the camera under water.
+
+mod common;
+
+use caustics::cascades::CascadeLayout;
+use caustics::gpu::GpuTriangle;
+use caustics::renderer::{FrameTargets, SceneGpu};
+use caustics::scene::{MaterialKind, Scene, Water, Wave};
+use caustics::shader_bindings as b;
+use caustics::techniques::water_photons::{
+    GpuWaterPhoton, WaterPhotons, GUARD_PHOTONS, GUARD_WORD, PARAMS,
+};
+use caustics::techniques::{Params, Technique};
+use caustics::vk::{
+    BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    Profiler,
+};
+use common::*;
+use glam::{Vec2, Vec3};
+use std::sync::Arc;
+
+const SIZE: u32 = 128;
+
+struct Run {
+    technique: WaterPhotons,
+    scene_gpu: SceneGpu,
+    /// The frame targets the technique records into.
+    targets: FrameTargets,
+}
+
+fn render(ctx: &Arc<Context>, scene: &Scene, overrides: &[&str], size: u32) -> Run {
+    render_at(ctx, scene, overrides, size, 0.0)
+}
+
+/// One frame with the geometry (and the GPU water surface) at `time`.
+fn render_at(ctx: &Arc<Context>, scene: &Scene, overrides: &[&str], size: u32, time: f32) -> Run {
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let params = Params::resolve("water_photons", PARAMS, &overrides).unwrap();
+    let scene_gpu = SceneGpu::new(ctx, scene, time).unwrap();
+    scene_gpu.update_frame(scene, size, size, time, 0).unwrap();
+    let targets = FrameTargets::new(ctx, size, size).unwrap();
+    let mut technique = WaterPhotons::new(ctx, &params, scene, &scene_gpu, size, size).unwrap();
+    let profiler = Profiler::new(ctx, 32).unwrap();
+    profiler
+        .frame(|rec| technique.record(rec, &scene_gpu, &targets))
+        .unwrap();
+    Run {
+        technique,
+        scene_gpu,
+        targets,
+    }
+}
+
+fn photons(run: &Run) -> Vec<GpuWaterPhoton> {
+    let counts = run.technique.photon_counts().unwrap();
+    let all: Vec<GpuWaterPhoton> = run.technique.trace.photons.download_pod().unwrap();
+    all[..counts.written as usize].to_vec()
+}
+
+fn water(size: Vec2, resolution: [u32; 2], base_height: f32, waves: Vec<Wave>) -> Water {
+    Water {
+        center: Vec2::ZERO,
+        size,
+        resolution,
+        base_height,
+        material: 1,
+        waves,
+    }
+}
+
+/// A 40 m floor at y = 0 (material 0), water (material 1, IOR 1.33) above.
+fn water_scene(water: Water, light_dir: Vec3, eye: Vec3) -> Scene {
+    let mut w = object("water", water.mesh(0.0));
+    w.water = Some(water);
+    scene(
+        camera(eye, Vec3::ZERO, 50.0),
+        vec![directional_light(light_dir, 1000.0)],
+        vec![diffuse("floor", 0.8), dielectric("water", 1.33)],
+        vec![object("floor", floor_mesh(20.0, 0.0, 0)), w],
+    )
+}
+
+#[test]
+fn algorithm_1_on_the_gpu_matches_the_cpu() {
+    let ctx = validated_context();
+    let set_layout =
+        DescriptorSetLayout::new(&ctx, &[(b::PROBE_BINDING_RESULTS, BindingKind::Storage)])
+            .unwrap();
+    let pipeline =
+        ComputePipeline::new(&ctx, "tests/ccm_distribution.comp", &[&set_layout], 32).unwrap();
+    for (size, levels, scale) in [
+        ([64, 64], 1, 2.0),
+        ([64, 64], 4, 2.0),
+        ([128, 128], 3, 4.0),
+        ([60, 34], 3, 3.0),
+        ([7, 6], 2, 2.0),
+        ([257, 129], 2, 1.7),
+    ] {
+        let layout = CascadeLayout::new(size, levels, scale).unwrap();
+        // A few threads past the end too: they must map to nothing.
+        let threads = layout.total_threads() as u32 + 70;
+        let results =
+            Buffer::new(&ctx, "probe", threads as u64 * 16, BufferUsage::Storage).unwrap();
+        let set = DescriptorSet::new(&ctx, &set_layout).unwrap();
+        set.write_buffer(b::PROBE_BINDING_RESULTS, &results);
+        let push: [u32; 8] = [
+            size[0],
+            size[1],
+            levels,
+            threads,
+            layout.border[0],
+            layout.border[1],
+            0,
+            0,
+        ];
+        ctx.submit_and_wait(|cmd| {
+            pipeline.dispatch(
+                cmd,
+                &[&set],
+                bytemuck::bytes_of(&push),
+                [threads.div_ceil(64), 1, 1],
+            )
+        })
+        .unwrap();
+        let gpu: Vec<[u32; 4]> = results.download_pod().unwrap();
+        for (thread, g) in gpu.iter().enumerate().take(threads as usize) {
+            let cpu = layout
+                .texel_of(thread as u64)
+                .map(|([x, y], c)| [x, y, c, 1])
+                .unwrap_or([0; 4]);
+            assert_eq!(*g, cpu, "{layout:?}: thread {thread}");
+        }
+    }
+    assert_validation_clean(&ctx);
+}
+
+#[test]
+fn flat_water_gives_a_uniform_caustic() {
+    let ctx = validated_context();
+    let light = Vec3::new(0.3, -1.0, 0.2).normalize();
+    let s = water_scene(
+        water(Vec2::new(4.0, 4.0), [16, 16], 1.0, vec![]),
+        light,
+        Vec3::new(0.0, 1.0, 0.0) - light * 5.0,
+    );
+    let run = render(&ctx, &s, &["ccm_size=64", "cascades=1"], SIZE);
+    let p = photons(&run);
+    let refracted: Vec<_> = p
+        .iter()
+        .filter(|p| p.axis_u[3] == b::WP_RAY_REFRACTED as f32)
+        .collect();
+    assert!(
+        refracted.len() > 1000,
+        "{} refracted photons",
+        refracted.len()
+    );
+    let (lo, hi) = refracted.iter().fold((f32::MAX, f32::MIN), |(lo, hi), p| {
+        (lo.min(p.normal[3]), hi.max(p.normal[3]))
+    });
+    println!(
+        "flat water: {} refracted photons, σ in [{lo:.5}, {hi:.5}]",
+        refracted.len()
+    );
+    assert!(
+        (lo - 1.0).abs() < 0.01 && (hi - 1.0).abs() < 0.01,
+        "σ in [{lo}, {hi}]"
+    );
+    // Reflected photons leave upward: nothing above to land on.
+    assert_eq!(refracted.len(), p.len());
+
+    // E = E_light cos θ_i (1 − F) on the floor, away from the beam's edges
+    // (where the last row of tents fades out).
+    let cos_i = -light.y as f64;
+    let eta = 1.0 / 1.33f64;
+    let sin_t2 = eta * eta * (1.0 - cos_i * cos_i);
+    let cos_t = (1.0 - sin_t2).sqrt();
+    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    let f = 0.5 * (rs * rs + rp * rp);
+    let expected = 1000.0 * cos_i * (1.0 - f);
+    let caustics = run.technique.splat.caustics.download_rgba32f().unwrap();
+    let position = run
+        .technique
+        .direct
+        .gbuffer
+        .position
+        .download_rgba32f()
+        .unwrap();
+    // Where the refracted beam's centre lands: the water's centre moved along the refracted ray.
+    let t_dir = {
+        let l = light.as_dvec3();
+        let n = glam::DVec3::Y;
+        (eta * l + (eta * cos_i - cos_t) * n).normalize()
+    };
+    let centre = (glam::DVec3::new(0.0, 1.0, 0.0) + t_dir * (1.0 / -t_dir.y)).as_vec3();
+    let (mut n, mut worst) = (0, 0.0f64);
+    for i in 0..(SIZE * SIZE) as usize {
+        let x = Vec3::from_slice(&position[4 * i..4 * i + 3]);
+        if position[4 * i + 3] == 0.0 || x.y.abs() > 1e-3 {
+            continue;
+        }
+        let d = x - centre;
+        if d.x.abs() > 1.5 || d.z.abs() > 1.5 {
+            continue;
+        }
+        let e = caustics[4 * i] as f64;
+        worst = worst.max((e - expected).abs() / expected);
+        n += 1;
+    }
+    println!("flat water: {n} floor pixels, E expected {expected:.3} W/m², worst relative error {worst:.5}");
+    assert!(n > 500, "{n} pixels checked");
+    assert!(worst < 0.01, "worst relative error {worst}");
+    assert_validation_clean(&ctx);
+}
+
+/// The focusing scene: an 8 x 2 m strip of water at 2 m over the floor,
+/// one long wave along x (A = 0.3 m, λ = 4 m, no steepness), the sun
+/// straight down.
+const CREST_A: f32 = 0.3;
+const CREST_LAMBDA: f32 = 4.0;
+const CREST_BASE: f32 = 2.0;
+
+fn crest_scene() -> Scene {
+    let wave = Wave {
+        amplitude: CREST_A,
+        wavelength: CREST_LAMBDA,
+        direction_deg: 0.0,
+        steepness: 0.0,
+        speed: 0.0,
+        phase: 0.0,
+    };
+    water_scene(
+        water(Vec2::new(8.0, 2.0), [256, 8], CREST_BASE, vec![wave]),
+        Vec3::NEG_Y,
+        Vec3::new(0.5, 8.0, 3.0),
+    )
+}
+
+#[test]
+fn a_crest_focuses_as_a_lens() {
+    let ctx = validated_context();
+    let run = render(&ctx, &crest_scene(), &["ccm_size=128", "cascades=1"], SIZE);
+    let p = photons(&run);
+    let refracted: Vec<_> = p
+        .iter()
+        .filter(|p| p.axis_u[3] == b::WP_RAY_REFRACTED as f32)
+        .collect();
+    // Paraxial: under the crest (slope 0, curvature κ = A k²) a ray at
+    // offset δ leaves tilted by (1 − 1/n) κ δ toward the axis, so after the
+    // depth d to the floor the strip δ shrinks to δ (1 − d κ (n − 1)/n);
+    // along the crest nothing changes, so σ² = A'/A is that factor.
+    let k = std::f32::consts::TAU / CREST_LAMBDA;
+    let d = CREST_BASE + CREST_A;
+    let n = 1.33;
+    let predicted = (1.0 - d * CREST_A * k * k * (n - 1.0) / n).sqrt();
+    let min = refracted
+        .iter()
+        .map(|p| p.normal[3])
+        .fold(f32::MAX, f32::min);
+    let max = refracted
+        .iter()
+        .map(|p| p.normal[3])
+        .fold(f32::MIN, f32::max);
+    println!(
+        "crest: {} refracted photons, σ in [{min:.4}, {max:.4}], paraxial crest σ {predicted:.4}",
+        refracted.len()
+    );
+    assert!(
+        (min - predicted).abs() < 0.05 * predicted,
+        "min σ {min}, predicted {predicted}"
+    );
+    // Troughs spread the light.
+    assert!(max > 1.1, "max σ {max}");
+    // The crests: sin(k x) = 1 at x = 1 and x = −3.
+    for p in refracted.iter().filter(|p| p.normal[3] < 0.85) {
+        let x = p.position[0];
+        assert!(
+            (x - 1.0).abs() < 0.8 || (x + 3.0).abs() < 0.8,
+            "focused photon (σ {}) at x = {x}, not under a crest",
+            p.normal[3]
+        );
+    }
+    assert_validation_clean(&ctx);
+}
+
+fn offset(x: Vec3, n: Vec3) -> Vec3 {
+    x + n * (1e-4 * x.abs().max_element().max(1.0))
+}
+
+/// The trace replayed on the CPU: rays from the CCM texels read back
+/// (Algorithm 1's threads), the CPU BVH, the same acceptance (water texel
+/// with a neighbour along each axis, lit, front face of a diffuse receiver).
+fn cpu_photon_count(run: &Run, s: &Scene, time: f32) -> u64 {
+    let tech = &run.technique;
+    let layout = tech.frame.layout;
+    let [w, h] = layout.size;
+    let read = |img: &caustics::vk::Image| -> Vec<Vec<f32>> {
+        (0..layout.levels)
+            .map(|c| img.download_layer_rgba32f(c).unwrap())
+            .collect()
+    };
+    let (pos, nrm) = (read(&tech.ccm.position), read(&tech.ccm.normal));
+    let fetch = |x: i64, y: i64, c: usize| -> Option<(Vec3, Vec3)> {
+        if x < 0 || y < 0 || x >= w as i64 || y >= h as i64 {
+            return None;
+        }
+        let i = 4 * (y as usize * w as usize + x as usize);
+        (pos[c][i + 3] != 0.0).then(|| {
+            (
+                Vec3::from_slice(&pos[c][i..i + 3]),
+                Vec3::from_slice(&nrm[c][i..i + 3]).normalize(),
+            )
+        })
+    };
+    let bvh = run.scene_gpu.bvh();
+    let tris: Vec<GpuTriangle> = SceneGpu::gpu_triangles(s, bvh, &s.triangles(time));
+    let l = s.lights[0].direction.normalize();
+    let water = s.objects.iter().find_map(|o| o.water.as_ref()).unwrap();
+    let eta = 1.0 / s.materials[water.material as usize].ior;
+    let mut count = 0;
+    for thread in 0..layout.total_threads() {
+        let ([x, y], c) = layout.texel_of(thread).unwrap();
+        let (x, y, c) = (x as i64, y as i64, c as usize);
+        let Some((x00, n00)) = fetch(x, y, c) else {
+            continue;
+        };
+        let has_u = fetch(x + 1, y, c).or_else(|| fetch(x - 1, y, c)).is_some();
+        let has_v = fetch(x, y + 1, c).or_else(|| fetch(x, y - 1, c)).is_some();
+        if !has_u || !has_v || bvh.occluded(&tris, offset(x00, -l), -l, 0.0, 1e30) {
+            continue;
+        }
+        let n = if l.dot(n00) < 0.0 { n00 } else { -n00 };
+        let cos_i = -l.dot(n);
+        let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+        let refracted = (eta * l + (eta * cos_i - (1.0 - sin2_t).sqrt()) * n).normalize();
+        for (dir, side) in [(l - 2.0 * l.dot(n) * n, n), (refracted, -n)] {
+            let origin = offset(x00, side);
+            let Some(hit) = bvh.intersect(&tris, origin, dir, 0.0, 1e30) else {
+                continue;
+            };
+            let t = tris[hit.triangle as usize];
+            let m = t.p0[3].to_bits() as usize;
+            if s.materials[m].kind != MaterialKind::Diffuse {
+                continue;
+            }
+            let p0 = Vec3::from_slice(&t.p0[..3]);
+            let ng = (Vec3::from_slice(&t.p1[..3]) - p0).cross(Vec3::from_slice(&t.p2[..3]) - p0);
+            if (-dir).dot(ng) > 0.0 {
+                count += 1;
+            }
+        }
+    }
+    count
+}
+
+fn pool() -> Scene {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/water_pool.toml");
+    Scene::load(&path).unwrap()
+}
+
+#[test]
+fn photon_count_matches_a_cpu_replay() {
+    let ctx = validated_context();
+    let s = pool();
+    // At t = 1.3 s: the GPU-evaluated surface the CCM holds and the CPU
+    // tessellation the BVH holds move together.
+    let run = render_at(&ctx, &s, &["ccm_size=96", "cascades=2"], 64, 1.3);
+    let counts = run.technique.photon_counts().unwrap();
+    let cpu = cpu_photon_count(&run, &s, 1.3);
+    println!("water_pool: GPU {counts:?}, CPU replay {cpu}");
+    assert_eq!(counts.overflow(), 0);
+    // Rays grazing a triangle edge may fall either way between the two
+    // traversals' roundings: a handful at most.
+    let diff = (counts.written as i64 - cpu as i64).unsigned_abs();
+    assert!(cpu > 3000, "{cpu} photons");
+    assert!(
+        diff <= 2 + cpu / 2000,
+        "GPU {} vs CPU {cpu}",
+        counts.written
+    );
+    assert_validation_clean(&ctx);
+}
+
+#[test]
+fn overflow_is_counted_and_nothing_is_written_past_the_buffer() {
+    let ctx = validated_context();
+    let light = Vec3::new(0.3, -1.0, 0.2).normalize();
+    let s = water_scene(
+        water(Vec2::new(4.0, 4.0), [16, 16], 1.0, vec![]),
+        light,
+        Vec3::new(0.0, 1.0, 0.0) - light * 5.0,
+    );
+    let run = render(
+        &ctx,
+        &s,
+        &["ccm_size=64", "cascades=1", "photon_capacity=100"],
+        64,
+    );
+    let counts = run.technique.photon_counts().unwrap();
+    println!("tiny buffer: {counts:?}");
+    assert_eq!(counts.capacity, 100);
+    assert_eq!(counts.written, 100);
+    assert!(counts.requested > 3000, "{counts:?}");
+    assert_eq!(counts.overflow(), counts.requested - 100);
+    let words: Vec<u32> = run.technique.trace.photons.download_pod().unwrap();
+    let per = std::mem::size_of::<GpuWaterPhoton>() / 4;
+    assert_eq!(words.len(), (100 + GUARD_PHOTONS as usize) * per);
+    assert!(
+        words[100 * per..].iter().all(|&w| w == GUARD_WORD),
+        "guard overwritten"
+    );
+    assert!(
+        words[..100 * per].iter().all(|&w| w != GUARD_WORD),
+        "a slot left unwritten"
+    );
+    // The draw's instance count is what was written.
+    let draw: Vec<u32> = run.technique.trace.draw.download_pod().unwrap();
+    assert_eq!(&draw[..5], &[4, 100, 0, 0, counts.requested]);
+    assert_validation_clean(&ctx);
+}
+
+/// rgb summed over the image.
+fn energy(img: &[f32]) -> f64 {
+    img.chunks(4).map(|p| (p[0] + p[1] + p[2]) as f64).sum()
+}
+
+/// One `water_photons` frame of `s` with `overrides`, surface caustics
+/// only: the radiance and the trace + splat time (ms, wall clock on lavapipe).
+/// The surface-caustics component of one frame, with the trace + splat
+/// milliseconds and the denoise milliseconds of the second (timed) frame.
+fn caustic_frame(ctx: &Arc<Context>, s: Scene, overrides: &[&str]) -> (Vec<f32>, f64, f64) {
+    use caustics::reference::Component;
+    use caustics::renderer::Renderer;
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let params = Params::resolve("water_photons", PARAMS, &overrides).unwrap();
+    let mut r = Renderer::new(ctx, s, "water_photons", &params, SIZE, SIZE, 0.0).unwrap();
+    r.scene_gpu.components = Component::SurfaceCaustics.mask();
+    // The second frame is timed: the first pays the pipelines' compilation.
+    r.render_frame(0.0).unwrap();
+    let timings = r.render_frame(0.0).unwrap();
+    let ms = timings
+        .iter()
+        .filter(|t| t.name == "photon trace" || t.name == "photon splat")
+        .map(|t| t.ms)
+        .sum();
+    let denoise_ms = timings
+        .iter()
+        .filter(|t| t.name.starts_with("denoise "))
+        .map(|t| t.ms)
+        .sum();
+    let img = r.radiance().unwrap();
+    assert_finite(&img);
+    (img, ms, denoise_ms)
+}
+
+/// FLIP mean over the pixels where `mask` holds.
+fn masked_flip_mean(map: &nv_flip::FlipImageFloat, mask: &[bool]) -> f64 {
+    let v = map.to_vec();
+    let (sum, n) = v
+        .iter()
+        .zip(mask)
+        .filter(|(_, &m)| m)
+        .fold((0.0, 0), |(s, n), (e, _)| (s + *e as f64, n + 1));
+    sum / n as f64
+}
+
+/// water_pool from a camera under the surface (module docs): the default
+/// settings against the reference's L S+ D component (energy within 10%,
+/// FLIP bounded); then the paper's two claims at lavapipe sizes, whose
+/// numbers BENCHMARKS.md records: (i) 2 cascades over the range r vs 1
+/// cascade over 2r (both at the same ccm_0: the defaults with `cascades`
+/// 2 and 1), FLIP over the inner cascade's region; (ii) photon
+/// differentials at ccm_0 = 128 vs fixed splats at 256, both undenoised
+/// (the paper's Fig. 10); (iii) one adaptive denoise pass vs ten
+/// fixed-radius passes on the same frame: FLIP between the two and the
+/// time ratio. Every variant keeps the energy within 10%.
+#[test]
+fn pool_caustics_from_below_match_the_reference() {
+    use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
+    use caustics::techniques::water_photons::CascadeFrame;
+    let ctx = validated_context();
+    let below = || {
+        let mut s = pool();
+        // Under the surface (1.2 m), looking down the pool at the floor.
+        s.camera = camera(Vec3::new(0.5, 0.9, 2.6), Vec3::new(-0.3, 0.0, -1.0), 60.0);
+        s
+    };
+    let mut reference =
+        ReferenceRenderer::new(&ctx, below(), SIZE, SIZE, 0.0, ReferenceSettings::default())
+            .unwrap();
+    reference.trace(4_000_000, |_, _| {}).unwrap();
+    let truth = reference.resolve(Component::SurfaceCaustics).unwrap();
+    drop(reference);
+    let truth_ldr = tonemap(&scaled(&truth));
+    let e_truth = energy(&truth);
+
+    // The inner cascade's region of the 2-cascade default, from the
+    // pixels' first hits.
+    let s = below();
+    let w = s.objects.iter().find_map(|o| o.water.clone()).unwrap();
+    let layout = CascadeLayout::new([128, 128], 2, 2.0).unwrap();
+    let frame = CascadeFrame::new(&w, s.camera.eye, s.lights[0].direction, layout, 0.0);
+    let inner = frame.view_proj(0);
+    let tris = s.triangles(0.0);
+    let bvh = caustics::bvh::Bvh::build(&tris);
+    let gpu = bvh.gpu_triangles(&tris);
+    let mut near = Vec::new();
+    for py in 0..SIZE {
+        for px in 0..SIZE {
+            let (o, d) = pixel_ray(&s.camera, SIZE, SIZE, px, py);
+            near.push(bvh.intersect(&gpu, o, d, 0.0, f32::MAX).is_some_and(|h| {
+                let ndc = inner.project_point3(o + d * h.t);
+                ndc.x.abs() < 1.0 && ndc.y.abs() < 1.0
+            }));
+        }
+    }
+
+    let variants: [(&str, &[&str]); 8] = [
+        (
+            "default (ccm 256, N 2, adaptive denoise)",
+            &["ccm_size=256"],
+        ),
+        (
+            "(i) N 2 over r, ccm 128",
+            &["ccm_size=128", "cascades=2", "denoise=0"],
+        ),
+        (
+            "(i) N 1 over 2r, ccm 128",
+            &["ccm_size=128", "cascades=1", "denoise=0"],
+        ),
+        (
+            "(ii) differentials, ccm 128, N 1",
+            &["ccm_size=128", "cascades=1", "splat_mode=0", "denoise=0"],
+        ),
+        (
+            "(ii) fixed splats, ccm 256, N 1",
+            &["ccm_size=256", "cascades=1", "splat_mode=2", "denoise=0"],
+        ),
+        (
+            "(ii) differentials, ccm 256, N 1",
+            &["ccm_size=256", "cascades=1", "splat_mode=0", "denoise=0"],
+        ),
+        (
+            "(iii) 1 adaptive denoise pass, ccm 128",
+            &["ccm_size=128", "denoise=1", "denoise_passes=1"],
+        ),
+        (
+            "(iii) 10 fixed-radius denoise passes, ccm 128",
+            &["ccm_size=128", "denoise=2", "denoise_passes=10"],
+        ),
+    ];
+    let mut flips = Vec::new();
+    let mut denoised = Vec::new();
+    for (i, (name, overrides)) in variants.iter().enumerate() {
+        let (img, ms, denoise_ms) = caustic_frame(&ctx, below(), overrides);
+        let e = energy(&img);
+        let rel = (e - e_truth) / e_truth;
+        let ldr = tonemap(&scaled(&img));
+        let (flip_mean, flip_map) = flip(&ldr, &truth_ldr, SIZE);
+        let flip_near = masked_flip_mean(&flip_map, &near);
+        println!(
+            "pool from below, {name}: L S D energy relative {rel:+.4}; FLIP mean {flip_mean:.4}, inner cascade region {flip_near:.4}; trace + splat {ms:.1} ms, denoise {denoise_ms:.1} ms"
+        );
+        let dir = write_comparison_pngs(
+            &format!("water_photons_pool_below_{i}"),
+            SIZE,
+            &ldr,
+            &truth_ldr,
+            &flip_map,
+        );
+        assert!(
+            rel.abs() < 0.1,
+            "{name}: relative energy {rel:+.4} (images in {dir})"
+        );
+        flips.push((flip_mean, flip_near));
+        denoised.push((ldr, denoise_ms));
+    }
+    // Claim (iii): one adaptive pass against ten fixed-radius passes.
+    let (adaptive, fixed) = (&denoised[6], &denoised[7]);
+    let (flip_between, _) = flip(&adaptive.0, &fixed.0, SIZE);
+    println!(
+        "(iii) 1 adaptive vs 10 fixed-radius denoise passes: FLIP between them {flip_between:.4}; time {:.2} ms vs {:.2} ms, ratio {:.2}",
+        adaptive.1,
+        fixed.1,
+        fixed.1 / adaptive.1
+    );
+    // Measured 0.0219 (lavapipe, 128²): the two look alike, as the paper
+    // finds (its Fig. 12); bound about 2x. The time ratio is a benchmark
+    // (BENCHMARKS.md), not asserted.
+    assert!(
+        flip_between < 0.045,
+        "1 adaptive vs 10 fixed passes: FLIP {flip_between:.4}"
+    );
+    // Measured 0.1048 with the default adaptive denoise pass, 0.0996
+    // without (lavapipe; most of it the reference's own noise at 4M
+    // photons, and the columns above the waterline, which the camera below
+    // sees without the interface while the reference cannot connect them);
+    // bound 1.25x.
+    assert!(flips[0].0 < 0.13, "FLIP mean {:.4}", flips[0].0);
+    // Claim (i): the finer inner cascade is closer to the truth where it
+    // reaches (measured 0.0987 vs 0.1248).
+    assert!(
+        flips[1].1 < flips[2].1,
+        "inner-region FLIP: 2 cascades {:.4}, 1 cascade {:.4}",
+        flips[1].1,
+        flips[2].1
+    );
+    assert_validation_clean(&ctx);
+}
+
+/// The pool's exposure (assets/scenes/water_pool.toml) before the test tonemap.
+fn scaled(img: &[f32]) -> Vec<f32> {
+    img.iter().map(|v| v * 0.004).collect()
+}
+
+/// Mean and worst relative deviation from `expected` of the caustic
+/// irradiance on floor pixels within `half` m of the refracted beam's centre.
+fn floor_irradiance(run: &Run, centre: Vec3, half: f32, expected: f64) -> (f64, f64, usize) {
+    let caustics = run.technique.splat.caustics.download_rgba32f().unwrap();
+    let position = run
+        .technique
+        .direct
+        .gbuffer
+        .position
+        .download_rgba32f()
+        .unwrap();
+    let (mut sum, mut worst, mut n) = (0.0, 0.0f64, 0);
+    for i in 0..position.len() / 4 {
+        let x = Vec3::from_slice(&position[4 * i..4 * i + 3]);
+        let d = x - centre;
+        if position[4 * i + 3] == 0.0 || x.y.abs() > 1e-3 || d.x.abs() > half || d.z.abs() > half {
+            continue;
+        }
+        let e = caustics[4 * i] as f64;
+        sum += e;
+        worst = worst.max((e - expected).abs() / expected);
+        n += 1;
+    }
+    (sum / n as f64 / expected - 1.0, worst, n)
+}
+
+#[test]
+fn paper_splats_and_intensity() {
+    let ctx = validated_context();
+    // Straight down: Eq. 19's a = 1 and the quads tile the floor's grid.
+    let s = water_scene(
+        water(Vec2::new(4.0, 4.0), [16, 16], 1.0, vec![]),
+        Vec3::NEG_Y,
+        Vec3::new(0.0, 5.0, 2.0),
+    );
+    let f = {
+        let r = (1.0 - 1.33f64) / (1.0 + 1.33);
+        r * r
+    };
+    let expected = 1000.0 * (1.0 - f);
+    // Splats of Eqs. 16-19, with σ (mode 1) or fixed (mode 2): q_0 = 2 tents
+    // on the texel lattice tile exactly, so both give E (1 − F) inside.
+    for mode in [1, 2] {
+        let run = render(
+            &ctx,
+            &s,
+            &["ccm_size=64", "cascades=1", &format!("splat_mode={mode}")],
+            SIZE,
+        );
+        let (mean, worst, n) = floor_irradiance(&run, Vec3::ZERO, 1.5, expected);
+        println!("splat_mode={mode}: {n} pixels, mean {mean:+.5}, worst {worst:.5}");
+        assert!(
+            n > 500 && mean.abs() < 0.01 && worst < 0.02,
+            "splat_mode={mode}"
+        );
+    }
+    // Paper intensity: R = L I_att F (Eqs. 12-15) per photon.
+    let run = render(
+        &ctx,
+        &s,
+        &[
+            "ccm_size=64",
+            "cascades=1",
+            "intensity_mode=1",
+            "attenuation_t_max=10",
+        ],
+        SIZE,
+    );
+    let frame = run.technique.frame;
+    let texel = frame.range.width * frame.range.height / (64.0 * 64.0);
+    let (gamma, t_max, f_frac, f_exp) = (0.95f32, 10.0f32, 0.02f32, 5.0f32);
+    let p = photons(&run);
+    assert!(p.len() > 1000);
+    for p in &p {
+        let t = p.axis_v[3];
+        let u = 1.0 - t / t_max;
+        let i_att = if u > gamma {
+            1.0 - (u - gamma) / (1.0 - gamma)
+        } else {
+            1.0 - (gamma - u) / gamma
+        };
+        // Straight down onto flat water: −l·n = 1, F_refl = F_frac.
+        let f_refl = f_frac + (1.0 - f_frac) * 0.0f32.powf(f_exp);
+        let r = 1000.0 * texel * i_att * (1.0 - f_refl);
+        assert!(
+            (p.flux[0] - r).abs() <= 1e-4 * r,
+            "photon at t' = {t}: R {} vs Eq. 12 {r}",
+            p.flux[0]
+        );
+    }
+    assert_validation_clean(&ctx);
+}
+
+/// `caustics render --technique water_photons` on a scene it cannot render,
+/// or with a bad parameter: a message naming the cause, exit code 1.
+#[test]
+fn unusable_scenes_and_parameters_are_refused() {
+    let run = |scene: &str, params: &[&str]| {
+        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_caustics"));
+        c.env(
+            "VK_DRIVER_FILES",
+            "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json",
+        )
+        .args([
+            "render",
+            "--technique",
+            "water_photons",
+            "--width",
+            "32",
+            "--height",
+            "32",
+        ])
+        .args(["--scene", scene, "--out"])
+        .arg(std::env::temp_dir().join("water_photons_refused.png"));
+        for p in params {
+            c.args(["--param", p]);
+        }
+        let out = c.output().unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).to_string(),
+        )
+    };
+    let assets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes");
+    // ball_lens: no water, and a point light.
+    let (code, err) = run(assets.join("ball_lens.toml").to_str().unwrap(), &[]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("water_photons needs a `water` object"),
+        "{err}"
+    );
+    let pool = assets.join("water_pool.toml");
+    let (code, err) = run(pool.to_str().unwrap(), &["cascades=5"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("--param cascades=5: must be a whole number in [1, 4]"),
+        "{err}"
+    );
+    let (code, err) = run(pool.to_str().unwrap(), &["photon_capacity=33554432"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("the device binds at most"), "{err}");
+    let (code, err) = run(
+        pool.to_str().unwrap(),
+        &["cascade_scale=1.01", "ccm_size=16"],
+    );
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("cascade_scale"), "{err}");
+
+    // Water under a point light only.
+    let ctx = validated_context();
+    let mut s = water_scene(
+        water(Vec2::new(4.0, 4.0), [4, 4], 1.0, vec![]),
+        Vec3::NEG_Y,
+        Vec3::new(0.0, 5.0, 2.0),
+    );
+    s.lights = vec![point_light(Vec3::new(0.0, 5.0, 0.0), 100.0)];
+    let params = Params::resolve("water_photons", PARAMS, &[]).unwrap();
+    let scene_gpu = SceneGpu::new(&ctx, &s, 0.0).unwrap();
+    let err = WaterPhotons::new(&ctx, &params, &s, &scene_gpu, 32, 32)
+        .err()
+        .expect("refused");
+    assert!(
+        err.to_string().contains("needs a directional light"),
+        "{err}"
+    );
+    assert_validation_clean(&ctx);
+}
+
+/// `ccm_precision` sizes the cascades by Eq. 3 from the derived range.
+#[test]
+fn eq_3_sizes_the_cascades_from_the_precision() {
+    let ctx = validated_context();
+    let s = water_scene(
+        water(Vec2::new(4.0, 4.0), [4, 4], 1.0, vec![]),
+        Vec3::NEG_Y,
+        Vec3::new(0.0, 5.0, 2.0),
+    );
+    let scene_gpu = SceneGpu::new(&ctx, &s, 0.0).unwrap();
+    for (precision, cascades, size) in [(0.05, 1, 256), (0.01, 1, 1024), (0.01, 2, 512)] {
+        let overrides = [
+            format!("ccm_precision={precision}"),
+            format!("cascades={cascades}"),
+        ];
+        let params = Params::resolve("water_photons", PARAMS, &overrides).unwrap();
+        let t = WaterPhotons::new(&ctx, &params, &s, &scene_gpu, 32, 32).unwrap();
+        let r = t.frame.range;
+        // The camera is 2 m off the water's centre along z: cascade N − 1 spans
+        // 2 × (2 + 2) m (+0.1%), cascade 0 that / 2^(N − 1).
+        assert!(
+            (r.width - 8.008 / 2f32.powi(cascades - 1)).abs() < 1e-3,
+            "{r:?}"
+        );
+        assert_eq!(
+            t.frame.layout.size,
+            [size, size],
+            "p = {precision}, N = {cascades}"
+        );
+    }
+    assert_validation_clean(&ctx);
+}
+
+/// Flux conservation through focusing: the caustic irradiance integrated
+/// over the floor (pixel footprints from the G-buffer's positions) equals
+/// the flux of the photons that landed there, for the differential splats
+/// and both rectangle modes (each quad deposits its photon's flux, whatever
+/// its size).
+#[test]
+fn splats_conserve_the_flux_of_a_focusing_crest() {
+    let ctx = validated_context();
+    let mut s = crest_scene();
+    s.camera = camera(Vec3::new(0.0, 10.0, 3.0), Vec3::ZERO, 70.0);
+    const PX: u32 = 256;
+    for mode in [0, 1, 2] {
+        let run = render(
+            &ctx,
+            &s,
+            &["ccm_size=128", "cascades=1", &format!("splat_mode={mode}")],
+            PX,
+        );
+        let flux: f64 = photons(&run).iter().map(|p| p.flux[0] as f64).sum();
+        let e = run.technique.splat.caustics.download_rgba32f().unwrap();
+        let pos = run
+            .technique
+            .direct
+            .gbuffer
+            .position
+            .download_rgba32f()
+            .unwrap();
+        let at = |x: u32, y: u32| {
+            let i = 4 * (y * PX + x) as usize;
+            (pos[i + 3] != 0.0).then(|| Vec3::from_slice(&pos[i..i + 3]))
+        };
+        let mut integral = 0.0f64;
+        for y in 0..PX - 1 {
+            for x in 0..PX - 1 {
+                let (Some(p), Some(px), Some(py)) = (at(x, y), at(x + 1, y), at(x, y + 1)) else {
+                    continue;
+                };
+                let area = (px - p).cross(py - p).length() as f64;
+                integral += e[4 * (y * PX + x) as usize] as f64 * area;
+            }
+        }
+        let rel = integral / flux - 1.0;
+        println!("crest, splat_mode={mode}: photon flux {flux:.2} W, integrated irradiance {integral:.2} W ({rel:+.4})");
+        assert!(rel.abs() < 0.02, "splat_mode={mode}: {rel:+.4}");
+    }
+    assert_validation_clean(&ctx);
+}
+
+/// Water of IOR 1 bends nothing and reflects nothing: the whole frame
+/// (direct light, whose shadow maps hold the water, + the caustic the water
+/// sends, seen through the surface by the camera refraction) equals the
+/// `direct` frame of the scene without the water, on the floor under the
+/// water's middle; with the surface-caustics component off, that floor is
+/// dark (the water's shadow).
+#[test]
+fn ior_one_water_gives_back_the_direct_frame() {
+    use caustics::reference::Component;
+    use caustics::renderer::Renderer;
+    let ctx = validated_context();
+    let light = Vec3::new(0.3, -1.0, 0.2).normalize();
+    let eye = Vec3::new(0.5, 5.0, 3.0);
+    let mut with_water = water_scene(water(Vec2::new(4.0, 4.0), [8, 8], 1.0, vec![]), light, eye);
+    with_water.materials[1].ior = 1.0;
+    let mut without = with_water.clone();
+    without.objects.truncate(1);
+    let frame = |s: &Scene, technique: &str, overrides: &[String], mask: u32| {
+        let params = Params::resolve(
+            technique,
+            caustics::techniques::find(technique).unwrap().params,
+            overrides,
+        )
+        .unwrap();
+        let mut r = Renderer::new(&ctx, s.clone(), technique, &params, SIZE, SIZE, 0.0).unwrap();
+        r.scene_gpu.components = mask;
+        r.render_frame(0.0).unwrap();
+        r.radiance().unwrap()
+    };
+    let ours = frame(
+        &with_water,
+        "water_photons",
+        &["ccm_size=128".into(), "cascades=1".into()],
+        Component::All.mask(),
+    );
+    let dark = frame(
+        &with_water,
+        "water_photons",
+        &["ccm_size=128".into(), "cascades=1".into()],
+        Component::Direct.mask(),
+    );
+    let truth = frame(&without, "direct", &[], Component::All.mask());
+    // Floor points whose light came through the water's middle: (x, 0, z)
+    // with (x, 0, z) − l t at the water's height inside ±1.2 m, found per
+    // pixel by the camera ray.
+    let (mut n, mut worst, mut darkest) = (0, 0.0f32, 0.0f32);
+    for py in 0..SIZE {
+        for px in 0..SIZE {
+            let (o, d) = pixel_ray(&with_water.camera, SIZE, SIZE, px, py);
+            if d.y >= 0.0 {
+                continue;
+            }
+            let floor = o + d * (-o.y / d.y);
+            let at_water = floor - light * (1.0 / -light.y);
+            if at_water.x.abs() > 1.2 || at_water.z.abs() > 1.2 {
+                continue;
+            }
+            let i = 4 * (py * SIZE + px) as usize;
+            worst = worst.max((ours[i] - truth[i]).abs() / truth[i]);
+            darkest = darkest.max(dark[i] / truth[i]);
+            n += 1;
+        }
+    }
+    println!("IOR 1: {n} floor pixels, worst relative difference {worst:.5}, direct-only at most {darkest:.5} of the lit floor");
+    assert!(n > 1000, "{n}");
+    assert!(worst < 0.01, "worst {worst}");
+    assert!(darkest < 0.01, "direct only {darkest}");
+    assert_validation_clean(&ctx);
+}
+
+/// Eq. 1: the light view is centred on the camera, frame by frame (the
+/// camera's position lies on the light's axis through the cascades' centre).
+#[test]
+fn the_cascades_follow_the_camera() {
+    let ctx = validated_context();
+    let light = Vec3::new(0.3, -1.0, 0.2).normalize();
+    let mut s = water_scene(
+        water(Vec2::new(4.0, 4.0), [8, 8], 1.0, vec![]),
+        light,
+        Vec3::new(0.5, 5.0, 3.0),
+    );
+    let mut run = render(&ctx, &s, &["ccm_size=64", "cascades=2"], 64);
+    let profiler = Profiler::new(&ctx, 32).unwrap();
+    for eye in [Vec3::new(0.5, 5.0, 3.0), Vec3::new(-2.0, 3.0, 1.0)] {
+        s.camera.eye = eye;
+        run.scene_gpu.update_frame(&s, 64, 64, 0.0, 1).unwrap();
+        profiler
+            .frame(|rec| run.technique.record(rec, &run.scene_gpu, &run.targets))
+            .unwrap();
+        let local = run.technique.frame.view.transform_point3(eye);
+        assert!(
+            local.x.abs() < 1e-4 && local.y.abs() < 1e-4,
+            "{eye}: {local}"
+        );
+    }
+    assert_validation_clean(&ctx);
+}
