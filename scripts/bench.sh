@@ -77,15 +77,18 @@ fi
 
 if wants water_photons; then
   # Fig. 14's split: CCM raster (with the GPU water surface), tracing,
-  # splat, composite (the denoiser is not in this branch), and the rest of
-  # the frame (direct passes, camera refraction, tonemap).
-  echo "| screen | ccm_0 | N | splat | trace threads | water surface + ccm raster | photon trace | photon splat | caustic composite | rest | frame |"
-  echo "| --- | ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
-  for run in "256 1 0" "512 1 0" "512 2 0" "512 4 0" "1024 1 0" "512 1 2"; do
+  # splat, denoise, composite, and the rest of the frame (direct passes,
+  # camera refraction, tonemap). Runs: ccm_0, N, splat mode, denoiser
+  # (0 none, 1 adaptive, 2 fixed), denoise passes.
+  echo "| screen | ccm_0 | N | splat | denoise | trace threads | water surface + ccm raster | photon trace | photon splat | denoise | caustic composite | rest | frame |"
+  echo "| --- | ---: | ---: | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+  for run in "256 1 0 1 1" "512 1 0 1 1" "512 2 0 1 1" "512 4 0 1 1" "1024 1 0 1 1" "1024 4 0 1 1" \
+             "512 1 2 1 1" "512 1 0 0 1" "512 1 0 2 10"; do
     set -- $run
-    json=out/bench/water_photons_pool_c$1_n$2_s$3.json
+    json=out/bench/water_photons_pool_c$1_n$2_s$3_d$4x$5.json
     $bin bench --scene assets/scenes/water_pool.toml --technique water_photons \
       --param ccm_size=$1 --param cascades=$2 --param splat_mode=$3 \
+      --param denoise=$4 --param denoise_passes=$5 \
       --width 256 --height 256 --frames ${FRAMES:-10} --warmup 2 --json $json \
       > ${json%.json}.log 2>&1 || { cat ${json%.json}.log; exit 1; }
     python3 - $json <<'PY'
@@ -94,13 +97,17 @@ b = json.load(open(sys.argv[1]))
 ms = {p["name"]: p["ms"] for p in b["passes_ms"]}
 p = b["params"]
 own = ["water surface", "ccm raster", "photon trace", "photon splat", "caustic composite"]
-rest = sum(v for k, v in ms.items() if k not in own)
+denoise = sum(v for k, v in ms.items() if k.startswith("denoise "))
+rest = sum(v for k, v in ms.items() if k not in own and not k.startswith("denoise "))
 splat = ["differential", "paper", "fixed"][int(p["splat_mode"])]
+kind = ["none", "adaptive", "fixed"][int(p["denoise"])]
+if kind != "none":
+    kind += f" x{int(p['denoise_passes'])}"
 layout = int(p["ccm_size"]), int(p["cascades"])
 threads = layout[0] ** 2 * (1 + 0.75 * (layout[1] - 1))
-print(f"| {b['width']}x{b['height']} | {layout[0]}² | {layout[1]} | {splat} | {int(threads)}"
+print(f"| {b['width']}x{b['height']} | {layout[0]}² | {layout[1]} | {splat} | {kind} | {int(threads)}"
       + f" | {ms['water surface'] + ms['ccm raster']:.1f} | {ms['photon trace']:.1f} | {ms['photon splat']:.1f}"
-      + f" | {ms['caustic composite']:.1f} | {rest:.1f} | {b['frame_ms']:.1f} |")
+      + f" | {denoise:.1f} | {ms['caustic composite']:.1f} | {rest:.1f} | {b['frame_ms']:.1f} |")
 PY
   done
 fi
