@@ -113,3 +113,8 @@ pub const WATER_SURFACE_BINDING_WAVES: u32 = 0;
 pub const WATER_SURFACE_BINDING_VERTICES: u32 = 1;
 /// Workgroup side of the water surface pass (8 x 8 grid vertices).
 pub const WATER_SURFACE_GROUP_SIZE: u32 = 8;
+
+// Airlight pass (src/passes/airlight.rs, glsl/passes/airlight.comp), descriptor set 1.
+pub const AIRLIGHT_BINDING_RADIANCE: u32 = 0;
+pub const AIRLIGHT_BINDING_SHADOW_MAP: u32 = 1;
+pub const AIRLIGHT_BINDING_SHADOW_LIGHTS: u32 = 2;
