@@ -14,7 +14,8 @@
 //!   against the same quadrature with V from a CPU ray-box test and rays
 //!   ending at the box, and darker than without the box;
 //! - against the reference's `airlight` component (L V) on volume_cone with
-//!   g = -0.7, 0, 0.7 and on smoke: relative energy and FLIP mean.
+//!   g = -0.7, 0, 0.7 and on smoke, 64², default parameters (64 jittered
+//!   steps): relative energy and FLIP mean.
 //!
 //! Measured values are in each bound's comment and in BENCHMARKS.md.
 
@@ -46,15 +47,24 @@ const BOX_MAX: Vec3 = Vec3::new(0.7, 0.5, 0.5);
 /// mask) plus the airlight pass; returns the radiance and the airlight
 /// pass's milliseconds.
 fn render_airlight(ctx: &Arc<Context>, scene: &Scene, overrides: &[&str]) -> (Vec<f32>, f64) {
+    render_airlight_at(ctx, scene, overrides, SIZE)
+}
+
+fn render_airlight_at(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    overrides: &[&str],
+    size: u32,
+) -> (Vec<f32>, f64) {
     let specs: Vec<ParamSpec> = [direct::PARAMS, airlight::PARAMS].concat();
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let params = Params::resolve("airlight", &specs, &overrides).unwrap();
     let mut scene_gpu = SceneGpu::new(ctx, scene, 0.0).unwrap();
     scene_gpu.components = Component::Airlight.mask();
-    let targets = FrameTargets::new(ctx, SIZE, SIZE).unwrap();
-    let mut direct = Direct::new(ctx, &params, scene, &scene_gpu, SIZE, SIZE).unwrap();
+    let targets = FrameTargets::new(ctx, size, size).unwrap();
+    let mut direct = Direct::new(ctx, &params, scene, &scene_gpu, size, size).unwrap();
     let mut air = Airlight::new(ctx, &params, scene, &scene_gpu, &direct.shadows).unwrap();
-    scene_gpu.update_frame(scene, SIZE, SIZE, 0.0, 0).unwrap();
+    scene_gpu.update_frame(scene, size, size, 0.0, 0).unwrap();
     let profiler = Profiler::new(ctx, 64).unwrap();
     let mut ms = 0.0;
     // Two frames: the first pays the pipelines' compilation; time the second.
@@ -216,11 +226,15 @@ fn check_analytic(g: f32) {
     assert_validation_clean(&ctx);
 }
 
-/// 512 midpoints vs the quadrature, every pixel and channel: measured TODO.
+/// 512 midpoints vs the quadrature, every pixel and channel: measured
+/// 1.3e-4 (g = 0) and 1.5e-4 (g = 0.6), float rounding and the midpoint
+/// rule's O(dt^2).
 const MAX_MIDPOINT: f64 = 1e-3;
-/// 64 jittered samples: measured TODO.
+/// 64 jittered samples (the default), one random offset per pixel: worst
+/// pixel measured 1.1e-2 (g = 0) and 2.8e-2 (g = 0.6); the image's total
+/// 3.5e-5 and 1.7e-4 (the offsets average out over pixels).
 const MAX_JITTERED_PIXEL: f64 = 0.05;
-const MAX_JITTERED_TOTAL: f64 = 0.01;
+const MAX_JITTERED_TOTAL: f64 = 2e-3;
 
 #[test]
 fn isotropic_airlight_matches_quadrature() {
@@ -290,13 +304,20 @@ fn occluder_casts_a_volumetric_shadow() {
     assert_validation_clean(&ctx);
 }
 
-/// Measured TODO.
-const MAX_SHADOW_TOTAL: f64 = 0.01;
-const MIN_SHADOW_CLOSE: f64 = 0.9;
+/// Measured (256 midpoints, 1024² shadow cube faces): the shadowed total is
+/// 0.496 of the open one; against the quadrature the total is off by
+/// 2.9e-4, 99.4% of the pixels lie within 1% (worst 1.2%: the shadow
+/// boundary within a shadow texel).
+const MAX_SHADOW_TOTAL: f64 = 2e-3;
+const MIN_SHADOW_CLOSE: f64 = 0.97;
 
 // ---- against the reference ----
 
-const PHOTONS: u64 = 16_000_000;
+/// The reference comparisons run at 64² (the airlight is smooth; a quarter
+/// of the pixels needs a quarter of the photons for the same noise per
+/// pixel), keeping this file's runtime near a minute on 2 busy cores.
+const REF_SIZE: u32 = 64;
+const PHOTONS: u64 = 2_000_000;
 
 fn load(path: &str, g: Option<f32>) -> Scene {
     let mut s = Scene::load(Path::new(path)).unwrap();
@@ -320,9 +341,16 @@ fn exposed(img: &[f32]) -> Vec<u8> {
 fn against_reference(path: &str, g: Option<f32>, name: &str) -> (f64, f32, f32, f64) {
     let ctx = validated_context();
     let s = load(path, g);
-    let (actual, ms) = render_airlight(&ctx, &s, &[]);
-    let mut reference =
-        ReferenceRenderer::new(&ctx, s, SIZE, SIZE, 0.0, ReferenceSettings::default()).unwrap();
+    let (actual, ms) = render_airlight_at(&ctx, &s, &[], REF_SIZE);
+    let mut reference = ReferenceRenderer::new(
+        &ctx,
+        s,
+        REF_SIZE,
+        REF_SIZE,
+        0.0,
+        ReferenceSettings::default(),
+    )
+    .unwrap();
     reference.trace(PHOTONS / 2, |_, _| {}).unwrap();
     let half_a = reference.resolve(Component::Airlight).unwrap();
     reference.trace(PHOTONS / 2, |_, _| {}).unwrap();
@@ -337,14 +365,14 @@ fn against_reference(path: &str, g: Option<f32>, name: &str) -> (f64, f32, f32, 
     };
     let energy = (sum(&actual) - sum(&truth)).abs() / sum(&truth);
     let halves = (sum(&half_a) - sum(&half_b)).abs() / sum(&truth);
-    let (noise_flip, _) = flip(&exposed(&half_b), &exposed(&half_a), SIZE);
-    let (flip_mean, flip_map) = flip(&exposed(&actual), &exposed(&truth), SIZE);
+    let (noise_flip, _) = flip(&exposed(&half_b), &exposed(&half_a), REF_SIZE);
+    let (flip_mean, flip_map) = flip(&exposed(&actual), &exposed(&truth), REF_SIZE);
     eprintln!(
         "{name}: relative energy {energy:.4} (reference halves differ by {halves:.4}), FLIP mean {flip_mean:.4} (reference halves {noise_flip:.4}), airlight pass {ms:.1} ms"
     );
     let dir = write_comparison_pngs(
         &format!("airlight_{name}"),
-        SIZE,
+        REF_SIZE,
         &exposed(&actual),
         &exposed(&truth),
         &flip_map,
@@ -401,5 +429,5 @@ fn volume_cone_forward_scattering_matches_reference() {
 
 #[test]
 fn smoke_matches_reference() {
-    check_reference("assets/scenes/smoke.toml", None, "smoke", 0.05, 0.2);
+    check_reference("assets/scenes/smoke.toml", None, "smoke");
 }
