@@ -382,15 +382,26 @@ fn against_reference(path: &str, g: Option<f32>, name: &str) -> (f64, f32, f32, 
     (energy, flip_mean, noise_flip, ms)
 }
 
-fn check_reference(path: &str, g: Option<f32>, name: &str, max_energy: f64, max_flip: f32) {
+/// Bounds of the reference comparisons (64², 2 M photons, default 64
+/// jittered steps). Measured relative energy: 0.0071 (g = -0.7), 0.0069
+/// (g = 0), 0.0071 (g = 0.7), 0.0018 (smoke), where the reference's two
+/// halves differ by 0.004-0.005; FLIP mean (exposure 16): 0.0073, 0.0121,
+/// 0.0055, 0.0117, where the halves differ by 0.0068-0.0144. At 128² and
+/// 16 M photons the energy errors were 0.0010-0.0011 (volume_cone) and
+/// 0.0003 (smoke). Bounds: energy 2% (a phase with the cosine's sign
+/// flipped, or a missing transmittance, is off by far more), FLIP 0.025.
+const MAX_REF_ENERGY: f64 = 0.02;
+const MAX_REF_FLIP: f32 = 0.025;
+
+fn check_reference(path: &str, g: Option<f32>, name: &str) {
     let (energy, flip_mean, _, _) = against_reference(path, g, name);
     assert!(
-        energy < max_energy,
-        "{name}: relative energy {energy:.4} >= {max_energy}"
+        energy < MAX_REF_ENERGY,
+        "{name}: relative energy {energy:.4} >= {MAX_REF_ENERGY}"
     );
     assert!(
-        flip_mean < max_flip,
-        "{name}: FLIP mean {flip_mean:.4} >= {max_flip}"
+        flip_mean < MAX_REF_FLIP,
+        "{name}: FLIP mean {flip_mean:.4} >= {MAX_REF_FLIP}"
     );
 }
 
@@ -400,8 +411,6 @@ fn volume_cone_backward_scattering_matches_reference() {
         "assets/scenes/volume_cone.toml",
         Some(-0.7),
         "volume_cone_g-0.7",
-        0.05,
-        0.2,
     );
 }
 
@@ -411,8 +420,6 @@ fn volume_cone_isotropic_matches_reference() {
         "assets/scenes/volume_cone.toml",
         Some(0.0),
         "volume_cone_g0",
-        0.05,
-        0.2,
     );
 }
 
@@ -422,8 +429,6 @@ fn volume_cone_forward_scattering_matches_reference() {
         "assets/scenes/volume_cone.toml",
         Some(0.7),
         "volume_cone_g0.7",
-        0.05,
-        0.2,
     );
 }
 
