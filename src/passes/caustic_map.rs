@@ -28,6 +28,14 @@
 //! 3. `apply` (glsl/caustic_map/apply.comp, recorded by the technique):
 //!    E = Phi_texel / A_texel(x) on each diffuse receiver.
 //!
+//! In a participating medium (Hu et al. 2010 Sect. 5.3) the photons' flux
+//! is attenuated by the medium's transmittance along every segment through
+//! air (light -> first specular surface, between interfaces outside the
+//! objects, exit -> receiver; solids hold no medium), and `apply`
+//! multiplies the caustic radiance by the transmittance to the eye; both
+//! deterministic (`medium_transmittance_steps`, `PhotonPaths::medium_steps`
+//! midpoint steps for noise/grid densities), exactly 1 without a medium.
+//!
 //! Limits: the specular bounds are taken once at construction (animated
 //! specular objects would need them per frame); a point light inside the
 //! specular bounding sphere gets no caustics (logged); sprites crossing a
