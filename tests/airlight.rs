@@ -9,7 +9,8 @@
 //!   intervals) of sigma_s p(theta) I / r^2 exp(-sigma_t (r + t - t_in))
 //!   over the ray's part inside the medium, per channel, for g = 0 and
 //!   g = 0.6 (checks the phase cosine's convention), and for a directional
-//!   light (E for I / r^2, its path through the medium clipped by the bounds);
+//!   light (E for I / r^2, its path through the medium clipped by the
+//!   bounds) and a spot light (smoothstep cone edge, g = -0.4);
 //! - sigma_s = 0 (absorbing medium) gives exactly 0;
 //! - an opaque box beside the light casts a volumetric shadow: the frame
 //!   against the same quadrature with V from a CPU ray-box test and rays
@@ -23,6 +24,7 @@
 mod common;
 
 use caustics::passes::airlight::{self, Airlight};
+use caustics::radiometry::spot_falloff;
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use caustics::renderer::{FrameTargets, SceneGpu};
 use caustics::scene::{Density, LightKind, Medium, Scene};
@@ -168,7 +170,17 @@ fn quadrature(s: &Scene, px: u32, py: u32, with_box: bool) -> DVec3 {
         } else {
             let v = x - light.position.as_dvec3();
             let r = v.length();
-            (v / r, r, 1.0 / (r * r))
+            let mut falloff = 1.0 / (r * r);
+            if light.kind == LightKind::Spot {
+                let cos_outer = light.cone_angle_deg.to_radians().cos();
+                let cos_inner = (light.cone_angle_deg - light.cone_falloff_deg)
+                    .max(0.0)
+                    .to_radians()
+                    .cos();
+                let c = (v / r).dot(light.direction.as_dvec3().normalize()) as f32;
+                falloff *= spot_falloff(c, cos_outer, cos_inner) as f64;
+            }
+            (v / r, r, falloff)
         };
         if with_box {
             let from = x - dir_in * travel;
@@ -199,29 +211,63 @@ fn pixel(img: &[f32], px: u32, py: u32) -> DVec3 {
     DVec3::new(img[i] as f64, img[i + 1] as f64, img[i + 2] as f64)
 }
 
-/// Worst per-pixel, per-channel relative error against the quadrature, and
-/// the relative error of the image's total.
+/// Worst per-pixel, per-channel error against the quadrature, relative to
+/// the pixel's value or, where that is darker, to 1% of the channel's
+/// brightest pixel (outside a spot's cone the light vanishes smoothly and a
+/// relative error means nothing); and the relative error of the total.
 fn against_quadrature(s: &Scene, img: &[f32], with_box: bool) -> (f64, f64) {
+    let q: Vec<DVec3> = (0..SIZE * SIZE)
+        .map(|i| quadrature(s, i % SIZE, i / SIZE, with_box))
+        .collect();
+    let peak = q.iter().fold(DVec3::ZERO, |m, v| m.max(*v));
     let (mut worst, mut sum_a, mut sum_q) = (0.0f64, 0.0, 0.0);
-    for py in 0..SIZE {
-        for px in 0..SIZE {
-            let q = quadrature(s, px, py, with_box);
-            let a = pixel(img, px, py);
-            for c in 0..3 {
-                worst = worst.max((a[c] - q[c]).abs() / q[c].max(1e-12));
-            }
-            sum_a += a.element_sum();
-            sum_q += q.element_sum();
+    for (i, q) in q.iter().enumerate() {
+        let a = pixel(img, i as u32 % SIZE, i as u32 / SIZE);
+        for c in 0..3 {
+            worst = worst.max((a[c] - q[c]).abs() / q[c].max(0.01 * peak[c]));
         }
+        sum_a += a.element_sum();
+        sum_q += q.element_sum();
     }
     (worst, (sum_a - sum_q).abs() / sum_q)
 }
 
 fn check_analytic(g: f32) {
-    check_analytic_scene(analytic_scene(SIGMA_S, g, false), g);
+    check_analytic_scene(analytic_scene(SIGMA_S, g, false), g, SMOOTH);
 }
 
-fn check_analytic_scene(s: Scene, g: f32) {
+/// Per-pixel bounds of one analytic case.
+#[derive(Clone, Copy)]
+struct PixelBounds {
+    /// 512 midpoints, every pixel and channel.
+    midpoint: f64,
+    /// 64 jittered samples (the default).
+    jittered: f64,
+}
+
+/// Point and directional light. 512 midpoints: worst pixel measured 1.3e-4
+/// (point, g = 0), 1.4e-4 (point, g = 0.6) and 6.1e-5 (directional, g =
+/// 0.3): float rounding and the midpoint rule's O(dt^2). 64 jittered
+/// samples, one random offset per pixel, so a pixel is off by about
+/// (u - 1/2) dt (f(end) - f(start)): measured 1.1e-2, 2.8e-2 and 5.6e-2
+/// (directional: no 1/r^2 decay, so the ends differ most).
+const SMOOTH: PixelBounds = PixelBounds {
+    midpoint: 1e-3,
+    jittered: 0.1,
+};
+/// Spot light (g = -0.4): its 8° smoothstep edge is crossed in a few
+/// centimetres by some rays: 512 midpoints measured 1.02e-3, 64 jittered
+/// 0.24 at those pixels (a handful of samples in the lit part).
+const SPOT: PixelBounds = PixelBounds {
+    midpoint: 3e-3,
+    jittered: 0.4,
+};
+/// The image's total, every case: measured at most 3.5e-6 (512 midpoints)
+/// and 1.9e-4 (64 jittered: the offsets average out over pixels).
+const MAX_MIDPOINT_TOTAL: f64 = 1e-4;
+const MAX_JITTERED_TOTAL: f64 = 2e-3;
+
+fn check_analytic_scene(s: Scene, g: f32, bounds: PixelBounds) {
     let ctx = validated_context();
     let (img, _) = render_airlight(&ctx, &s, &["airlight_steps=512", "airlight_jitter=0"]);
     let (worst, total) = against_quadrature(&s, &img, false);
@@ -230,32 +276,19 @@ fn check_analytic_scene(s: Scene, g: f32) {
     eprintln!(
         "g = {g}: 512 midpoints: worst pixel {worst:.2e}, total {total:.2e}; 64 jittered: worst pixel {worst_j:.2e}, total {total_j:.2e}"
     );
-    assert!(
-        worst < MAX_MIDPOINT,
-        "g = {g}: worst pixel {worst:.2e} >= {MAX_MIDPOINT}"
-    );
-    assert!(
-        worst_j < MAX_JITTERED_PIXEL,
-        "g = {g}: jittered worst pixel {worst_j:.2e} >= {MAX_JITTERED_PIXEL}"
-    );
-    assert!(
-        total_j < MAX_JITTERED_TOTAL,
-        "g = {g}: jittered total {total_j:.2e} >= {MAX_JITTERED_TOTAL}"
-    );
+    let failures: Vec<String> = [
+        ("512 midpoints, worst pixel", worst, bounds.midpoint),
+        ("512 midpoints, total", total, MAX_MIDPOINT_TOTAL),
+        ("64 jittered, worst pixel", worst_j, bounds.jittered),
+        ("64 jittered, total", total_j, MAX_JITTERED_TOTAL),
+    ]
+    .iter()
+    .filter(|(_, v, bound)| v >= bound)
+    .map(|(what, v, bound)| format!("{what} {v:.2e} >= {bound}"))
+    .collect();
+    assert!(failures.is_empty(), "g = {g}: {}", failures.join("; "));
     assert_validation_clean(&ctx);
 }
-
-/// 512 midpoints vs the quadrature, every pixel and channel: measured
-/// 1.3e-4 (point, g = 0), 1.5e-4 (point, g = 0.6) and 6.1e-5 (directional,
-/// g = 0.3): float rounding and the midpoint rule's O(dt^2).
-const MAX_MIDPOINT: f64 = 1e-3;
-/// 64 jittered samples (the default), one random offset per pixel, so a
-/// pixel is off by about (u - 1/2) dt (f(end) - f(start)): worst pixel
-/// measured 1.1e-2, 2.8e-2 and 5.6e-2 (directional: no 1/r^2 decay, so the
-/// ends differ most); the image's total 3.5e-5, 1.7e-4 and 1.9e-4 (the
-/// offsets average out over pixels).
-const MAX_JITTERED_PIXEL: f64 = 0.1;
-const MAX_JITTERED_TOTAL: f64 = 2e-3;
 
 #[test]
 fn isotropic_airlight_matches_quadrature() {
@@ -274,7 +307,20 @@ fn directional_airlight_matches_quadrature() {
     let mut s = analytic_scene(SIGMA_S, 0.3, false);
     s.lights = vec![directional_light(Vec3::new(0.4, -1.0, -0.3), 2.0)];
     s.lights[0].intensity = INTENSITY * 0.2;
-    check_analytic_scene(s, 0.3);
+    check_analytic_scene(s, 0.3, SMOOTH);
+}
+
+#[test]
+fn spot_airlight_matches_quadrature() {
+    // A spot aimed across the view: the cone's smoothstep edge (as
+    // lights.glsl and the reference evaluate it) crosses many camera rays.
+    let mut s = analytic_scene(SIGMA_S, -0.4, false);
+    let light = &mut s.lights[0];
+    light.kind = LightKind::Spot;
+    light.direction = Vec3::new(1.0, 0.2, 0.0).normalize();
+    light.cone_angle_deg = 20.0;
+    light.cone_falloff_deg = 8.0;
+    check_analytic_scene(s, -0.4, SPOT);
 }
 
 #[test]
