@@ -157,3 +157,7 @@ pub const WP_SPLAT_FIXED: u32 = 2;
 /// Ray types of a photon (Algorithm 3 line 37).
 pub const WP_RAY_REFLECTED: u32 = 0;
 pub const WP_RAY_REFRACTED: u32 = 1;
+// Airlight pass (src/passes/airlight.rs, glsl/passes/airlight.comp), descriptor set 1.
+pub const AIRLIGHT_BINDING_RADIANCE: u32 = 0;
+pub const AIRLIGHT_BINDING_SHADOW_MAP: u32 = 1;
+pub const AIRLIGHT_BINDING_SHADOW_LIGHTS: u32 = 2;

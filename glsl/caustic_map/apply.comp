@@ -17,9 +17,15 @@
 // texel's flux: instead of the light's depth map we trace the straight line
 // to the light through the BVH, skipping specular surfaces (they are what
 // the caustic map accounts for), which is exact.
+//
+// In a participating medium the photons' flux already carries the light
+// side's transmittance (photons.comp); the caustic radiance is attenuated
+// toward the eye by tau(x, v) (Hu et al. 2010 Sect. 5.3, Fig. 2 C).
 #include "scene.glsl"
 #include "optics.glsl"
 #include "bvh.glsl"
+#include "random.glsl"
+#include "medium.glsl"
 
 #define SHADOW_SET 1
 #define SHADOW_BINDING_LIGHTS CAUSTIC_BINDING_VIEWS
@@ -35,6 +41,7 @@ layout(set = 1, binding = CAUSTIC_BINDING_RADIANCE, rgba32f) uniform image2D rad
 
 layout(push_constant) uniform Push {
     uint light_count;
+    uint medium_steps; // midpoint steps of inhomogeneous transmittance
 } pc;
 
 // Solid angle of the tan-plane rectangle [u0,u1] x [v0,v1] (2x2 Gauss-Legendre,
@@ -120,6 +127,9 @@ void main() {
     }
     vec3 albedo = materials[material].color.rgb;
     vec4 prev = imageLoad(radiance, p);
-    vec3 caustic = component_weight(COMPONENT_SURFACE_CAUSTICS) * albedo / PI * e_sum;
+    vec3 to_eye = frame.eye.xyz - x;
+    float eye_dist = length(to_eye);
+    vec3 tau_eye = medium_transmittance_steps(x, to_eye / eye_dist, eye_dist, pc.medium_steps);
+    vec3 caustic = component_weight(COMPONENT_SURFACE_CAUSTICS) * albedo / PI * e_sum * tau_eye;
     imageStore(radiance, p, vec4(prev.rgb + caustic, prev.a));
 }

@@ -40,12 +40,19 @@
 // lost 61% of the gemstone's caustic (diamond reflects >= 17% inside at
 // every exit). Mirrors reflect with their reflectance. A photon that leaves
 // the scene or runs out of bounces is dropped (w = 0).
+// In a participating medium (Hu et al. 2010 Sect. 5.3) the flux is
+// attenuated along every segment through air, light -> first specular
+// surface, between interfaces outside the objects, exit -> receiver, by the
+// deterministic transmittance of glsl/common/medium.glsl (`mode.w` midpoint
+// steps for noise/grid densities); inside solid objects there is no medium
+// (as in the reference). The camera side (receiver -> eye) is apply.comp's.
 #include "scene.glsl"
 #include "optics.glsl"
 #include "lights.glsl"
 #include "bvh.glsl"
 #include "photon.glsl"
 #include "random.glsl"
+#include "medium.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -56,8 +63,13 @@ layout(push_constant) uniform Push {
     vec4 right;   // xyz; w: light index (uint bits)
     vec4 up;      // xyz; w: photon view size N (uint bits)
     vec4 forward; // xyz; w: SHADOW_RADIAL (perspective) or SHADOW_PLANAR (ortho) (uint bits)
-    uvec4 mode;   // x: PHOTON_MODE_*; y: TIR_* remedy; z: 1 = Eq. 6.3.2 on
+    uvec4 mode;   // x: PHOTON_MODE_*; y: TIR_* remedy; z: 1 = Eq. 6.3.2 on; w: medium steps
 } pc;
+
+// Transmittance of the medium over the air segment o + t d, t in [0, dist].
+vec3 air_transmittance(vec3 o, vec3 d, float dist) {
+    return medium_transmittance_steps(o, d, dist, pc.mode.w);
+}
 
 // Light-space specular G-buffer (src/passes/specular_gbuffer.rs; photon
 // modes 1 and 2): nearest front faces and farthest back faces, position
@@ -106,6 +118,7 @@ bool follow(vec3 o, inout vec3 d, inout vec3 w, bool inside, vec3 absorption, in
         if (!trace_closest(o, d, 0.0, 1e30, h)) return false;
         vec3 x = hit_position(h, o, d);
         if (inside) w *= exp(-absorption * h.t);
+        else w *= air_transmittance(o, d, h.t);
         uint m = hit_material(h);
         uint kind = material_kind(m);
         if (kind == MATERIAL_DIFFUSE) {
@@ -209,6 +222,14 @@ bool back_face_normal(vec3 x, out vec3 n) {
 
 #include "image_space_refraction.glsl"
 
+// `land` for a photon leaving the refractor at o: the flux is attenuated by
+// the medium over the straight path to the receiver.
+bool land_through_air(vec3 o, vec3 d, inout vec3 w, out vec3 p3) {
+    if (!land(o, d, p3)) return false;
+    w *= air_transmittance(o, d, length(p3 - o));
+    return true;
+}
+
 // The refracted photon of texel `id` through the refractor seen from the
 // light, entering at p1 (outward normal n1 facing the light, incident
 // direction d, material m, interpolated d_N), weight w already times
@@ -243,7 +264,7 @@ bool image_space_refraction(uvec2 id, vec3 p1, vec3 n1, vec3 d, uint m, float d_
         if (!two_sided_refraction(d, p1, n1, ior, d_v, d_n, pc.mode.y, pc.mode.z != 0u, e)) return false;
         w *= e.transmit * exp(-materials[m].absorption_ior.rgb * e.dist);
         dir = e.dir;
-        return land(e.p2, e.dir, p3);
+        return land_through_air(e.p2, e.dir, w, p3);
     }
     // PHOTON_MODE_BACK_MARCH
     vec3 t1;
@@ -269,7 +290,7 @@ bool image_space_refraction(uvec2 id, vec3 p1, vec3 n1, vec3 d, uint m, float d_
     if (!refract_dir(t1, n2, ior, t2)) return false;
     w *= exp(-materials[m].absorption_ior.rgb * hi) * (1.0 - fresnel_dielectric(-dot(t1, n2), ior));
     dir = t2;
-    return land(p2, t2, p3);
+    return land_through_air(p2, t2, w, p3);
 }
 
 void main() {
@@ -325,6 +346,7 @@ void main() {
         vec4 fn = imageLoad(front_normal, ivec2(id));
         m = uint(fn.w + 0.5);
         x = fp.xyz;
+        w *= air_transmittance(o, d, dot(x - o, d));
         ns = normalize(fn.xyz);
         ng = dot(ns, d) < 0.0 ? ns : -ns;
     } else {
@@ -332,6 +354,7 @@ void main() {
         if (!trace_closest(o, d, 0.0, 1e30, hit)) return;
         m = hit_material(hit);
         x = hit_position(hit, o, d);
+        w *= air_transmittance(o, d, hit.t);
         ng = hit_geometric_normal(hit);
         front = dot(d, ng) < 0.0;
         ns = hit_normal(hit);

@@ -104,6 +104,38 @@ vec3 medium_transmittance(vec3 o, vec3 d, float dist, inout uint rng) {
     return tr;
 }
 
+// sigma_t at x (1/m, per channel): the coefficients times the density.
+vec3 medium_sigma_t(vec3 x) {
+    return (medium.sigma_s.rgb + medium.sigma_a.rgb) * medium_density(x);
+}
+
+// Deterministic transmittance for the real-time techniques (Hu et al. 2010
+// Sect. 5.4, Fig. 11: "the attenuation ... is computed by ray marching with
+// a fixed number of steps"): along o + t d, t in [0, dist], clipped to the
+// medium bounds (free of solid objects, as medium_transmittance).
+// Constant density: Beer-Lambert exactly, exp(-sigma_t * length). Noise or
+// grid: the optical depth by the midpoint rule with `steps` equal steps over
+// the clipped segment. Without a medium: exactly 1.
+vec3 medium_transmittance_steps(vec3 o, vec3 d, float dist, uint steps) {
+    if (!medium_present()) return vec3(1.0);
+    float t0 = 0.0, t1 = dist;
+    if (!clip_to_medium(o, d, t0, t1)) return vec3(1.0);
+    vec3 sigma_t = medium.sigma_s.rgb + medium.sigma_a.rgb;
+    if (floatBitsToUint(medium.sigma_a.w) == DENSITY_CONSTANT) return exp(-sigma_t * medium.bounds_min.w * (t1 - t0));
+    uint n = max(steps, 1u);
+    float dt = (t1 - t0) / float(n);
+    float density_sum = 0.0;
+    for (uint i = 0u; i < n; ++i) density_sum += medium_density(o + (t0 + (float(i) + 0.5) * dt) * d);
+    return exp(-sigma_t * (density_sum * dt));
+}
+
+// The far end of a light's shadow ray from x for transmittance: the light's
+// position, or for a directional light far enough to leave the scene
+// (the bounds clip it), as the reference's camera pass does.
+float light_travel(float dist, vec3 x) {
+    return dist > 1e29 ? 2.0 * frame.scene_sphere.w + length(x - frame.scene_sphere.xyz) : dist;
+}
+
 // Henyey-Greenstein phase, normalised over the sphere; cos_theta between the
 // propagation directions before and after scattering.
 float hg_phase(float cos_theta, float g) {

@@ -5,9 +5,16 @@
 // falloff, or E cos for directional light) and V_l the shadow-map visibility.
 // Specular surfaces seen directly and the background get 0: the ground
 // truth follows specular chains, which later techniques add.
+// In a participating medium (Hu et al. 2010 Sect. 5.3, Fig. 2 C) each
+// light's irradiance is attenuated by the transmittance tau(s, x) from the
+// light to x, and the surface radiance by tau(x, v) toward the eye, both
+// from glsl/common/medium.glsl's deterministic estimate (exact for constant
+// density, `medium_steps` midpoint steps otherwise); exactly 1 without one.
 #include "scene.glsl"
 #include "lights.glsl"
 #include "optics.glsl"
+#include "random.glsl"
+#include "medium.glsl"
 
 #define SHADOW_SET 1
 #define SHADOW_BINDING_LIGHTS DIRECT_BINDING_SHADOW_LIGHTS
@@ -23,6 +30,7 @@ layout(set = 1, binding = DIRECT_BINDING_RADIANCE, rgba32f) uniform writeonly im
 layout(push_constant) uniform Push {
     uint light_count; // lights with shadow maps (<= MAX_LIGHTS)
     int pcf_radius;   // PCF window half-width in texels
+    uint medium_steps; // midpoint steps of inhomogeneous transmittance
 } pc;
 
 void main() {
@@ -47,8 +55,13 @@ void main() {
         float dist;
         vec3 e = light_irradiance(l, x, n, to_light, dist);
         if (all(equal(e, vec3(0.0)))) continue;
-        e_sum += e * shadow_visibility(l, x, n, to_light, pc.pcf_radius);
+        float v = shadow_visibility(l, x, n, to_light, pc.pcf_radius);
+        if (v == 0.0) continue;
+        e_sum += e * v * medium_transmittance_steps(x, to_light, light_travel(dist, x), pc.medium_steps);
     }
     vec3 albedo = materials[material].color.rgb;
-    imageStore(radiance, p, vec4(component_weight(COMPONENT_DIRECT) * albedo / PI * e_sum, 1.0));
+    vec3 to_eye = frame.eye.xyz - x;
+    float eye_dist = length(to_eye);
+    vec3 tau_eye = medium_transmittance_steps(x, to_eye / eye_dist, eye_dist, pc.medium_steps);
+    imageStore(radiance, p, vec4(component_weight(COMPONENT_DIRECT) * albedo / PI * e_sum * tau_eye, 1.0));
 }

@@ -28,6 +28,14 @@
 //! 3. `apply` (glsl/caustic_map/apply.comp, recorded by the technique):
 //!    E = Phi_texel / A_texel(x) on each diffuse receiver.
 //!
+//! In a participating medium (Hu et al. 2010 Sect. 5.3) the photons' flux
+//! is attenuated by the medium's transmittance along every segment through
+//! air (light -> first specular surface, between interfaces outside the
+//! objects, exit -> receiver; solids hold no medium), and `apply`
+//! multiplies the caustic radiance by the transmittance to the eye; both
+//! deterministic (`medium_transmittance_steps`, `PhotonPaths::medium_steps`
+//! midpoint steps for noise/grid densities), exactly 1 without a medium.
+//!
 //! Limits: the specular bounds are taken once at construction (animated
 //! specular objects would need them per frame); a point light inside the
 //! specular bounding sphere gets no caustics (logged); sprites crossing a
@@ -97,7 +105,9 @@ pub struct PhotonViewPush {
     pub up: [f32; 4],
     pub forward: [f32; 4],
     /// x: `PHOTON_MODE_*`; y: TIR remedy (`TIR_*`); z: 1 to use Eq. 6.3.2
-    /// where the back-face texel holds no normal (see image_space PARAMS).
+    /// where the back-face texel holds no normal (see image_space PARAMS);
+    /// w: midpoint steps of the medium transmittance along the photon's
+    /// paths through air (`medium_steps`).
     pub mode: [u32; 4],
 }
 
@@ -202,6 +212,9 @@ pub struct PhotonPaths {
     pub tir_remedy: u32,
     /// Eq. 6.3.2 where the back-face texel holds no normal (photon mode 1).
     pub use_eq632: bool,
+    /// Midpoint steps of the transmittance through inhomogeneous media
+    /// along the photons' air segments (`medium_steps`).
+    pub medium_steps: u32,
 }
 
 pub struct CausticMap {
@@ -218,6 +231,8 @@ pub struct CausticMap {
     pub mode: u32,
     /// `[TIR_*, 1 if Eq. 6.3.2 is on]` for the image-space photon mode.
     pub refraction: [u32; 2],
+    /// Midpoint steps of the medium transmittance (`PhotonPaths::medium_steps`).
+    pub medium_steps: u32,
     /// Light-space G-buffer of the specular objects (photon modes 1, 2),
     /// N x N, one light at a time.
     pub light_view: SpecularGBuffer,
@@ -319,6 +334,7 @@ impl CausticMap {
             splat_size: splat_size | 1,
             mode: paths.mode,
             refraction: [paths.tir_remedy, u32::from(paths.use_eq632)],
+            medium_steps: paths.medium_steps,
             light_view,
             lights,
             specular,
@@ -379,7 +395,12 @@ impl CausticMap {
     /// Photon view of light `l`, if it has one.
     pub fn photon_view(&self, l: usize) -> Option<PhotonViewPush> {
         let mut v = photon_view(&self.lights[l], l as u32, self.specular?, self.photon_size)?;
-        v.mode = [self.mode, self.refraction[0], self.refraction[1], 0];
+        v.mode = [
+            self.mode,
+            self.refraction[0],
+            self.refraction[1],
+            self.medium_steps,
+        ];
         Some(v)
     }
 

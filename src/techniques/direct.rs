@@ -10,8 +10,16 @@
 //! 3. "direct lighting" (glsl/direct/lighting.comp): per pixel, into the
 //!    frame's radiance image.
 //!
-//! Specular surfaces seen directly and the background read 0; no medium
-//! attenuation (the medium techniques add it).
+//! Specular surfaces seen directly and the background read 0.
+//!
+//! In a scene with a medium the surface radiance is attenuated as the
+//! ground truth attenuates it (Hu et al. 2010 Sect. 5.3, Fig. 2 C): each
+//! light's irradiance by the transmittance tau(s, x) from the light to x and
+//! the result by tau(x, v) to the eye. Transmittance is deterministic
+//! (glsl/common/medium.glsl `medium_transmittance_steps`): Beer-Lambert on
+//! the segment clipped to the medium's bounds for constant density, the
+//! midpoint rule with `medium_steps` steps for noise and grid densities
+//! (Hu Sect. 5.4). Without a medium the factors are exactly 1.
 
 use super::{ParamSpec, Params, Technique};
 use crate::passes::gbuffer::{GBuffer, GBufferContents};
@@ -45,7 +53,19 @@ pub const PCF_RADIUS: ParamSpec = ParamSpec {
     integer: true,
 };
 
-pub const PARAMS: &[ParamSpec] = &[SHADOW_MAP_SIZE, PCF_RADIUS];
+/// Midpoint steps of the deterministic transmittance through inhomogeneous
+/// media, shared by every technique that attenuates surface light.
+pub const MEDIUM_STEPS: ParamSpec = ParamSpec {
+    name: "medium_steps",
+    description:
+        "midpoint steps of the transmittance through noise/grid media (constant density is exact)",
+    min: 1.0,
+    max: 256.0,
+    default: 16.0,
+    integer: true,
+};
+
+pub const PARAMS: &[ParamSpec] = &[SHADOW_MAP_SIZE, PCF_RADIUS, MEDIUM_STEPS];
 
 /// Push constants of glsl/direct/lighting.comp.
 #[repr(C)]
@@ -53,12 +73,14 @@ pub const PARAMS: &[ParamSpec] = &[SHADOW_MAP_SIZE, PCF_RADIUS];
 struct LightingPush {
     light_count: u32,
     pcf_radius: i32,
+    medium_steps: u32,
 }
 
 pub struct Direct {
     pub shadows: ShadowMaps,
     pub gbuffer: GBuffer,
     pcf_radius: i32,
+    medium_steps: u32,
     light_count: u32,
     lighting: ComputePipeline,
     set: DescriptorSet,
@@ -103,6 +125,7 @@ impl Direct {
     ) -> VkResult<Self> {
         let shadow_map_size = params.get("shadow_map_size") as u32;
         let pcf_radius = params.get("pcf_radius") as i32;
+        let medium_steps = params.get("medium_steps") as u32;
         let shadows = ShadowMaps::new(ctx, &scene_gpu.layout, &scene.lights, shadow_map_size)?;
         let gbuffer = GBuffer::new(ctx, &scene_gpu.layout, width, height, contents)?;
         let layout = DescriptorSetLayout::new(
@@ -140,6 +163,7 @@ impl Direct {
             shadows,
             gbuffer,
             pcf_radius,
+            medium_steps,
             lighting,
             set,
             bound_radiance: vk::ImageView::null(),
@@ -173,6 +197,7 @@ impl Technique for Direct {
         let push = LightingPush {
             light_count: self.light_count,
             pcf_radius: self.pcf_radius,
+            medium_steps: self.medium_steps,
         };
         rec.pass("direct lighting", |cmd| {
             // The G-buffer's and shadow maps' attachment writes must be

@@ -72,6 +72,7 @@ use std::sync::Arc;
 pub const PARAMS: &[ParamSpec] = &[
     direct::SHADOW_MAP_SIZE,
     direct::PCF_RADIUS,
+    direct::MEDIUM_STEPS,
     ParamSpec {
         name: "photon_buffer_size",
         description: "photon buffer resolution (photons per side of the light view)",
@@ -192,6 +193,7 @@ impl ImageSpace {
                 mode: params.get("photon_mode") as u32,
                 tir_remedy,
                 use_eq632: use_eq632 != 0,
+                medium_steps: params.get("medium_steps") as u32,
             },
         )?;
         let layout = DescriptorSetLayout::new(
@@ -220,7 +222,7 @@ impl ImageSpace {
             ctx,
             "caustic_map/apply.comp",
             &[&scene_gpu.layout, &layout],
-            4,
+            size_of::<[u32; 2]>() as u32,
         )?;
         let refraction = CameraRefraction::new(
             ctx,
@@ -266,7 +268,8 @@ impl Technique for ImageSpace {
             self.caustics_geometry_time = Some(scene.geometry_time);
         }
         let ctx = rec.ctx().clone();
-        let light_count = self.caustics.light_count();
+        // apply.comp's push constants: light count, medium steps.
+        let push = [self.caustics.light_count(), self.caustics.medium_steps];
         rec.pass("caustic apply", |cmd| {
             // The splats' attachment writes and the direct pass's radiance
             // writes must be visible to this read-modify-write.
@@ -285,7 +288,7 @@ impl Technique for ImageSpace {
             self.apply.dispatch(
                 cmd,
                 &[&scene.set, &self.set],
-                bytemuck::bytes_of(&light_count),
+                bytemuck::bytes_of(&push),
                 groups,
             );
         });

@@ -97,6 +97,7 @@ use std::sync::Arc;
 pub const PARAMS: &[ParamSpec] = &[
     direct::SHADOW_MAP_SIZE,
     direct::PCF_RADIUS,
+    direct::MEDIUM_STEPS,
     ParamSpec {
         name: "cascades",
         description: "N, the number of cascaded caustic maps (Eqs. 4-5)",
