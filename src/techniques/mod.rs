@@ -5,6 +5,7 @@
 
 pub mod direct;
 pub mod image_space;
+pub mod volume_lines;
 
 use crate::reference::Component;
 use crate::renderer::{FrameTargets, SceneGpu};
@@ -130,6 +131,11 @@ pub const TECHNIQUES: &[TechniqueInfo] = &[TechniqueInfo {
     description: "Wyman 2005-06: two-sided image-space refraction of what the camera sees through glass (and in mirrors), and caustic maps (photons through the specular objects, Gaussian splats, projected onto diffuse receivers)",
     params: image_space::PARAMS,
     components: &[Component::Direct, Component::SurfaceCaustics],
+}, TechniqueInfo {
+    name: "volume_lines",
+    description: "Hu et al. 2010: volume caustics as lines (light rays after one reflection or two refractions, drawn by a geometry shader, Eq. 3 per fragment) over image_space's surface radiance",
+    params: volume_lines::PARAMS,
+    components: &[Component::Direct, Component::SurfaceCaustics, Component::VolumeCaustics],
 }];
 
 pub fn find(name: &str) -> anyhow::Result<&'static TechniqueInfo> {
@@ -172,6 +178,9 @@ pub fn create(
             ctx, params, scene, scene_gpu, width, height,
         )?),
         "image_space" => Box::new(image_space::ImageSpace::new(
+            ctx, params, scene, scene_gpu, width, height,
+        )?),
+        "volume_lines" => Box::new(volume_lines::VolumeLines::new(
             ctx, params, scene, scene_gpu, width, height,
         )?),
         other => {
