@@ -30,6 +30,7 @@
 //!    depending on the device's `strictLines`), redistributed over the
 //!    ray-marching points k Delta_x within the filter support r of x_l
 //!    with normalised Gaussian weights. No scale factor.
+//!
 //! Once per frame: "volume visibility" (the distance to the first surface,
 //! diffuse or specular, per pixel: Sect. 5.3's culling; refractors hide the
 //! volume caustic behind them) before the lines, "volume composite" (adds B
