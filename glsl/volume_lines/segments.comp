@@ -3,8 +3,10 @@
 // texel of the light's view of the specular objects, followed through one
 // reflection (mirrors) or two refractions (dielectrics) to its exit point
 // p1 and direction w'_l, and on to p2 on the first diffuse surface; written
-// to the volume caustic buffer (one Segment per texel, invalid ones
-// flagged with p1.w = 0).
+// to the volume caustic buffer: N^2 Segments, one per texel, invalid ones
+// flagged with p1.w = 0, then N^2 more for the Fresnel reflection off a
+// dielectric's front face (a one-bounce reflection, as Hu's gemstone
+// draws both; flagged invalid for other texels).
 //
 // The view is the caustic map's photon view (src/passes/caustic_map.rs
 // `photon_view`: a frustum fitted to the specular objects' bounding sphere,
@@ -152,7 +154,9 @@ void main() {
         }
         phi = intensity * measure;
     }
+    uint count = n_size * n_size;
     segments[index] = Segment(vec4(0.0), vec4(0.0), vec4(0.0, 0.0, 0.0, measure));
+    segments[count + index] = Segment(vec4(0.0), vec4(0.0), vec4(0.0, 0.0, 0.0, measure));
 
     // p0: the specular surface this texel sees first (diffuse geometry in
     // front of it marks the texel not covered).
@@ -183,7 +187,12 @@ void main() {
         vec3 absorption = materials[m].absorption_ior.rgb;
         vec3 t_1;
         if (!refract_dir(d, n, 1.0 / ior, t_1)) return;
-        phi *= 1.0 - fresnel_dielectric(-dot(d, n), 1.0 / ior); // T0
+        // The Fresnel reflection at the front face is a one-bounce
+        // reflection of its own (part of L S+ V): second half of the buffer.
+        float f0 = fresnel_dielectric(-dot(d, n), 1.0 / ior);
+        vec3 r = reflect(d, n);
+        segments[count + index] = Segment(vec4(p0, 1.0), vec4(segment_end(p0, r), 0.0), vec4(phi * f0, measure));
+        phi *= 1.0 - f0; // T0
         vec4 bp = imageLoad(back_position, ivec2(id));
         if (bp.w < 0.0) {
             // No back face: a closed refractor's silhouette texel (d_N > 0)

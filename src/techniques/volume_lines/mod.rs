@@ -18,8 +18,10 @@
 //!    along it (BVH; the scene's bounding sphere where it leaves). Stored
 //!    with its flux Phi = I Omega_texel T0 T1 tau_glass tau(s, p0) in the
 //!    volume caustic buffer (`GpuSegment`, one per texel, invalid ones
-//!    flagged).
-//! 3. "volume lines": one point per texel (`vkCmdDraw`, vertex pulling); the
+//!    flagged), followed by a second N x N half holding the Fresnel
+//!    reflection F0 off a dielectric's front face (a one-bounce
+//!    reflection; both are L S+ V).
+//! 3. "volume lines": one point per buffer entry (`vkCmdDraw`, vertex pulling); the
 //!    geometry shader emits the camera-space line p1 -> p2; the fragment
 //!    shader evaluates Eq. 3 with the regular-step resampling of Fig. 5 and
 //!    blends additively into `volume` (RGBA32F; alpha counts fragments).
@@ -39,9 +41,8 @@
 //! Homogeneous media use exact transmittance; inhomogeneous ones (noise,
 //! grid) a `transmittance_steps`-point midpoint rule (Sect. 5.4).
 //!
-//! Limits: two interfaces (light reflected inside the glass, and the
-//! Fresnel reflection at the front face, are not drawn; the latter is
-//! part of the reference's L S+ V); one segment per texel (no chains of
+//! Limits: two interfaces (light reflected inside the glass is not
+//! drawn); one segment per texel (no chains of
 //! several objects); the camera sees no volume caustic through glass or
 //! in mirrors (Sect. 5.3; the reference cannot show those paths either);
 //! a point light inside the specular objects' bounding sphere gets no
@@ -160,7 +161,9 @@ struct LinePush {
 pub struct VolumeLines {
     /// C: direct light, surface caustics, refraction seen by the camera.
     pub image_space: ImageSpace,
-    /// The volume caustic buffer of the last light recorded, N x N.
+    /// The volume caustic buffer of the last light recorded: N x N
+    /// transmitted (or mirror-reflected) light rays, then N x N rays
+    /// reflected off a dielectric's front face.
     pub segments: Buffer,
     /// B alone: radiance (rgb) and fragments per pixel (a).
     pub volume: Image,
@@ -204,7 +207,7 @@ impl VolumeLines {
         let segments = Buffer::new(
             ctx,
             "volume caustic buffer",
-            (n as u64 * n as u64) * size_of::<GpuSegment>() as u64,
+            2 * (n as u64 * n as u64) * size_of::<GpuSegment>() as u64,
             BufferUsage::Storage,
         )?;
         let visibility = Buffer::new(
@@ -484,7 +487,7 @@ impl Technique for VolumeLines {
                     bytemuck::bytes_of(&self.line_push),
                     extent,
                 );
-                let count = self.buffer_size * self.buffer_size;
+                let count = 2 * self.buffer_size * self.buffer_size;
                 unsafe { ctx.device.cmd_draw(cmd, count, 1, 0, 0) };
                 end_rendering(&ctx, cmd);
             });
