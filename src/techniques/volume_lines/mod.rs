@@ -53,7 +53,7 @@ use super::{ParamSpec, Params, Technique};
 use crate::passes::caustic_map::{photon_view, photon_view_proj, specular_bounds, PhotonViewPush};
 use crate::passes::specular_gbuffer::{SpecularGBuffer, Viewpoint};
 use crate::renderer::{FrameTargets, SceneGpu};
-use crate::scene::{Light, Scene};
+use crate::scene::{Density, Light, Scene};
 use crate::shader_bindings as b;
 use crate::vk::{
     barrier, begin_rendering, end_rendering, Access, BindingKind, Buffer, BufferAccess,
@@ -144,7 +144,8 @@ struct SegmentPush {
     right: [f32; 4],
     up: [f32; 4],
     forward: [f32; 4],
-    /// x: TIR remedy; y: Eq. 6.3.2 on; z: transmittance steps.
+    /// x: TIR remedy; y: Eq. 6.3.2 on; z: transmittance steps; w: the
+    /// filter radius (f32 bits; the clipping margin).
     params: [u32; 4],
 }
 
@@ -298,8 +299,18 @@ impl VolumeLines {
             ComputePipeline::new(ctx, "volume_lines/visibility.comp", &sets, 0)?;
         let composite_pipeline =
             ComputePipeline::new(ctx, "volume_lines/composite.comp", &sets, 0)?;
-        let mut desc =
-            GraphicsPipelineDesc::new("volume_lines/lines.vert", "volume_lines/lines.frag");
+        // A constant density (or none) gets fragments compiled without the
+        // density field's code.
+        let homogeneous = scene
+            .medium
+            .as_ref()
+            .is_none_or(|m| matches!(m.density, Density::Constant(_)));
+        let fragment = if homogeneous {
+            "volume_lines/lines.frag"
+        } else {
+            "volume_lines/lines_heterogeneous.frag"
+        };
+        let mut desc = GraphicsPipelineDesc::new("volume_lines/lines.vert", fragment);
         desc.geometry = Some("volume_lines/lines.geom");
         desc.color_formats = vec![vk::Format::R32G32B32A32_SFLOAT];
         desc.additive = true;
@@ -325,7 +336,7 @@ impl VolumeLines {
                 params.get("tir_remedy") as u32,
                 params.get("eq_6_3_2") as u32,
                 transmittance_steps,
-                0,
+                radius.to_bits(),
             ],
             line_push: LinePush {
                 step,
