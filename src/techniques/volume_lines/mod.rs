@@ -20,7 +20,8 @@
 //!    volume caustic buffer (`GpuSegment`, one per texel, invalid ones
 //!    flagged), followed by a second N x N half holding the Fresnel
 //!    reflection F0 off a dielectric's front face (a one-bounce
-//!    reflection; both are L S+ V).
+//!    reflection; both are L S+ V; `front_reflection` = 0 leaves it
+//!    undrawn).
 //! 3. "volume lines": one point per buffer entry (`vkCmdDraw`, vertex pulling); the
 //!    geometry shader emits the camera-space line p1 -> p2; the fragment
 //!    shader evaluates Eq. 3 with the regular-step resampling of Fig. 5 and
@@ -99,6 +100,15 @@ pub const TRANSMITTANCE_STEPS: ParamSpec = ParamSpec {
     integer: true,
 };
 
+pub const FRONT_REFLECTION: ParamSpec = ParamSpec {
+    name: "front_reflection",
+    description: "1: also draw the light reflected off a dielectric's front face (Fresnel F0; part of L S+ V, 14% of volume_cone's volume caustic at g = 0, but long lines across the whole medium: most of the fragments); 0: Hu's two-bounce refraction only",
+    min: 0.0,
+    max: 1.0,
+    default: 1.0,
+    integer: true,
+};
+
 /// image_space's parameters (passed through to C) followed by B's.
 pub const PARAMS: &[ParamSpec] = &[
     image_space::PARAMS[0],
@@ -115,6 +125,7 @@ pub const PARAMS: &[ParamSpec] = &[
     RAY_STEP,
     FILTER_RADIUS,
     TRANSMITTANCE_STEPS,
+    FRONT_REFLECTION,
 ];
 const _: () = assert!(image_space::PARAMS.len() == 10);
 
@@ -171,6 +182,9 @@ pub struct VolumeLines {
     /// Light-space front/back G-buffer of the specular objects.
     pub light_view: SpecularGBuffer,
     pub buffer_size: u32,
+    /// Buffer entries drawn: the transmitted half, or both halves with
+    /// `front_reflection`.
+    draw_count: u32,
     /// Distance to the first surface per pixel (floats).
     visibility: Buffer,
     lights: Vec<Light>,
@@ -324,6 +338,11 @@ impl VolumeLines {
             volume,
             light_view,
             buffer_size: n,
+            draw_count: if params.get(FRONT_REFLECTION.name) != 0.0 {
+                2 * n * n
+            } else {
+                n * n
+            },
             visibility,
             lights: scene
                 .lights
@@ -498,8 +517,7 @@ impl Technique for VolumeLines {
                     bytemuck::bytes_of(&self.line_push),
                     extent,
                 );
-                let count = 2 * self.buffer_size * self.buffer_size;
-                unsafe { ctx.device.cmd_draw(cmd, count, 1, 0, 0) };
+                unsafe { ctx.device.cmd_draw(cmd, self.draw_count, 1, 0, 0) };
                 end_rendering(&ctx, cmd);
             });
         }
