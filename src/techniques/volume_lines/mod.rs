@@ -128,25 +128,35 @@ pub const FRONT_REFLECTION: ParamSpec = ParamSpec {
     integer: true,
 };
 
-/// image_space's parameters (passed through to C) followed by B's.
-pub const PARAMS: &[ParamSpec] = &[
-    image_space::PARAMS[0],
-    image_space::PARAMS[1],
-    image_space::PARAMS[2],
-    image_space::PARAMS[3],
-    image_space::PARAMS[4],
-    image_space::PARAMS[5],
-    image_space::PARAMS[6],
-    image_space::PARAMS[7],
-    image_space::PARAMS[8],
-    image_space::PARAMS[9],
+/// B's own parameters.
+const OWN_PARAMS: &[ParamSpec] = &[
     VOLUME_BUFFER_SIZE,
     RAY_STEP,
     FILTER_RADIUS,
     TRANSMITTANCE_STEPS,
     FRONT_REFLECTION,
 ];
-const _: () = assert!(image_space::PARAMS.len() == 10);
+const PARAM_COUNT: usize = image_space::PARAMS.len() + OWN_PARAMS.len();
+/// `a` followed by `b` (a compile-time error unless they fill all N).
+const fn concat<const N: usize>(a: &[ParamSpec], b: &[ParamSpec]) -> [ParamSpec; N] {
+    let mut out = [b[0]; N];
+    let mut i = 0;
+    while i < a.len() {
+        out[i] = a[i];
+        i += 1;
+    }
+    let mut j = 0;
+    while j < b.len() {
+        out[a.len() + j] = b[j];
+        j += 1;
+    }
+    out
+}
+const ALL_PARAMS: [ParamSpec; PARAM_COUNT] = concat(image_space::PARAMS, OWN_PARAMS);
+
+/// image_space's parameters (passed through to C, whatever they are)
+/// followed by B's.
+pub const PARAMS: &[ParamSpec] = &ALL_PARAMS;
 
 /// Most regular step points a fragment visits (glsl/volume_lines/lines.frag).
 const MAX_RADIUS_IN_STEPS: f32 = 16.0;
