@@ -23,6 +23,8 @@
 //!   transmitted lines = 15600 covered front texels, 15600 reflected
 //!   lines, 15598 CPU rays through the texel centres meet the lens first
 //!   (silhouette ties; bound 0.2%).
+//! - components_add_up_to_the_frame: B alone + (direct, surface caustics)
+//!   alone = the whole frame, worst pixel 1.2e-7 relative (bound 1e-4).
 //! - filter_radius_beyond_sixteen_steps_is_refused: r = 50 Delta_x is an
 //!   error naming the parameter and the limit.
 //! - against the reference's L S+ V (128², 2 M photons, default
@@ -570,5 +572,34 @@ fn filter_radius_beyond_sixteen_steps_is_refused() {
         err.contains("filter_radius") && err.contains("16 x ray_step"),
         "{err}"
     );
+    assert_validation_clean(&ctx);
+}
+
+/// The components add up to the frame: B drawn alone plus C (direct and
+/// surface caustics) drawn alone equals everything drawn at once.
+#[test]
+fn components_add_up_to_the_frame() {
+    let ctx = validated_context();
+    let scene = load("volume_cone");
+    let opts = ["volume_buffer_size=128", "photon_buffer_size=64"];
+    let all = render(&ctx, &scene, &opts, Component::All.mask()).radiance();
+    let b = render(&ctx, &scene, &opts, Component::VolumeCaustics.mask()).radiance();
+    let c = render(
+        &ctx,
+        &scene,
+        &opts,
+        Component::Direct.mask() | Component::SurfaceCaustics.mask(),
+    )
+    .radiance();
+    assert!(energy(&b) > 0.0 && energy(&c) > 0.0);
+    let mut worst = 0.0f32;
+    for ((a, b), c) in all.chunks(4).zip(b.chunks(4)).zip(c.chunks(4)) {
+        for k in 0..3 {
+            let err = (a[k] - b[k] - c[k]).abs() / a[k].abs().max(1e-3);
+            worst = worst.max(err);
+        }
+    }
+    println!("all vs B + C: worst relative difference {worst:.2e}");
+    assert!(worst < 1e-4, "{worst}");
     assert_validation_clean(&ctx);
 }
