@@ -3,18 +3,22 @@
 # device (set VK_DRIVER_FILES to pick lavapipe). JSON goes to out/bench/.
 #   scripts/bench.sh               every section below
 #   scripts/bench.sh SECTION...    only those: direct, reference, geometry,
-#                                  image_space, water_photons
+#                                  image_space, volume_lines, water_photons
 # direct: the base frame per pass at 512^2 and 1024^2; reference: photons per
 # second; geometry: BVH build time and size per canonical scene; image_space:
 # caustic-map passes over photon buffers 64^2/256^2/1024^2, caustic maps
 # 128^2/512^2 and screens 512^2/1024^2 on ball_lens (Wyman's Figs. 6.3.7-8
-# sweep); water_photons: the per-pass split of Kougianos & Moustakas'
-# Fig. 14 on water_pool over ccm_0 and cascade counts. FRAMES (10) and
-# PHOTONS (2e7) set the effort.
+# sweep); volume_lines: stage B (Hu 2010's volume caustic passes) over
+# volume caustic buffers 256^2/512^2/1024^2 x screens 256^2/512^2/1024^2 on
+# volume_cone (Hu's Table 2 sweep), then the line and covered-pixel counts
+# (tests/volume_lines.rs, ignored test `coverage_statistics`);
+# water_photons: the per-pass split of Kougianos & Moustakas' Fig. 14 on
+# water_pool over ccm_0 and cascade counts. FRAMES (10) and PHOTONS (2e7)
+# set the effort.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 sections=("$@")
-[ ${#sections[@]} -eq 0 ] && sections=(direct reference geometry image_space water_photons)
+[ ${#sections[@]} -eq 0 ] && sections=(direct reference geometry image_space volume_lines water_photons)
 wants() { [[ " ${sections[*]} " == *" $1 "* ]]; }
 cargo build --release --quiet
 bin=target/release/caustics
@@ -73,6 +77,33 @@ PY
       done
     done
   done
+fi
+
+if wants volume_lines; then
+  # C (image_space) runs with its smallest photon buffer and caustic map:
+  # only stage B's passes are tabulated.
+  echo "| volume caustic buffer | screen | visibility | light view | segments | lines | composite | stage B total | frame |"
+  echo "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+  for buffer in 256 512 1024; do
+    for size in 256 512 1024; do
+      json=out/bench/volume_lines_volume_cone_b${buffer}_s${size}.json
+      $bin bench --scene assets/scenes/volume_cone.toml --technique volume_lines \
+        --param volume_buffer_size=$buffer --param photon_buffer_size=64 --param caustic_map_size=64 \
+        --width $size --height $size --frames ${FRAMES:-10} --warmup 2 --json $json \
+        > /dev/null 2> ${json%.json}.log || { cat ${json%.json}.log; exit 1; }
+      python3 - $json <<'PY'
+import json, sys
+b = json.load(open(sys.argv[1]))
+ms = {p["name"]: p["ms"] for p in b["passes_ms"]}
+stage_b = ["volume visibility", "volume clear", "volume light view", "volume segments", "volume lines", "volume composite"]
+n = int(b["params"]["volume_buffer_size"])
+cells = [f"{ms[k]:.1f}" for k in ["volume visibility", "volume light view", "volume segments", "volume lines", "volume composite"]]
+print(f"| {n}² | {b['width']}x{b['height']} | " + " | ".join(cells)
+      + f" | {sum(ms[k] for k in stage_b):.1f} | {b['frame_ms']:.1f} |")
+PY
+    done
+  done
+  cargo test --release --quiet --test volume_lines -- --ignored --nocapture coverage_statistics | grep '^|'
 fi
 
 if wants water_photons; then

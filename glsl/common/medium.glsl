@@ -116,17 +116,25 @@ vec3 medium_sigma_t(vec3 x) {
 // Constant density: Beer-Lambert exactly, exp(-sigma_t * length). Noise or
 // grid: the optical depth by the midpoint rule with `steps` equal steps over
 // the clipped segment. Without a medium: exactly 1.
+// A shader that defines MEDIUM_HOMOGENEOUS_ONLY before including this file
+// guarantees a constant (or no) density and compiles only that case: the
+// density field's code costs a CPU rasteriser in every fragment even when
+// the branch is not taken (volume_lines' line fragments).
 vec3 medium_transmittance_steps(vec3 o, vec3 d, float dist, uint steps) {
     if (!medium_present()) return vec3(1.0);
     float t0 = 0.0, t1 = dist;
     if (!clip_to_medium(o, d, t0, t1)) return vec3(1.0);
     vec3 sigma_t = medium.sigma_s.rgb + medium.sigma_a.rgb;
+#ifdef MEDIUM_HOMOGENEOUS_ONLY
+    return exp(-sigma_t * medium.bounds_min.w * (t1 - t0));
+#else
     if (floatBitsToUint(medium.sigma_a.w) == DENSITY_CONSTANT) return exp(-sigma_t * medium.bounds_min.w * (t1 - t0));
     uint n = max(steps, 1u);
     float dt = (t1 - t0) / float(n);
     float density_sum = 0.0;
     for (uint i = 0u; i < n; ++i) density_sum += medium_density(o + (t0 + (float(i) + 0.5) * dt) * d);
     return exp(-sigma_t * (density_sum * dt));
+#endif
 }
 
 // The far end of a light's shadow ray from x for transmittance: the light's

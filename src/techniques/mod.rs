@@ -5,6 +5,7 @@
 
 pub mod direct;
 pub mod image_space;
+pub mod volume_lines;
 pub mod water_photons;
 
 use crate::reference::Component;
@@ -132,6 +133,16 @@ pub const TECHNIQUES: &[TechniqueInfo] = &[TechniqueInfo {
     params: image_space::PARAMS,
     components: &[Component::Direct, Component::SurfaceCaustics],
 }, TechniqueInfo {
+    name: "volume_lines",
+    description: "Hu et al. 2010: volume caustics as lines (light rays after one reflection or two refractions, drawn by a geometry shader, Eq. 3 per fragment), plus ray-marched airlight with volumetric shadows, over image_space's surface radiance attenuated by the medium",
+    params: volume_lines::PARAMS,
+    components: &[
+        Component::Direct,
+        Component::SurfaceCaustics,
+        Component::Airlight,
+        Component::VolumeCaustics,
+    ],
+}, TechniqueInfo {
     name: "water_photons",
     description: "Kougianos & Moustakas 2021: cascaded caustic maps of the water from the sun, photon differentials traced through the BVH, splats drawn indirect into a screen-space caustic buffer",
     params: water_photons::PARAMS,
@@ -178,6 +189,9 @@ pub fn create(
             ctx, params, scene, scene_gpu, width, height,
         )?),
         "image_space" => Box::new(image_space::ImageSpace::new(
+            ctx, params, scene, scene_gpu, width, height,
+        )?),
+        "volume_lines" => Box::new(volume_lines::VolumeLines::new(
             ctx, params, scene, scene_gpu, width, height,
         )?),
         "water_photons" => Box::new(water_photons::WaterPhotons::new(
