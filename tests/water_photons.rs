@@ -727,6 +727,30 @@ fn paper_splats_and_intensity() {
             p.flux[0]
         );
     }
+    // The floor lies 1 m under the water: with t_max = 0.5 m the rays end
+    // before it (the paper's TMax), so nothing lands and nothing is
+    // negative (Eq. 13 as printed is negative past t_max).
+    let run = render(
+        &ctx,
+        &s,
+        &[
+            "ccm_size=64",
+            "cascades=1",
+            "intensity_mode=1",
+            "attenuation_t_max=0.5",
+        ],
+        SIZE,
+    );
+    let p = photons(&run);
+    let caustics = run.technique.splat.caustics.download_rgba32f().unwrap();
+    let negative = caustics.iter().filter(|v| **v < 0.0).count();
+    let lit = caustics.iter().filter(|v| **v > 0.0).count();
+    println!(
+        "t_max below the floor: {} photons, {negative} negative and {lit} positive values",
+        p.len()
+    );
+    assert!(p.is_empty(), "{} photons beyond t_max", p.len());
+    assert_eq!((negative, lit), (0, 0));
     assert_validation_clean(&ctx);
 }
 

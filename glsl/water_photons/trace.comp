@@ -83,11 +83,13 @@ vec3 on_tangent_plane(vec3 o, vec3 d, vec3 hit, vec3 nh, float t_hit) {
     return o + (t > 0.0 ? t : t_hit) * d;
 }
 
-// Eq. 13, as printed.
+// Eq. 13, as printed, for t' in [0, t_max] (paper mode traces no further,
+// the DXR TMax the paper relies on), where u = 1 − t'/t_max lies in [0, 1]
+// and I_att in [0, 1]; the clamp only guards rounding at t' = t_max.
 float intensity_attenuation(float t) {
     float u = 1.0 - t / wp.paper.y;
     float g = wp.paper.x;
-    return u > g ? 1.0 - (u - g) / (1.0 - g) : 1.0 - (g - u) / g;
+    return max(u > g ? 1.0 - (u - g) / (1.0 - g) : 1.0 - (g - u) / g, 0.0);
 }
 
 void main() {
@@ -137,7 +139,10 @@ void main() {
         if (!leave(type, l, n, eta, dir)) continue;
         vec3 origin = offset_origin(x00, type == WP_RAY_REFLECTED ? n : -n);
         Hit h;
-        if (!trace_closest(origin, dir, 0.0, 1e30, h)) continue;
+        // Paper mode: rays end at t_max (Eq. 13's range, DXR's TMax in the
+        // paper), so a farther receiver is a miss, never a negative I_att.
+        float t_end = wp.modes.z == WP_INTENSITY_PAPER ? wp.paper.y : 1e30;
+        if (!trace_closest(origin, dir, 0.0, t_end, h)) continue;
         // Only diffuse receivers take photons (one specular bounce: L S D).
         uint hm = hit_material(h);
         if (material_kind(hm) != MATERIAL_DIFFUSE) continue;
