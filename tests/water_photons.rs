@@ -157,6 +157,10 @@ fn algorithm_1_on_the_gpu_matches_the_cpu() {
     assert_validation_clean(&ctx);
 }
 
+/// Flat water, N = 1, 2, 3 cascades (s = 2): the floor's caustic is uniform
+/// across the cascades' seams (the box splats of the ring tile with the
+/// finer cascade's), and a photon of cascade c carries s^(2c) times the flux
+/// of one of cascade 0 (Eq. 7).
 #[test]
 fn flat_water_gives_a_uniform_caustic() {
     let ctx = validated_context();
@@ -166,33 +170,7 @@ fn flat_water_gives_a_uniform_caustic() {
         light,
         Vec3::new(0.0, 1.0, 0.0) - light * 5.0,
     );
-    let run = render(&ctx, &s, &["ccm_size=64", "cascades=1"], SIZE);
-    let p = photons(&run);
-    let refracted: Vec<_> = p
-        .iter()
-        .filter(|p| p.axis_u[3] == b::WP_RAY_REFRACTED as f32)
-        .collect();
-    assert!(
-        refracted.len() > 1000,
-        "{} refracted photons",
-        refracted.len()
-    );
-    let (lo, hi) = refracted.iter().fold((f32::MAX, f32::MIN), |(lo, hi), p| {
-        (lo.min(p.normal[3]), hi.max(p.normal[3]))
-    });
-    println!(
-        "flat water: {} refracted photons, σ in [{lo:.5}, {hi:.5}]",
-        refracted.len()
-    );
-    assert!(
-        (lo - 1.0).abs() < 0.01 && (hi - 1.0).abs() < 0.01,
-        "σ in [{lo}, {hi}]"
-    );
-    // Reflected photons leave upward: nothing above to land on.
-    assert_eq!(refracted.len(), p.len());
-
-    // E = E_light cos θ_i (1 − F) on the floor, away from the beam's edges
-    // (where the last row of tents fades out).
+    // E = E_light cos θ_i (1 − F) on the floor, away from the beam's edges.
     let cos_i = -light.y as f64;
     let eta = 1.0 / 1.33f64;
     let sin_t2 = eta * eta * (1.0 - cos_i * cos_i);
@@ -201,14 +179,6 @@ fn flat_water_gives_a_uniform_caustic() {
     let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
     let f = 0.5 * (rs * rs + rp * rp);
     let expected = 1000.0 * cos_i * (1.0 - f);
-    let caustics = run.technique.splat.caustics.download_rgba32f().unwrap();
-    let position = run
-        .technique
-        .direct
-        .gbuffer
-        .position
-        .download_rgba32f()
-        .unwrap();
     // Where the refracted beam's centre lands: the water's centre moved along the refracted ray.
     let t_dir = {
         let l = light.as_dvec3();
@@ -216,23 +186,83 @@ fn flat_water_gives_a_uniform_caustic() {
         (eta * l + (eta * cos_i - cos_t) * n).normalize()
     };
     let centre = (glam::DVec3::new(0.0, 1.0, 0.0) + t_dir * (1.0 / -t_dir.y)).as_vec3();
-    let (mut n, mut worst) = (0, 0.0f64);
-    for i in 0..(SIZE * SIZE) as usize {
-        let x = Vec3::from_slice(&position[4 * i..4 * i + 3]);
-        if position[4 * i + 3] == 0.0 || x.y.abs() > 1e-3 {
-            continue;
+    for cascades in [1u32, 2, 3] {
+        let run = render(
+            &ctx,
+            &s,
+            &["ccm_size=64", &format!("cascades={cascades}")],
+            SIZE,
+        );
+        let p = photons(&run);
+        let refracted: Vec<_> = p
+            .iter()
+            .filter(|p| p.axis_u[3] == b::WP_RAY_REFRACTED as f32)
+            .collect();
+        assert!(
+            refracted.len() > 1000,
+            "{} refracted photons",
+            refracted.len()
+        );
+        let (lo, hi) = refracted.iter().fold((f32::MAX, f32::MIN), |(lo, hi), p| {
+            (lo.min(p.normal[3]), hi.max(p.normal[3]))
+        });
+        println!(
+            "flat water, N = {cascades}: {} refracted photons, σ in [{lo:.5}, {hi:.5}]",
+            refracted.len()
+        );
+        assert!(
+            (lo - 1.0).abs() < 0.01 && (hi - 1.0).abs() < 0.01,
+            "σ in [{lo}, {hi}]"
+        );
+        // Reflected photons leave upward: nothing above to land on.
+        assert_eq!(refracted.len(), p.len());
+        // Eq. 7 on the GPU: every photon of cascade c has s^(2c) = 4^c
+        // times cascade 0's flux (flat water: same Fresnel everywhere).
+        let phi0 = refracted
+            .iter()
+            .find(|p| p.position[3] == 0.0)
+            .expect("a photon of cascade 0")
+            .flux[0] as f64;
+        for c in 0..cascades {
+            let of_c: Vec<_> = refracted
+                .iter()
+                .filter(|p| p.position[3] == c as f32)
+                .collect();
+            assert!(!of_c.is_empty(), "no photon of cascade {c}");
+            let worst = of_c
+                .iter()
+                .map(|p| (p.flux[0] as f64 / (phi0 * 4f64.powi(c as i32)) - 1.0).abs())
+                .fold(0.0, f64::max);
+            assert!(worst < 1e-4, "cascade {c}: flux ratio off 4^c by {worst}");
         }
-        let d = x - centre;
-        if d.x.abs() > 1.5 || d.z.abs() > 1.5 {
-            continue;
+        let caustics = run.technique.splat.caustics.download_rgba32f().unwrap();
+        let position = run
+            .technique
+            .direct
+            .gbuffer
+            .position
+            .download_rgba32f()
+            .unwrap();
+        let (mut n, mut worst) = (0, 0.0f64);
+        for i in 0..(SIZE * SIZE) as usize {
+            let x = Vec3::from_slice(&position[4 * i..4 * i + 3]);
+            if position[4 * i + 3] == 0.0 || x.y.abs() > 1e-3 {
+                continue;
+            }
+            let d = x - centre;
+            if d.x.abs() > 1.5 || d.z.abs() > 1.5 {
+                continue;
+            }
+            let e = caustics[4 * i] as f64;
+            worst = worst.max((e - expected).abs() / expected);
+            n += 1;
         }
-        let e = caustics[4 * i] as f64;
-        worst = worst.max((e - expected).abs() / expected);
-        n += 1;
+        println!(
+            "flat water, N = {cascades}: {n} floor pixels, E expected {expected:.3} W/m², worst relative error {worst:.5}"
+        );
+        assert!(n > 500, "{n} pixels checked");
+        assert!(worst < 0.01, "N = {cascades}: worst relative error {worst}");
     }
-    println!("flat water: {n} floor pixels, E expected {expected:.3} W/m², worst relative error {worst:.5}");
-    assert!(n > 500, "{n} pixels checked");
-    assert!(worst < 0.01, "worst relative error {worst}");
     assert_validation_clean(&ctx);
 }
 
@@ -677,7 +707,7 @@ fn paper_splats_and_intensity() {
         r * r
     };
     let expected = 1000.0 * (1.0 - f);
-    // Splats of Eqs. 16-19, with σ (mode 1) or fixed (mode 2): q_0 = 2 tents
+    // Splats of Eqs. 16-19, with σ (mode 1) or fixed (mode 2): q_0 = 1 boxes
     // on the texel lattice tile exactly, so both give E (1 − F) inside.
     for mode in [1, 2] {
         let run = render(

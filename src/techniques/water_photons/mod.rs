@@ -32,15 +32,23 @@
 //! beam (Eq. 7's s^(2c) is the ratio to cascade 0), so its photon leaves
 //! the water with Φ = E_light A_⊥ times the exact Fresnel F (reflected) or
 //! 1 − F and the water's Beer-Lambert absorption (refracted). The splat
-//! deposits exactly Φ: E(x) = Φ k(x) / |U × V| with the tent kernel k over
-//! the quad x = x' + a U + b V, whose integral is |U × V| (Eq. 20's
-//! I = R / (a q²) is this quad's mean). On a regular lattice of photons
-//! (flat water) the tents tile exactly, so the caustic is uniform:
-//! E = E_light cos θ_i (1 − F) on a floor parallel to the water. Paper mode
+//! deposits exactly Φ: E(x) = Φ / (4 |U × V|), a box over the quad
+//! x = x' + a U + b V, (a, b) ∈ [−1, 1]² (Eq. 20's I = R / (a q²), the
+//! paper's shaded quad). On a regular lattice of photons (flat water) the
+//! boxes tile exactly, so the caustic is uniform: E = E_light cos θ_i
+//! (1 − F) on a floor parallel to the water; across the seam between
+//! cascade c − 1 and cascade c's ring as well, since the ring's texels line
+//! up with the finer cascade's border when Eq. 6 is integral (a tent kernel
+//! sums to one only within one lattice: ±25% bands at the seams for s = 2).
+//! Where Eq. 6 is rounded (src/cascades.rs), the ring's inner edge is off
+//! the finer cascade's border by |ΔX − ccm_0 (1 − 1/s)/2| < 1/2 texel of
+//! cascade c: a band of that width along the seam is covered twice (ΔX
+//! rounded up) or not at all (rounded down), E doubled or zero there; the
+//! default s = 2 with a power-of-two ccm_0 keeps Eq. 6 integral. Paper mode
 //! (1): R = L I_att F of Eqs. 12-15 (attenuation γ, t_max; stylised Fresnel
 //! F_frac, F_exp) in place of the flux, same splat.
-//! Splat shapes (`splat_mode`): 0, the differential's own parallelogram
-//! (U, V = ∂x'/∂u, ∂x'/∂v); 1, Eqs. 16-19's rectangle (size q from σ,
+//! Splat shapes (`splat_mode`): 0, the differential's own parallelogram,
+//! the footprint of the photon's texel (U, V = ∂x'/∂u / 2, ∂x'/∂v / 2); 1, Eqs. 16-19's rectangle (size q from σ,
 //! stretched by a along the projected ray); 2, fixed splats: that rectangle
 //! with σ = s^c, no differentials (the paper's comparison).
 //!
@@ -53,13 +61,24 @@
 //! Deviations from the paper: the light view's up vector is +z under a
 //! high sun (`CascadeFrame::new`), so the texel grid lines up with the
 //! water's; Eq. 16's grid pitch is r / ccm_0 (the printed r / (ccm_0 − 1)
-//! would leave q_0 = 2 tents overlapping); the neighbours' rays of
+//! would leave q_0 = 1 boxes overlapping); the neighbours' rays of
 //! Algorithm 2 meet the receiver's tangent plane instead of stopping at t'
-//! (the same on a plane parallel to flat water, exact on any plane); the
-//! kernel is a tent normalised over the quad where the paper scales a
-//! shaded quad by Eq. 20 (the tent's mean is Eq. 20's I); Algorithm 3
-//! line 24 prints reflect(LDir, n10), we reflect about the photon's own
-//! normal n00 (n10 belongs to the right neighbour's ray, Algorithm 2).
+//! (the same on a plane parallel to flat water, exact on any plane);
+//! Algorithm 3 line 24 prints reflect(LDir, n10), we reflect about the
+//! photon's own normal n00 (n10 belongs to the right neighbour's ray,
+//! Algorithm 2); Algorithm 3 lines 4-6 loop the scale up to c inclusive,
+//! s^(2(c+1)), contradicting Eq. 7's L = s^(2c): we use Eq. 7 (a texel of
+//! cascade c covers s^(2c) cascade-0 texels, so its flux is s^(2c) times
+//! theirs); Eq. 1's back-off l_pos = o − l_dir (z_near + z_far) is replaced
+//! by a back-off from the water's extent (`CascadeFrame::new`: 1 m behind
+//! the rearmost corner of the water's bounds seen from o), so every water
+//! point lies in front of the light whatever the depth range; the
+//! denoiser's z in Eq. 22 is the linear view depth in metres (from the
+//! G-buffer's world positions) where Algorithm 4 loads the depth buffer:
+//! a nonlinear perspective depth would make Eq. 22's ε mean different
+//! distances near and far, while metres keep ε a physical tolerance; paper
+//! mode traces the reflected and refracted rays only up to t_max (the
+//! paper's DXR TMax), so Eq. 13's u = 1 − t'/t_max stays in [0, 1].
 //!
 //! Limits: one specular bounce (L S D): photons whose ray meets another
 //! specular surface first are dropped, so light reflected back under the
@@ -164,10 +183,10 @@ pub const PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         name: "quad_size",
-        description: "q_0 of Eq. 16 in texel pitches (splat modes 1, 2); 2 makes tent kernels tile a flat surface",
+        description: "q_0 of Eq. 16 in texel pitches (splat modes 1, 2); 1 makes the box splats tile a flat surface",
         min: 0.25,
         max: 16.0,
-        default: 2.0,
+        default: 1.0,
         integer: false,
     },
     ParamSpec {
@@ -355,6 +374,8 @@ pub struct WaterPhotons {
     light: Light,
     range_param: f32,
     water: Water,
+    /// The last completed frame's photon counts (`after_frame`).
+    last_counts: Option<PhotonCounts>,
 }
 
 fn first_directional(lights: &[Light]) -> Option<&Light> {
@@ -529,6 +550,7 @@ impl WaterPhotons {
             light,
             range_param,
             water,
+            last_counts: None,
         };
         technique.set_light(&light);
         Ok(technique)
@@ -569,16 +591,6 @@ impl Technique for WaterPhotons {
         scene: &SceneGpu,
         targets: &FrameTargets,
     ) -> VkResult<()> {
-        // Last frame's counts (the renderer waited for it): report overflow.
-        let counts = self.trace.counts()?;
-        if counts.overflow() > 0 {
-            log::warn!(
-                "water_photons: {} of {} photons did not fit the buffer of {} (raise photon_capacity)",
-                counts.overflow(),
-                counts.requested,
-                counts.capacity
-            );
-        }
         // Eq. 1 follows the camera: the frame constants (host-visible,
         // written before recording) hold this frame's eye.
         let constants: Vec<GpuFrame> = scene.frame.download_pod()?;
@@ -632,6 +644,36 @@ impl Technique for WaterPhotons {
             targets,
         );
         Ok(())
+    }
+
+    /// The frame's photon counts (copied to the host by "photon trace"),
+    /// read once the frame has completed: overflow is reported for the
+    /// frame that overflowed, the last one included.
+    fn after_frame(&mut self) -> VkResult<()> {
+        let counts = self.trace.counts()?;
+        if counts.overflow() > 0 {
+            log::warn!(
+                "water_photons: {} of {} photons did not fit the buffer of {} (raise photon_capacity)",
+                counts.overflow(),
+                counts.requested,
+                counts.capacity
+            );
+        }
+        self.last_counts = Some(counts);
+        Ok(())
+    }
+
+    fn counters(&self) -> Vec<(&'static str, u64)> {
+        self.last_counts
+            .map(|c| {
+                vec![
+                    ("photons_written", c.written.into()),
+                    ("photons_requested", c.requested.into()),
+                    ("photon_capacity", c.capacity.into()),
+                    ("photons_overflow", c.overflow().into()),
+                ]
+            })
+            .unwrap_or_default()
     }
 
     fn set_lights(&mut self, lights: &[Light]) -> bool {
