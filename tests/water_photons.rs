@@ -1037,3 +1037,75 @@ fn the_cascades_follow_the_camera() {
     }
     assert_validation_clean(&ctx);
 }
+
+/// A one-frame `caustics render` whose photon buffer overflows reports it
+/// (the counts are read after the frame's fence, `Technique::after_frame`),
+/// still exits 0 with a valid image; `caustics bench --json` writes the
+/// frame's photon counts.
+#[test]
+fn a_one_frame_render_reports_overflow() {
+    let pool =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/water_pool.toml");
+    let dir = std::env::temp_dir().join(format!("water_photons_overflow_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let exr = dir.join("pool.exr");
+    let json = dir.join("bench.json");
+    let caustics = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_caustics"))
+            .args(args)
+            .args([
+                "--scene",
+                pool.to_str().unwrap(),
+                "--technique",
+                "water_photons",
+            ])
+            .args(["--width", "48", "--height", "48", "--validate"])
+            .args(["--param", "ccm_size=64", "--param", "photon_capacity=50"])
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).to_string(),
+        )
+    };
+    let (code, err) = caustics(&["render", "--out", exr.to_str().unwrap()]);
+    println!("render stderr: {err}");
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        err.contains("photons did not fit the buffer of 50"),
+        "no overflow warning: {err}"
+    );
+    assert!(!err.contains("Validation Error"), "{err}");
+    let (w, h, rgba) = caustics::output::read_exr(&exr).unwrap();
+    assert_eq!((w, h), (48, 48));
+    assert!(rgba.iter().all(|v| v.is_finite() && *v >= 0.0));
+    assert!(rgba.iter().any(|v| *v > 0.0));
+
+    let (code, err) = caustics(&[
+        "bench",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        err.contains("photons did not fit the buffer of 50"),
+        "{err}"
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let counters = &report["counters"];
+    println!("bench counters: {counters}");
+    assert_eq!(counters["photon_capacity"], 50);
+    assert_eq!(counters["photons_written"], 50);
+    let requested = counters["photons_requested"].as_u64().unwrap();
+    assert!(requested > 50, "{counters}");
+    assert_eq!(
+        counters["photons_overflow"].as_u64().unwrap(),
+        requested - 50
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
