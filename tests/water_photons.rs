@@ -1133,3 +1133,78 @@ fn a_one_frame_render_reports_overflow() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// ocean_large (400 m basin, walls 200 m away, low sun) at 96², ccm_0 128,
+/// otherwise the defaults: the frame is finite and non-negative, the
+/// seabed under the water carries caustics, nothing overflows, validation
+/// is clean. Also measured (BENCHMARKS.md): the adaptive denoiser's energy
+/// change on this frame's sparse far caustics, and the caustic energy with
+/// a 10x smaller depth bias (splats leaking through occluders would lose
+/// energy there).
+#[test]
+fn ocean_large_renders_with_caustics_on_the_seabed() {
+    use caustics::reference::Component;
+    use caustics::renderer::Renderer;
+    const PX: u32 = 96;
+    let ctx = validated_context();
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/ocean_large.toml");
+    let frame = |overrides: &[&str], components: Option<u32>| {
+        let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        let params = Params::resolve("water_photons", PARAMS, &overrides).unwrap();
+        let s = Scene::load(&path).unwrap();
+        let mut r = Renderer::new(&ctx, s, "water_photons", &params, PX, PX, 0.0).unwrap();
+        if let Some(mask) = components {
+            r.scene_gpu.components = mask;
+        }
+        r.render_frame(0.0).unwrap();
+        let img = r.radiance().unwrap();
+        let counters: std::collections::BTreeMap<_, _> =
+            r.technique_counters().into_iter().collect();
+        (img, counters)
+    };
+    let (full, counters) = frame(&["ccm_size=128"], None);
+    println!("ocean_large: {counters:?}");
+    assert_finite(&full);
+    assert!(full.iter().all(|v| *v >= 0.0), "negative radiance");
+    assert_eq!(counters["photons_overflow"], 0);
+    assert!(counters["photons_written"] > 1000, "{counters:?}");
+    let caustic_energy =
+        |img: &[f32]| -> f64 { img.chunks(4).map(|p| (p[0] + p[1] + p[2]) as f64).sum() };
+    let caustics_only = Some(Component::SurfaceCaustics.mask());
+    let (caustic, _) = frame(&["ccm_size=128"], caustics_only);
+    assert_finite(&caustic);
+    assert!(caustic.iter().all(|v| *v >= 0.0));
+    let lit = caustic.chunks(4).filter(|p| p[0] > 0.0).count();
+    let e = caustic_energy(&caustic);
+    println!(
+        "ocean_large: surface caustics on {lit} of {} pixels, energy {e:.4}",
+        PX * PX
+    );
+    // The camera looks across the water at the seabed: caustics on a good
+    // part of the image.
+    assert!(lit > (PX * PX / 10) as usize, "{lit} pixels with caustics");
+    let (undenoised, _) = frame(&["ccm_size=128", "denoise=0"], caustics_only);
+    let e0 = caustic_energy(&undenoised);
+    println!(
+        "ocean_large: adaptive denoiser energy change {:+.6} ({e:.2} vs {e0:.2} undenoised), pixels changed by > 1%: {}",
+        e / e0 - 1.0,
+        caustic
+            .chunks(4)
+            .zip(undenoised.chunks(4))
+            .filter(|(a, b)| (a[0] - b[0]).abs() > 0.01 * b[0].max(1e-6))
+            .count()
+    );
+    let (small_bias, _) = frame(&["ccm_size=128", "depth_bias=0.001"], caustics_only);
+    let e_bias = caustic_energy(&small_bias);
+    println!(
+        "ocean_large: depth_bias 0.001 vs 0.01: caustic energy {:+.4}, pixels differing by > 1%: {}",
+        e_bias / e - 1.0,
+        small_bias
+            .chunks(4)
+            .zip(caustic.chunks(4))
+            .filter(|(a, b)| (a[0] - b[0]).abs() > 0.01 * b[0].max(1e-6))
+            .count()
+    );
+    assert_validation_clean(&ctx);
+}
