@@ -8,8 +8,9 @@
 //   does not reach emits nothing;
 // - the reflected and the refracted ray from x_{0:0} (the paper traces both;
 //   line 24 onwards, the refracted case "implemented in a similar fashion");
-// - for each ray that lands on a front face of a diffuse receiver
-//   (line 33), the photon differential: the neighbours (u+1, v) and
+// - for each ray that lands on a diffuse receiver (line 33 takes front
+//   faces only; we take either side, as the reference does), the photon
+//   differential: the neighbours (u+1, v) and
 //   (u, v+1) (Eq. 10; the left or lower neighbour, negated, where the right
 //   or upper one holds no water) send their own rays, which we intersect
 //   with the receiver's tangent plane at the hit ("projected down onto the
@@ -147,9 +148,12 @@ void main() {
         uint hm = hit_material(h);
         if (material_kind(hm) != MATERIAL_DIFFUSE) continue;
         vec3 hit = hit_position(h, origin, dir);
+        // Line 33 keeps front faces only; our diffuse surfaces are
+        // two-sided, as in the reference light tracer (a photon lands on
+        // the side it arrives on whatever the winding; an open mesh such
+        // as a plane is lit from either side): face the normal toward the ray.
         vec3 ng = hit_geometric_normal(h);
-        // Line 33: front faces only.
-        if (dot(-dir, ng) <= 0.0) continue;
+        if (dot(dir, ng) > 0.0) ng = -ng;
 
         // Algorithm 2: the neighbours' rays, with their own normals.
         vec3 nu_s = dot(l, nu) < 0.0 ? nu : -nu;
