@@ -45,7 +45,11 @@
 //! the finer cascade's border by |ΔX − ccm_0 (1 − 1/s)/2| < 1/2 texel of
 //! cascade c: a band of that width along the seam is covered twice (ΔX
 //! rounded up) or not at all (rounded down), E doubled or zero there; the
-//! default s = 2 with a power-of-two ccm_0 keeps Eq. 6 integral. Paper mode
+//! default s = 2 with a power-of-two ccm_0 keeps Eq. 6 integral. Measured
+//! on the flat-water test scene with s = 3, ccm_0 64 (ΔX = 21.33 rounded to
+//! 21, a gap of a third of a cascade-1 texel): 95 of 4464 floor pixels off
+//! by more than 1%, down to 8.5% of E in the band, the mean over the 3 m
+//! square 1.3% low (N = 2 and 3 alike). Paper mode
 //! (1): R = L I_att F of Eqs. 12-15 (attenuation γ, t_max; stylised Fresnel
 //! F_frac, F_exp) in place of the flux, same splat.
 //! Splat shapes (`splat_mode`): 0, the differential's own parallelogram,
