@@ -63,7 +63,7 @@ if wants image_space; then
           --param photon_buffer_size=$photons --param caustic_map_size=$map \
           --width $size --height $size --frames ${FRAMES:-10} --warmup 2 --json $json \
           > /dev/null 2> ${json%.json}.log || { cat ${json%.json}.log; exit 1; }
-        python3 - $json <<'PY'
+    python3 - $json <<'PY'
 import json, sys
 b = json.load(open(sys.argv[1]))
 ms = {p["name"]: p["ms"] for p in b["passes_ms"]}
@@ -71,8 +71,8 @@ caustic = ["caustic map clear", "caustic photons", "caustic splat", "caustic app
 p, m = int(b["params"]["photon_buffer_size"]), int(b["params"]["caustic_map_size"])
 cells = [f"{ms[n]:.1f}" for n in caustic[1:]]
 print(f"| {b['width']}x{b['height']} | {p}² | {m}² | " + " | ".join(cells)
-      + f" | {sum(ms[n] for n in caustic):.1f}"
-      + f" | {ms['refractor gbuffer'] + ms['refraction']:.1f} | {b['frame_ms']:.1f} |")
+    + f" | {sum(ms[n] for n in caustic):.1f}"
+    + f" | {ms['refractor gbuffer'] + ms['refraction']:.1f} | {b['frame_ms']:.1f} |")
 PY
       done
     done
@@ -111,13 +111,12 @@ if wants water_photons; then
   # splat, denoise, composite, and the rest of the frame (direct passes,
   # camera refraction, tonemap). Runs: ccm_0, N, splat mode, denoiser
   # (0 none, 1 adaptive, 2 fixed), denoise passes.
-  echo "| screen | ccm_0 | N | splat | denoise | trace threads | water surface + ccm raster | photon trace | photon splat | denoise | caustic composite | rest | frame |"
-  echo "| --- | ---: | ---: | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
-  for run in "256 1 0 1 1" "512 1 0 1 1" "512 2 0 1 1" "512 4 0 1 1" "1024 1 0 1 1" "1024 4 0 1 1" \
-             "512 1 2 1 1" "512 1 0 0 1" "512 1 0 2 10"; do
-    set -- $run
-    json=out/bench/water_photons_pool_c$1_n$2_s$3_d$4x$5.json
-    $bin bench --scene assets/scenes/water_pool.toml --technique water_photons \
+  # One row: scene, then ccm_0, N, splat mode, denoiser, denoise passes.
+  wp_row() {
+    local scene=$1
+    shift
+    json=out/bench/water_photons_${scene}_c$1_n$2_s$3_d$4x$5.json
+    $bin bench --scene assets/scenes/$scene.toml --technique water_photons \
       --param ccm_size=$1 --param cascades=$2 --param splat_mode=$3 \
       --param denoise=$4 --param denoise_passes=$5 \
       --width 256 --height 256 --frames ${FRAMES:-10} --warmup 2 --json $json \
@@ -140,5 +139,15 @@ print(f"| {b['width']}x{b['height']} | {layout[0]}² | {layout[1]} | {splat} | {
       + f" | {ms['water surface'] + ms['ccm raster']:.1f} | {ms['photon trace']:.1f} | {ms['photon splat']:.1f}"
       + f" | {denoise:.1f} | {ms['caustic composite']:.1f} | {rest:.1f} | {b['frame_ms']:.1f} |")
 PY
+  }
+  echo "| screen | ccm_0 | N | splat | denoise | trace threads | water surface + ccm raster | photon trace | photon splat | denoise | caustic composite | rest | frame |"
+  echo "| --- | ---: | ---: | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+  for run in "256 1 0 1 1" "512 1 0 1 1" "512 2 0 1 1" "512 4 0 1 1" "1024 1 0 1 1" "1024 4 0 1 1" \
+             "512 1 2 1 1" "512 1 0 0 1" "512 1 0 2 10"; do
+    wp_row water_pool $run
   done
+  # ocean_large (400 m basin): the defaults (N = 2) at ccm_0 512.
+  echo
+  echo "ocean_large:"
+  wp_row ocean_large 512 2 0 1 1
 fi

@@ -500,6 +500,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             let (device_name, driver) = (ctx.info.name.clone(), ctx.info.driver.trim().to_string());
             let (source, stats) = (renderer.profiler.source, renderer.scene_gpu.stats);
+            let counters: std::collections::BTreeMap<_, _> =
+                renderer.technique_counters().into_iter().collect();
             drop(renderer);
             check_validation(ctx)?;
             let passes = average(&all);
@@ -533,6 +535,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     "passes_ms": passes,
                     "frame_ms": frame_mean,
                     "geometry": stats,
+                    "counters": counters,
                 });
                 if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
                     std::fs::create_dir_all(dir)

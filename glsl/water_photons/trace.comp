@@ -8,8 +8,9 @@
 //   does not reach emits nothing;
 // - the reflected and the refracted ray from x_{0:0} (the paper traces both;
 //   line 24 onwards, the refracted case "implemented in a similar fashion");
-// - for each ray that lands on a front face of a diffuse receiver
-//   (line 33), the photon differential: the neighbours (u+1, v) and
+// - for each ray that lands on a diffuse receiver (line 33 takes front
+//   faces only; we take either side, as the reference does), the photon
+//   differential: the neighbours (u+1, v) and
 //   (u, v+1) (Eq. 10; the left or lower neighbour, negated, where the right
 //   or upper one holds no water) send their own rays, which we intersect
 //   with the receiver's tangent plane at the hit ("projected down onto the
@@ -83,11 +84,13 @@ vec3 on_tangent_plane(vec3 o, vec3 d, vec3 hit, vec3 nh, float t_hit) {
     return o + (t > 0.0 ? t : t_hit) * d;
 }
 
-// Eq. 13, as printed.
+// Eq. 13, as printed, for t' in [0, t_max] (paper mode traces no further,
+// the DXR TMax the paper relies on), where u = 1 − t'/t_max lies in [0, 1]
+// and I_att in [0, 1]; the clamp only guards rounding at t' = t_max.
 float intensity_attenuation(float t) {
     float u = 1.0 - t / wp.paper.y;
     float g = wp.paper.x;
-    return u > g ? 1.0 - (u - g) / (1.0 - g) : 1.0 - (g - u) / g;
+    return max(u > g ? 1.0 - (u - g) / (1.0 - g) : 1.0 - (g - u) / g, 0.0);
 }
 
 void main() {
@@ -137,14 +140,20 @@ void main() {
         if (!leave(type, l, n, eta, dir)) continue;
         vec3 origin = offset_origin(x00, type == WP_RAY_REFLECTED ? n : -n);
         Hit h;
-        if (!trace_closest(origin, dir, 0.0, 1e30, h)) continue;
+        // Paper mode: rays end at t_max (Eq. 13's range, DXR's TMax in the
+        // paper), so a farther receiver is a miss, never a negative I_att.
+        float t_end = wp.modes.z == WP_INTENSITY_PAPER ? wp.paper.y : 1e30;
+        if (!trace_closest(origin, dir, 0.0, t_end, h)) continue;
         // Only diffuse receivers take photons (one specular bounce: L S D).
         uint hm = hit_material(h);
         if (material_kind(hm) != MATERIAL_DIFFUSE) continue;
         vec3 hit = hit_position(h, origin, dir);
+        // Line 33 keeps front faces only; our diffuse surfaces are
+        // two-sided, as in the reference light tracer (a photon lands on
+        // the side it arrives on whatever the winding; an open mesh such
+        // as a plane is lit from either side): face the normal toward the ray.
         vec3 ng = hit_geometric_normal(h);
-        // Line 33: front faces only.
-        if (dot(-dir, ng) <= 0.0) continue;
+        if (dot(dir, ng) > 0.0) ng = -ng;
 
         // Algorithm 2: the neighbours' rays, with their own normals.
         vec3 nu_s = dot(l, nu) < 0.0 ? nu : -nu;

@@ -2,10 +2,10 @@
 //! (glsl/common/water.glsl, the formula of src/scene/water.rs) at one time
 //! on the GPU, one invocation per grid vertex, into a storage buffer of
 //! `GpuWaterVertex` (position, normal) in the grid order of `Water::mesh`.
-//! It is meant as the input of the light-view raster of the water (the
-//! cascaded caustic maps of Kougianos & Moustakas 2021, §3.1, reading
-//! `vertices`), which is not written yet: today only tests/water_surface.rs
-//! runs it, checking it against the CPU evaluation.
+//! It is the input of the light-view raster of the water (the cascaded
+//! caustic maps of Kougianos & Moustakas 2021, §3.1: water_photons' "ccm
+//! raster" reads `vertices`); tests/water_surface.rs checks it against the
+//! CPU evaluation.
 
 use crate::gpu::{GpuWaterVertex, GpuWave};
 use crate::scene::Water;

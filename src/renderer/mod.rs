@@ -179,11 +179,19 @@ impl Renderer {
         let targets = &self.targets;
         let tonemap = &self.tonemap;
         let exposure = self.scene.output.exposure;
-        self.profiler.frame(|rec| {
+        let timings = self.profiler.frame(|rec| {
             technique.record(rec, scene_gpu, targets)?;
             tonemap.record(rec, &targets.radiance, exposure);
             Ok(())
-        })
+        })?;
+        // The frame has completed: the technique's read-backs are current.
+        self.technique.after_frame()?;
+        Ok(timings)
+    }
+
+    /// The technique's counts of the last frame (`Technique::counters`).
+    pub fn technique_counters(&self) -> Vec<(&'static str, u64)> {
+        self.technique.counters()
     }
 
     /// The last frame's radiance, RGBA f32 per pixel, rows top to bottom.

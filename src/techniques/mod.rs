@@ -110,6 +110,19 @@ pub trait Technique {
     fn set_lights(&mut self, _lights: &[crate::scene::Light]) -> bool {
         false
     }
+
+    /// Called once the frame recorded by `record` has completed (after the
+    /// renderer's fence wait): host-visible results of that frame are
+    /// current, so this is where a technique reads them back and reports.
+    fn after_frame(&mut self) -> VkResult<()> {
+        Ok(())
+    }
+
+    /// Named counts of the last completed frame (`caustics bench --json`
+    /// writes them); none by default.
+    fn counters(&self) -> Vec<(&'static str, u64)> {
+        Vec::new()
+    }
 }
 
 /// Every real-time technique: name, one-line description, parameters.

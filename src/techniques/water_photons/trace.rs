@@ -59,7 +59,7 @@ const _: () = assert!(size_of::<DrawCounters>() == 32);
 pub struct PhotonCounts {
     /// Written into the buffer (= the splat's instance count).
     pub written: u32,
-    /// Front-facing receiver hits the trace wanted to store.
+    /// Diffuse receiver hits the trace wanted to store.
     pub requested: u32,
     pub capacity: u32,
 }
