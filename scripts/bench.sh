@@ -104,6 +104,26 @@ PY
     done
   done
   cargo test --release --quiet --test volume_lines -- --ignored --nocapture coverage_statistics | grep '^|'
+  # Hu's Table 1: the whole frame's stage split (A airlight, C surface
+  # radiance = image_space, B volume caustics, composition) at 256^2.
+  echo "| scene | A airlight | C surface (image_space) | B volume caustics | composition | frame |"
+  echo "| --- | ---: | ---: | ---: | ---: | ---: |"
+  for scene in volume_cone smoke; do
+    json=out/bench/volume_lines_stages_$scene.json
+    $bin bench --scene assets/scenes/$scene.toml --technique volume_lines \
+      --width 256 --height 256 --frames ${FRAMES:-10} --warmup 1 --json $json \
+      > /dev/null 2> ${json%.json}.log || { cat ${json%.json}.log; exit 1; }
+    python3 - $json $scene <<'PY'
+import json, sys
+b = json.load(open(sys.argv[1]))
+ms = {p["name"]: p["ms"] for p in b["passes_ms"]}
+a = ms["airlight"]
+bb = sum(v for k, v in ms.items() if k in ("volume visibility", "volume clear", "volume light view", "volume segments", "volume lines"))
+comp = ms["volume composite"] + ms["tonemap"]
+c = sum(ms.values()) - a - bb - comp
+print(f"| {sys.argv[2]} | {a:.1f} | {c:.1f} | {bb:.1f} | {comp:.1f} | {b['frame_ms']:.1f} |")
+PY
+  done
 fi
 
 if wants water_photons; then
