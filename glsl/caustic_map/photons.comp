@@ -71,6 +71,17 @@ vec3 air_transmittance(vec3 o, vec3 d, float dist) {
     return medium_transmittance_steps(o, d, dist, pc.mode.w);
 }
 
+// tau(s, x) of the first leg, from the light to the first hit x along d
+// (emitted at o, `dist` from x). A planar (directional) view's origin is a
+// plane just outside the specular objects, not the light: the light's path
+// starts far enough back to cross the whole medium (light_travel, as
+// `direct` and the airlight do).
+vec3 light_leg_transmittance(vec3 o, vec3 d, float dist, vec3 x, bool planar) {
+    if (!planar) return air_transmittance(o, d, dist);
+    float back = light_travel(1e30, x);
+    return air_transmittance(x - d * back, d, back);
+}
+
 // Light-space specular G-buffer (src/passes/specular_gbuffer.rs; photon
 // modes 1 and 2): nearest front faces and farthest back faces, position
 // (w: d_N at the front, < 0 where not covered) and outward smooth normal
@@ -346,7 +357,7 @@ void main() {
         vec4 fn = imageLoad(front_normal, ivec2(id));
         m = uint(fn.w + 0.5);
         x = fp.xyz;
-        w *= air_transmittance(o, d, dot(x - o, d));
+        w *= light_leg_transmittance(o, d, dot(x - o, d), x, planar);
         ns = normalize(fn.xyz);
         ng = dot(ns, d) < 0.0 ? ns : -ns;
     } else {
@@ -354,7 +365,7 @@ void main() {
         if (!trace_closest(o, d, 0.0, 1e30, hit)) return;
         m = hit_material(hit);
         x = hit_position(hit, o, d);
-        w *= air_transmittance(o, d, hit.t);
+        w *= light_leg_transmittance(o, d, hit.t, x, planar);
         ng = hit_geometric_normal(hit);
         front = dot(d, ng) < 0.0;
         ns = hit_normal(hit);

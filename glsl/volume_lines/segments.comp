@@ -211,7 +211,7 @@ void main() {
     // tau(s, p0): the medium between the light and the object (a
     // directional light's rays come from beyond the medium's bounds, to
     // which vl_transmittance clips).
-    phi *= vl_transmittance(planar ? p0 - d * 1e5 : o, p0, pc.params.z);
+    phi *= vl_transmittance(planar ? p0 - d * light_travel(1e30, p0) : o, p0, pc.params.z);
 
     vec3 p1, dir;
     if (kind == MATERIAL_MIRROR) {

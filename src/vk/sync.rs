@@ -21,6 +21,10 @@ pub enum Access {
     FragmentRead,
     /// Read as storage by vertex or geometry shaders (vertex pulling).
     VertexRead,
+    /// Read as storage by every stage of a draw: vertex, geometry and
+    /// fragment shaders (a buffer pulled per primitive and read again per
+    /// fragment).
+    GraphicsRead,
     /// Written as storage (e.g. atomics) by fragment shaders.
     FragmentWrite,
     /// Colour attachment written by rendering.
@@ -76,6 +80,7 @@ impl Access {
             Access::ComputeRead | Access::ComputeWrite => S::COMPUTE_SHADER,
             Access::FragmentRead | Access::FragmentWrite => S::FRAGMENT_SHADER,
             Access::VertexRead => S::VERTEX_SHADER | S::GEOMETRY_SHADER,
+            Access::GraphicsRead => S::VERTEX_SHADER | S::GEOMETRY_SHADER | S::FRAGMENT_SHADER,
             Access::ColorAttachment => S::COLOR_ATTACHMENT_OUTPUT,
             Access::DepthAttachment => S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
             Access::IndirectRead => S::DRAW_INDIRECT,
@@ -89,7 +94,10 @@ impl Access {
         use vk::AccessFlags2 as A;
         match self {
             Access::Undefined | Access::Present => A::NONE,
-            Access::ComputeRead | Access::FragmentRead | Access::VertexRead => A::SHADER_READ,
+            Access::ComputeRead
+            | Access::FragmentRead
+            | Access::VertexRead
+            | Access::GraphicsRead => A::SHADER_READ,
             Access::ComputeWrite | Access::FragmentWrite => A::SHADER_READ | A::SHADER_WRITE,
             Access::ColorAttachment => A::COLOR_ATTACHMENT_READ | A::COLOR_ATTACHMENT_WRITE,
             Access::DepthAttachment => {
@@ -117,7 +125,7 @@ impl Access {
         match self {
             Access::Undefined => L::UNDEFINED,
             Access::ComputeRead | Access::ComputeWrite | Access::FragmentWrite => L::GENERAL,
-            Access::FragmentRead | Access::VertexRead => {
+            Access::FragmentRead | Access::VertexRead | Access::GraphicsRead => {
                 // The DEPTH_STENCIL_* layouts need no separateDepthStencilLayouts.
                 if format_is_depth {
                     L::DEPTH_STENCIL_READ_ONLY_OPTIMAL

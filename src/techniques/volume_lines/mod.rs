@@ -1,5 +1,5 @@
 //! `volume_lines`: line-based volume caustics in single-scattering media
-//! (Hu, Dong, Hawkins, Peers 2010, "Interactive Volume Caustics in
+//! (Hu, Dong, Ihrke, Grosch, Yuan, Seidel 2010, "Interactive Volume Caustics in
 //! Single-Scattering Media"), on top of `image_space`.
 //!
 //! The frame is Hu's Fig. 2 sum: C (surface radiance with surface caustics
@@ -28,13 +28,21 @@
 //!    geometry shader emits the camera-space line p1 -> p2; the fragment
 //!    shader evaluates Eq. 3 with the regular-step resampling of Fig. 5 and
 //!    blends additively into `volume` (RGBA32F; alpha counts fragments).
-//!    Radiometry (glsl/volume_lines/lines.frag has the derivation): a line
+//!    Radiometry (glsl/volume_lines/lines.glsl has the derivation): a line
 //!    is a beam x beam kernel, L = sigma_s p tau Phi / (w_world sin theta),
 //!    w_world the width in metres, perpendicular to both rays, of the
 //!    line's rasterised footprint (1 px wide, rectangular or parallelogram
 //!    depending on the device's `strictLines`), redistributed over the
 //!    ray-marching points k Delta_x within the filter support r of x_l
-//!    with normalised Gaussian weights. No scale factor.
+//!    with normalised Gaussian weights. No scale factor. This is how Eq. 3's
+//!    L_in Delta_omega Delta_x is made radiometric (the issue's "Delta_omega
+//!    from the light's radiometry"): L_in Delta_omega is the irradiance of
+//!    the light tube, Phi over its cross-section, and the line's kernel
+//!    over the beam-to-ray distance integrates the tube along the viewing
+//!    ray; Delta_x then only picks where along the ray the contribution
+//!    lands (Fig. 5's resampling), not how much, so the energy does not
+//!    depend on Delta_x (as long as r >= Delta_x / 2, so that every line
+//!    reaches a step point).
 //!
 //! Once per frame: "volume visibility" (the distance to the first surface,
 //! diffuse or specular, per pixel: Sect. 5.3's culling; refractors hide the
@@ -541,14 +549,15 @@ impl Technique for VolumeLines {
                 );
             });
             rec.pass("volume lines", |cmd| {
-                // Segments pulled by the geometry shader and read by the
-                // fragments; the distances read by the fragments.
+                // Segments pulled by the geometry shader and read again by
+                // the fragments (so the next light's segment pass waits for
+                // both); the distances read by the fragments.
                 barrier(
                     &ctx,
                     cmd,
                     &[ImageAccess::new(&self.volume, Access::ColorAttachment)],
                     &[
-                        BufferAccess::new(&self.segments, Access::VertexRead),
+                        BufferAccess::new(&self.segments, Access::GraphicsRead),
                         BufferAccess::new(&self.visibility, Access::FragmentRead),
                     ],
                 );
