@@ -33,7 +33,6 @@ use caustics::techniques::{ParamSpec, Params, Technique};
 use caustics::vk::{Context, Profiler};
 use common::*;
 use glam::{DVec3, Vec3};
-use std::f64::consts::PI;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -122,11 +121,6 @@ fn analytic_scene(sigma_s: Vec3, g: f32, with_box: bool) -> Scene {
     s
 }
 
-fn hg(cos: f64, g: f64) -> f64 {
-    let denom = 1.0 + g * g - 2.0 * g * cos;
-    (1.0 - g * g) / (4.0 * PI * denom * denom.sqrt())
-}
-
 /// Entry and exit distances of the ray (o, d) through the box [lo, hi].
 fn slab(o: DVec3, d: DVec3, lo: DVec3, hi: DVec3) -> Option<(f64, f64)> {
     let (mut t0, mut t1) = (0.0f64, f64::MAX);
@@ -190,7 +184,7 @@ fn quadrature(s: &Scene, px: u32, py: u32, with_box: bool) -> DVec3 {
                 }
             }
         }
-        let phase = hg(dir_in.dot(-d), m.g as f64);
+        let phase = hg_phase(dir_in.dot(-d), m.g as f64);
         sigma_s
             * phase
             * light.intensity.as_dvec3()

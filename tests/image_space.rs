@@ -536,27 +536,6 @@ fn ball_lens_focus() {
     assert_validation_clean(&ctx);
 }
 
-/// Per pixel of a SIZE² frame of `s`: true when the camera ray's first hit
-/// is a diffuse surface (CPU BVH).
-fn diffuse_first_mask(s: &Scene) -> Vec<bool> {
-    use caustics::bvh::Bvh;
-    use caustics::scene::MaterialKind;
-    let tris = s.triangles(0.0);
-    let bvh = Bvh::build(&tris);
-    let gpu = bvh.gpu_triangles(&tris);
-    let mut mask = Vec::with_capacity((SIZE * SIZE) as usize);
-    for py in 0..SIZE {
-        for px in 0..SIZE {
-            let (o, d) = pixel_ray(&s.camera, SIZE, SIZE, px, py);
-            mask.push(bvh.intersect(&gpu, o, d, 0.0, f32::MAX).is_some_and(|h| {
-                let m = gpu[h.triangle as usize].p0[3].to_bits() as usize;
-                s.materials[m].kind == MaterialKind::Diffuse
-            }));
-        }
-    }
-    mask
-}
-
 /// rgb summed over the image.
 fn energy(img: &[f32]) -> f64 {
     img.chunks(4).map(|p| (p[0] + p[1] + p[2]) as f64).sum()
@@ -600,7 +579,9 @@ fn caustics_match_reference(name: &str, photons: u64, bounds: &[Bound]) {
         r.render_frame(0.0).unwrap();
         r.radiance().unwrap()
     };
-    let mask = diffuse_first_mask(&load());
+    let mask = first_hit_mask(&load(), SIZE, false, |k| {
+        k == caustics::scene::MaterialKind::Diffuse
+    });
     let masked = |img: Vec<f32>| -> Vec<f32> {
         img.chunks(4)
             .zip(&mask)

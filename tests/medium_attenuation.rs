@@ -27,7 +27,7 @@ use caustics::renderer::Renderer;
 use caustics::scene::{Density, Medium, Scene};
 use caustics::techniques::{self, Params};
 use common::*;
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -68,24 +68,6 @@ fn plane_scene(medium: Option<Medium>) -> Scene {
     s
 }
 
-/// Length of the segment a -> b inside the box [lo, hi].
-fn inside_length(a: DVec3, b: DVec3, lo: DVec3, hi: DVec3) -> f64 {
-    let d = b - a;
-    let (mut t0, mut t1) = (0.0f64, 1.0f64);
-    for k in 0..3 {
-        if d[k].abs() < 1e-300 {
-            if a[k] < lo[k] || a[k] > hi[k] {
-                return 0.0;
-            }
-            continue;
-        }
-        let (u, v) = ((lo[k] - a[k]) / d[k], (hi[k] - a[k]) / d[k]);
-        t0 = t0.max(u.min(v));
-        t1 = t1.min(u.max(v));
-    }
-    (t1 - t0).max(0.0) * d.length()
-}
-
 /// Worst relative errors over the floor pixels of `plane_scene(medium)`:
 /// of the radiance against the analytic L, and of the ratio to the same
 /// frame without the medium against the analytic tau(s, x) tau(x, v).
@@ -116,8 +98,8 @@ fn check_plane(medium: Medium) -> (f64, f64) {
             let to_light = light.position.as_dvec3() - x;
             let r = to_light.length();
             let cos = to_light.y / r;
-            let tau_light = (-sigma_t * inside_length(x, light.position.as_dvec3(), lo, hi)).exp();
-            let tau_eye = (-sigma_t * inside_length(x, o, lo, hi)).exp();
+            let tau_light = (-sigma_t * length_in_box(x, light.position.as_dvec3(), lo, hi)).exp();
+            let tau_eye = (-sigma_t * length_in_box(x, o, lo, hi)).exp();
             let expected = ALBEDO as f64 / std::f64::consts::PI * light.intensity.as_dvec3() * cos
                 / (r * r)
                 * tau_light
@@ -290,30 +272,14 @@ fn direct_matches_reference_in_noise_medium() {
 const MAX_ENERGY: f64 = 0.005;
 const MAX_FLIP: f32 = 0.005;
 
-/// Per pixel: true when the camera ray's first hit is a diffuse surface.
-fn diffuse_first_mask(s: &Scene) -> Vec<bool> {
-    use caustics::bvh::Bvh;
-    use caustics::scene::MaterialKind;
-    let tris = s.triangles(0.0);
-    let bvh = Bvh::build(&tris);
-    let gpu = bvh.gpu_triangles(&tris);
-    (0..SIZE * SIZE)
-        .map(|i| {
-            let (o, d) = pixel_ray(&s.camera, SIZE, SIZE, i % SIZE, i / SIZE);
-            bvh.intersect(&gpu, o, d, 0.0, f32::MAX).is_some_and(|h| {
-                let m = gpu[h.triangle as usize].p0[3].to_bits() as usize;
-                s.materials[m].kind == MaterialKind::Diffuse
-            })
-        })
-        .collect()
-}
-
 #[test]
 fn image_space_caustics_are_attenuated_like_the_reference() {
     let ctx = validated_context();
     let path = Path::new("assets/scenes/volume_cone.toml");
     let load = || Scene::load(path).unwrap();
-    let mask = diffuse_first_mask(&load());
+    let mask = first_hit_mask(&load(), SIZE, false, |k| {
+        k == caustics::scene::MaterialKind::Diffuse
+    });
     let masked = |img: Vec<f32>| -> Vec<f32> {
         img.chunks(4)
             .zip(&mask)

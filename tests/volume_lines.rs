@@ -160,28 +160,6 @@ fn optically_thin_volume_caustic_is_linear_in_sigma_s() {
     assert_validation_clean(&ctx);
 }
 
-/// Per pixel of a SIZE² frame of `s`: true unless the camera ray's first
-/// hit is a specular surface (CPU BVH). Neither the reference nor the
-/// lines show the medium seen through glass (docs/ARCHITECTURE.md, "What
-/// the ground truth does not cover"; Hu Sect. 5.3), so those pixels are
-/// zeroed in both images.
-fn not_specular_first_mask(s: &Scene) -> Vec<bool> {
-    let tris = s.triangles(0.0);
-    let bvh = Bvh::build(&tris);
-    let gpu = bvh.gpu_triangles(&tris);
-    let mut mask = Vec::with_capacity((SIZE * SIZE) as usize);
-    for py in 0..SIZE {
-        for px in 0..SIZE {
-            let (o, d) = pixel_ray(&s.camera, SIZE, SIZE, px, py);
-            mask.push(bvh.intersect(&gpu, o, d, 0.0, f32::MAX).is_none_or(|h| {
-                let m = gpu[h.triangle as usize].p0[3].to_bits() as usize;
-                s.materials[m].kind == MaterialKind::Diffuse
-            }));
-        }
-    }
-    mask
-}
-
 fn masked(img: &[f32], mask: &[bool]) -> Vec<f32> {
     img.chunks(4)
         .zip(mask)
@@ -207,7 +185,11 @@ struct Bound {
 /// volume_caustics component with `photons` photons (two halves, to report
 /// the reference's own noise).
 fn matches_reference(ctx: &Arc<Context>, label: &str, scene: &Scene, photons: u64, bound: Bound) {
-    let mask = not_specular_first_mask(scene);
+    // Neither the reference nor the lines show the medium seen through
+    // glass (docs/ARCHITECTURE.md, "What the ground truth does not cover";
+    // Hu Sect. 5.3): pixels whose camera ray meets a specular surface first
+    // are zeroed in both images.
+    let mask = first_hit_mask(scene, SIZE, true, |k| k == MaterialKind::Diffuse);
     let mut reference = ReferenceRenderer::new(
         ctx,
         scene.clone(),
@@ -315,30 +297,6 @@ fn smoke_matches_reference() {
     assert_validation_clean(&ctx);
 }
 
-/// Henyey-Greenstein on the CPU (normalised over the sphere).
-fn hg(cos: f64, g: f64) -> f64 {
-    let denom = 1.0 + g * g - 2.0 * g * cos;
-    (1.0 - g * g) / (4.0 * std::f64::consts::PI * denom * denom.sqrt())
-}
-
-/// The light path length of the segment a -> b inside the axis-aligned box.
-fn length_in_box(a: Vec3, b: Vec3, lo: Vec3, hi: Vec3) -> f32 {
-    let d = b - a;
-    let (mut t0, mut t1) = (0.0f32, 1.0f32);
-    for k in 0..3 {
-        if d[k].abs() < 1e-12 {
-            if a[k] < lo[k] || a[k] > hi[k] {
-                return 0.0;
-            }
-            continue;
-        }
-        let (u, v) = ((lo[k] - a[k]) / d[k], (hi[k] - a[k]) / d[k]);
-        t0 = t0.max(u.min(v));
-        t1 = t1.min(u.max(v));
-    }
-    (t1 - t0).max(0.0) * d.length()
-}
-
 /// Sum over the SIZE² image of the single-scattered radiance of the light
 /// rays in `segments`, by the physics the lines stand for, independent of
 /// line rasterisation: a length ds of a light ray of flux Phi sends the
@@ -393,14 +351,20 @@ fn beam_energy(scene: &Scene, segments: &[GpuSegment], gs: &[f64], samples: u32)
                 continue;
             }
             let tau = (-sigma_t
-                * (length_in_box(p1, x, lo, hi) + length_in_box(cam.eye, x, lo, hi)) as f64)
-                .exp();
+                * (length_in_box(p1.as_dvec3(), x.as_dvec3(), lo.as_dvec3(), hi.as_dvec3())
+                    + length_in_box(
+                        cam.eye.as_dvec3(),
+                        x.as_dvec3(),
+                        lo.as_dvec3(),
+                        hi.as_dvec3(),
+                    )))
+            .exp();
             let cos_axis = w.dot(forward) as f64;
             let omega_px = a_px * a_px * cos_axis.powi(3);
             let common =
                 sigma_s * s.flux[0] as f64 * tau * ds as f64 / (t as f64 * t as f64 * omega_px);
             for (sum, &g) in sums.iter_mut().zip(gs) {
-                *sum += common * hg(u.dot(-w) as f64, g);
+                *sum += common * hg_phase(u.dot(-w) as f64, g);
             }
         }
     }

@@ -352,3 +352,53 @@ pub fn render_image_space(
 pub fn second_half(whole: &[f32], half_a: &[f32]) -> Vec<f32> {
     whole.iter().zip(half_a).map(|(t, a)| 2.0 * t - a).collect()
 }
+
+/// Henyey-Greenstein phase on the CPU, normalised over the sphere; `cos`
+/// between the propagation directions before and after scattering
+/// (glsl/common/medium.glsl `hg_phase`).
+pub fn hg_phase(cos: f64, g: f64) -> f64 {
+    let denom = 1.0 + g * g - 2.0 * g * cos;
+    (1.0 - g * g) / (4.0 * std::f64::consts::PI * denom * denom.sqrt())
+}
+
+/// Length of the segment a -> b inside the axis-aligned box [lo, hi].
+pub fn length_in_box(a: glam::DVec3, b: glam::DVec3, lo: glam::DVec3, hi: glam::DVec3) -> f64 {
+    let d = b - a;
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for k in 0..3 {
+        if d[k].abs() < 1e-300 {
+            if a[k] < lo[k] || a[k] > hi[k] {
+                return 0.0;
+            }
+            continue;
+        }
+        let (u, v) = ((lo[k] - a[k]) / d[k], (hi[k] - a[k]) / d[k]);
+        t0 = t0.max(u.min(v));
+        t1 = t1.min(u.max(v));
+    }
+    (t1 - t0).max(0.0) * d.length()
+}
+
+/// Per pixel of a `size`² frame of `s` (row-major): `keep` of the material
+/// kind the camera ray hits first (CPU BVH), or `on_miss` where it hits
+/// nothing.
+pub fn first_hit_mask(
+    s: &Scene,
+    size: u32,
+    on_miss: bool,
+    keep: impl Fn(MaterialKind) -> bool,
+) -> Vec<bool> {
+    let tris = s.triangles(0.0);
+    let bvh = caustics::bvh::Bvh::build(&tris);
+    let gpu = bvh.gpu_triangles(&tris);
+    (0..size * size)
+        .map(|i| {
+            let (o, d) = pixel_ray(&s.camera, size, size, i % size, i / size);
+            bvh.intersect(&gpu, o, d, 0.0, f32::MAX)
+                .map_or(on_miss, |h| {
+                    let m = gpu[h.triangle as usize].p0[3].to_bits() as usize;
+                    keep(s.materials[m].kind)
+                })
+        })
+        .collect()
+}
