@@ -13,7 +13,8 @@ use caustics::techniques::water_photons::denoise::{
     adaptive_vs_fixed, c_scene, DenoiseConfig, DenoiseKind, Denoiser,
 };
 use caustics::vk::{
-    barrier, vk, Access, Buffer, BufferUsage, Context, Image, ImageAccess, ImageDesc, Profiler,
+    barrier, copy_image, vk, Access, Buffer, BufferUsage, Context, Image, ImageAccess, ImageDesc,
+    Profiler,
 };
 use common::{assert_validation_clean, validated_context};
 use glam::Vec3;
@@ -619,39 +620,7 @@ fn real_gbuffer_edges() {
             .frame(|rec| {
                 let ctx = rec.ctx().clone();
                 rec.pass("copy", |cmd| {
-                    barrier(
-                        &ctx,
-                        cmd,
-                        &[
-                            ImageAccess::new(&staged, Access::TransferRead),
-                            ImageAccess::discard(&caustics, Access::TransferWrite),
-                        ],
-                        &[],
-                    );
-                    let layers = vk::ImageSubresourceLayers {
-                        aspect_mask: vk::ImageAspectFlags::COLOR,
-                        mip_level: 0,
-                        base_array_layer: 0,
-                        layer_count: 1,
-                    };
-                    let region = vk::ImageCopy::default()
-                        .src_subresource(layers)
-                        .dst_subresource(layers)
-                        .extent(vk::Extent3D {
-                            width: SIZE,
-                            height: SIZE,
-                            depth: 1,
-                        });
-                    unsafe {
-                        ctx.device.cmd_copy_image(
-                            cmd,
-                            staged.raw,
-                            staged.layout(),
-                            caustics.raw,
-                            caustics.layout(),
-                            &[region],
-                        )
-                    };
+                    copy_image(&ctx, cmd, &staged, &caustics);
                 });
                 denoiser.record(
                     rec,

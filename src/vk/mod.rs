@@ -23,7 +23,7 @@ pub use pipeline::{
 pub use profiler::{FrameRecorder, PassTiming, Profiler, TimingSource};
 pub use resources::{Buffer, BufferUsage, Image, ImageDesc};
 pub use swapchain::{Acquired, Surface, Swapchain};
-pub use sync::{barrier, Access, BufferAccess, ImageAccess};
+pub use sync::{barrier, copy_image, Access, BufferAccess, ImageAccess};
 
 pub use ash::vk;
 

@@ -252,3 +252,41 @@ pub fn barrier(
         .buffer_memory_barriers(&buffer_barriers);
     unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
 }
+
+/// Records a copy of `src`'s first layer over all of `dst` (same extent and
+/// format), with the barrier that orders it after both images' last uses;
+/// `dst`'s old contents are discarded.
+pub fn copy_image(ctx: &Context, cmd: vk::CommandBuffer, src: &Image, dst: &Image) {
+    assert_eq!(
+        (src.extent(), src.desc.format),
+        (dst.extent(), dst.desc.format),
+        "copy_image: images differ in extent or format"
+    );
+    barrier(
+        ctx,
+        cmd,
+        &[
+            ImageAccess::new(src, Access::TransferRead),
+            ImageAccess::discard(dst, Access::TransferWrite),
+        ],
+        &[],
+    );
+    let layers = vk::ImageSubresourceLayers {
+        aspect_mask: src.aspect(),
+        mip_level: 0,
+        base_array_layer: 0,
+        layer_count: 1,
+    };
+    let region = vk::ImageCopy::default()
+        .src_subresource(layers)
+        .dst_subresource(layers)
+        .extent(vk::Extent3D {
+            width: src.desc.width,
+            height: src.desc.height,
+            depth: 1,
+        });
+    unsafe {
+        ctx.device
+            .cmd_copy_image(cmd, src.raw, src.layout(), dst.raw, dst.layout(), &[region])
+    };
+}

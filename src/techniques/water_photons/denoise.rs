@@ -49,8 +49,8 @@ use crate::scene::{Camera, Light, LightKind, Scene};
 use crate::shader_bindings as b;
 use crate::techniques::{ParamSpec, Params};
 use crate::vk::{
-    barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
-    FrameRecorder, Image, ImageAccess, ImageDesc, Profiler, TimingSource,
+    barrier, copy_image, Access, BindingKind, ComputePipeline, Context, DescriptorSet,
+    DescriptorSetLayout, FrameRecorder, Image, ImageAccess, ImageDesc, Profiler, TimingSource,
 };
 use anyhow::{bail, ensure, Context as _};
 use ash::vk;
@@ -434,39 +434,7 @@ pub fn adaptive_vs_fixed(
             let timings = profiler.frame(|rec| {
                 let ctx = rec.ctx().clone();
                 rec.pass("denoise input copy", |cmd| {
-                    barrier(
-                        &ctx,
-                        cmd,
-                        &[
-                            ImageAccess::new(input, Access::TransferRead),
-                            ImageAccess::discard(&work, Access::TransferWrite),
-                        ],
-                        &[],
-                    );
-                    let layers = vk::ImageSubresourceLayers {
-                        aspect_mask: vk::ImageAspectFlags::COLOR,
-                        mip_level: 0,
-                        base_array_layer: 0,
-                        layer_count: 1,
-                    };
-                    let region = vk::ImageCopy::default()
-                        .src_subresource(layers)
-                        .dst_subresource(layers)
-                        .extent(vk::Extent3D {
-                            width: input.desc.width,
-                            height: input.desc.height,
-                            depth: 1,
-                        });
-                    unsafe {
-                        ctx.device.cmd_copy_image(
-                            cmd,
-                            input.raw,
-                            input.layout(),
-                            work.raw,
-                            work.layout(),
-                            &[region],
-                        )
-                    };
+                    copy_image(&ctx, cmd, input, &work);
                 });
                 denoiser.record(
                     rec,
