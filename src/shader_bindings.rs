@@ -178,3 +178,26 @@ pub const WP_RAY_REFRACTED: u32 = 1;
 pub const AIRLIGHT_BINDING_RADIANCE: u32 = 0;
 pub const AIRLIGHT_BINDING_SHADOW_MAP: u32 = 1;
 pub const AIRLIGHT_BINDING_SHADOW_LIGHTS: u32 = 2;
+// Ground truth (src/reference.rs, glsl/reference/), descriptor set 1.
+/// Running sums over passes, COMPONENT_COUNT rgb images.
+pub const REFERENCE_BINDING_TOTAL: u32 = 0;
+/// This pass's radiance estimates, COMPONENT_COUNT rgb images, folded into
+/// the sums (and cleared) at the end of every pass.
+pub const REFERENCE_BINDING_PASS: u32 = 1;
+pub const REFERENCE_BINDING_RADIANCE: u32 = 2;
+/// Per pixel: sum and sum of squares of the pass estimates' luminance.
+pub const REFERENCE_BINDING_MOMENTS: u32 = 3;
+/// One visible point per pixel and pass (progressive photon mapping).
+pub const REFERENCE_BINDING_VISIBLE_POINTS: u32 = 4;
+/// Hash grid over the visible points: bucket heads, then one link per point.
+pub const REFERENCE_BINDING_SURFACE_HEADS: u32 = 5;
+pub const REFERENCE_BINDING_SURFACE_NEXT: u32 = 6;
+/// Photons stored at medium collisions, their hash grid and its links.
+pub const REFERENCE_BINDING_VOLUME_PHOTONS: u32 = 7;
+pub const REFERENCE_BINDING_VOLUME_HEADS: u32 = 8;
+pub const REFERENCE_BINDING_VOLUME_NEXT: u32 = 9;
+/// Counters: [0] volume photons stored this pass (may pass the capacity),
+/// [1] noise sum of the variance of the mean, [2] sum of the mean.
+pub const REFERENCE_BINDING_STATS: u32 = 10;
+/// End of a hash-grid chain.
+pub const REFERENCE_GRID_NONE: u32 = 4294967295;

@@ -1,11 +1,20 @@
 #version 460
-// Ground truth, camera side: light tracing cannot connect a diffuse point to
-// the eye through glass or a mirror (a delta BSDF in between), so pixels whose
-// camera ray meets a specular surface first follow the specular chain from
-// the eye (Fresnel-weighted random choice at dielectrics, absorption inside,
-// medium transmittance along the way) to a diffuse surface and add its
-// direct light there (path L D S+ E, counted in the direct component). One
-// jittered sample per pixel per pass; resolve divides by the passes.
+// Ground truth, camera side (GUIDE §3). A light tracer cannot connect a
+// diffuse point to the eye through glass or a mirror (a delta BSDF sits on
+// the connection), so a pixel whose camera ray meets a specular surface first
+// follows the specular chain from the eye (Fresnel-weighted random choice at
+// dielectrics, absorption inside, medium transmittance, the (n_t/n_i)^2 of
+// radiance at each refraction) to its first diffuse point x, a visible point.
+// There, per pass and pixel:
+//   - direct light by a shadow ray to each light (path L D S+ E, the direct
+//     component), unbiased;
+//   - the visible point is stored in a hash grid; the photon pass that
+//     follows adds every photon landing within r of it on the side the
+//     camera sees, except photons straight from the light (those are the
+//     direct light above): L S+ D S+ E, L D+ D S+ E, L V D S+ E (trace.comp).
+// How the path space splits: a pixel sample whose first hit is diffuse is
+// the light tracer's (its camera connections, trace.comp); one whose first
+// hit is specular is this pass's. So no path is counted twice.
 #include "common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -29,25 +38,21 @@ vec3 direct_light(vec3 x, vec3 n, vec3 albedo, inout uint rng) {
 void main() {
     uvec2 p = gl_GlobalInvocationID.xy;
     if (p.x >= image_width() || p.y >= image_height()) return;
+    uint index = p.y * image_width() + p.x;
     // A stream apart from the photon pass's (same seed, other constant).
-    uint rng = rng_seed(p.y * image_width() + p.x, pc.seed ^ 0x68bc21ebu);
-    vec2 jitter = vec2(rng_next(rng), rng_next(rng));
-    vec2 ndc = (vec2(p) + jitter) / frame.viewport.xy * 2.0 - 1.0;
-    vec4 far = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
-    SpecularState s;
-    s.origin = frame.eye.xyz;
-    s.dir = normalize(far.xyz / far.w - s.origin);
-    s.weight = vec3(1.0);
-    s.inside = false;
-    s.inside_absorption = vec3(0.0);
+    uint rng = rng_seed(index, pc.seed ^ 0x68bc21ebu);
+    SpecularState s = camera_ray(p, rng);
+    VisiblePoint vp;
+    vp.position = vec4(0.0);
+    vp.normal = vec4(0.0);
+    vp.weight = vec4(0.0);
 
-    vec3 result = vec3(0.0);
     for (uint depth = 0u; depth < pc.max_depth; ++depth) {
         Hit hit;
         if (!trace_closest(s.origin, s.dir, 0.0, 1e30, hit)) break;
         Material m = materials[hit_material(hit)];
         bool diffuse = floatBitsToUint(m.color.w) == MATERIAL_DIFFUSE;
-        // The first hit is diffuse: the photon pass already covers this pixel.
+        // The first hit is diffuse: the light tracer covers this sample.
         if (diffuse && depth == 0u) break;
         vec3 x = s.origin + hit.t * s.dir;
         // Every segment's attenuation: absorption inside glass, the medium outside.
@@ -56,13 +61,22 @@ void main() {
         vec3 ng = hit_geometric_normal(hit);
         bool front = dot(s.dir, ng) < 0.0;
         if (diffuse) {
-            result = s.weight * direct_light(x, front ? ng : -ng, m.color.rgb, rng);
+            vec3 seen_side = front ? ng : -ng;
+            add_pass(index, COMPONENT_DIRECT, s.weight * direct_light(x, seen_side, m.color.rgb, rng));
+            vec3 weight = s.weight * m.color.rgb / PI;
+            if (pc.gather != 0u && any(greaterThan(weight, vec3(0.0)))) {
+                vp.position = vec4(x, 1.0);
+                vp.normal = vec4(seen_side, 0.0);
+                vp.weight = vec4(weight, 0.0);
+            }
             break;
         }
-        specular_bounce(s, x, ng, hit_normal(hit), front, m, rng_next(rng));
+        specular_bounce(s, x, ng, hit_normal(hit), front, m, rng_next(rng), true);
     }
-    uint base = (p.y * image_width() + p.x) * 3u;
-    camera_accum[base + 0u] += result.r;
-    camera_accum[base + 1u] += result.g;
-    camera_accum[base + 2u] += result.b;
+    visible_points[index] = vp;
+    if (vp.position.w != 0.0) {
+        // Push onto the bucket's list (heads were cleared to GRID_NONE).
+        uint bucket = grid_bucket(grid_cell(vp.position.xyz, 2.0 * pc.radius), pc.surface_mask);
+        surface_next[index] = atomicExchange(surface_heads[bucket], index);
+    }
 }

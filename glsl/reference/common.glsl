@@ -3,6 +3,8 @@
 #ifndef REFERENCE_COMMON_GLSL
 #define REFERENCE_COMMON_GLSL
 
+#extension GL_EXT_shader_atomic_float : require
+
 #define SCENE_SET 0
 #include "scene.glsl"
 #include "bvh.glsl"
@@ -11,27 +13,80 @@
 #include "lights.glsl"
 #include "medium.glsl"
 
-// Photon contributions, COMPONENT_COUNT images of width*height rgb floats,
-// summed with float atomics; divided by the photon count when resolved.
-layout(set = 1, binding = 0, std430) buffer PhotonAccum { float photon_accum[]; };
-// Camera-side specular chains (eye -> S+ -> D, lit directly), summed per pass.
-layout(set = 1, binding = 1, std430) buffer CameraAccum { float camera_accum[]; };
+// Every estimate of one pass is radiance (W m^-2 sr^-1) added into `pass_accum`
+// (COMPONENT_COUNT images of width*height rgb floats, float atomics); the fold
+// pass adds it to `total_accum` and clears it, so the image after P passes is
+// total / P and the spread of the pass estimates measures the noise.
+layout(set = 1, binding = REFERENCE_BINDING_TOTAL, std430) buffer TotalAccum { float total_accum[]; };
+layout(set = 1, binding = REFERENCE_BINDING_PASS, std430) buffer PassAccum { float pass_accum[]; };
+// Per pixel: sum over passes of the pass estimate's luminance, and of its square.
+layout(set = 1, binding = REFERENCE_BINDING_MOMENTS, std430) buffer Moments { vec2 moments[]; };
+
+// Progressive photon mapping (Knaus & Zwicker 2011): one visible point per
+// pixel and pass, the first diffuse point a camera path reaches through at
+// least one specular bounce (camera.comp), kept in a hash grid of cell side
+// 2 r so that a photon finds every point within r in at most 2x2x2 cells.
+struct VisiblePoint {
+    vec4 position; // w: 1 when the pixel has a visible point this pass
+    vec4 normal;   // the side of the surface the camera path sees
+    vec4 weight;   // camera path weight times the BRDF albedo / pi
+};
+layout(set = 1, binding = REFERENCE_BINDING_VISIBLE_POINTS, std430) buffer VisiblePoints { VisiblePoint visible_points[]; };
+layout(set = 1, binding = REFERENCE_BINDING_SURFACE_HEADS, std430) buffer SurfaceHeads { uint surface_heads[]; };
+layout(set = 1, binding = REFERENCE_BINDING_SURFACE_NEXT, std430) buffer SurfaceNext { uint surface_next[]; };
+
+// Volume photon map: every tentative medium collision of the photon pass,
+// with its flux already weighted by sigma_s / majorant (the same weight its
+// camera connection gets), in a hash grid of cell side 2 r_v.
+struct VolumePhoton {
+    vec4 position; // w: path-type tag (uint bits)
+    vec4 direction;
+    vec4 flux;     // W, divided by the photons emitted this pass
+};
+layout(set = 1, binding = REFERENCE_BINDING_VOLUME_PHOTONS, std430) buffer VolumePhotons { VolumePhoton volume_photons[]; };
+layout(set = 1, binding = REFERENCE_BINDING_VOLUME_HEADS, std430) buffer VolumeHeads { uint volume_heads[]; };
+layout(set = 1, binding = REFERENCE_BINDING_VOLUME_NEXT, std430) buffer VolumeNext { uint volume_next[]; };
+layout(set = 1, binding = REFERENCE_BINDING_STATS, std430) buffer Stats {
+    uint volume_photon_count;
+    float noise_variance_sum;
+    float noise_mean_sum;
+    uint stats_pad;
+};
 
 layout(push_constant) uniform Push {
-    uint seed;            // a different value every dispatch
-    uint max_depth;       // longest path (specular bounces + scattering events)
-    uint diffuse_bounces; // photons continue this many times past diffuse surfaces
-    uint component;       // resolve only: which image (COMPONENT_COUNT = all)
-    float photon_count;   // resolve only: photons emitted so far
-    float camera_passes;  // resolve only: camera-chain passes so far
-    float exposure;       // unused here; keeps one push layout for every shader
-    float pad;
+    uint seed;             // a different value every dispatch
+    uint max_depth;        // longest path (specular bounces + scattering events)
+    uint diffuse_bounces;  // photons continue this many times past diffuse surfaces
+    uint component;        // resolve only: which image (COMPONENT_COUNT = all)
+    float passes;          // resolve and noise: passes so far
+    float pass_photons;    // photons emitted per pass
+    float radius;          // surface gather radius r_i of this pass (m)
+    float volume_radius;   // volume gather radius of this pass (m)
+    uint surface_mask;     // surface hash table size - 1 (a power of two)
+    uint volume_mask;      // volume hash table size - 1
+    uint volume_capacity;  // volume photons stored at most (0: no volume photon map)
+    uint gather;           // 1: progressive photon mapping on (0: light tracer only)
 } pc;
-
-const float RAY_EPS = 1e-4;
 
 uint image_width() { return uint(frame.viewport.x); }
 uint image_height() { return uint(frame.viewport.y); }
+uint image_pixels() { return image_width() * image_height(); }
+
+// Adds the radiance estimate `value` to pixel `index` of this pass's image `component`.
+void add_pass(uint index, uint component, vec3 value) {
+    uint base = (component * image_pixels() + index) * 3u;
+    atomicAdd(pass_accum[base + 0u], value.r);
+    atomicAdd(pass_accum[base + 1u], value.g);
+    atomicAdd(pass_accum[base + 2u], value.b);
+}
+
+// The hash-grid cell of x for cells of side `side`, and its bucket.
+ivec3 grid_cell(vec3 x, float side) { return ivec3(floor(x / side)); }
+uint grid_bucket(ivec3 c, uint mask) {
+    return (uint(c.x) * 73856093u ^ uint(c.y) * 19349663u ^ uint(c.z) * 83492791u) & mask;
+}
+
+const float RAY_EPS = 1e-4;
 
 // Offsets a ray origin off a surface along the side `side_normal` points to,
 // scaled with the magnitude of the position to survive float rounding.
@@ -54,7 +109,12 @@ struct SpecularState {
 // the geometric normal `ng` points to. Smooth shading normals can bend a new
 // direction to the wrong side of the true surface at grazing angles; then the
 // geometric normal is used instead, so the inside/outside state stays right.
-void specular_bounce(inout SpecularState s, vec3 x, vec3 ng, vec3 ns, bool front, Material m, float u) {
+// `carries_radiance`: a camera (importance) path carries radiance, which
+// crossing an interface from index n_i to n_t scales by (n_t/n_i)^2 in the
+// light's direction of travel (radiance / n^2 is invariant): a camera ray
+// entering water from the air sees L_water / n^2. Photons carry flux, which
+// no such factor touches.
+void specular_bounce(inout SpecularState s, vec3 x, vec3 ng, vec3 ns, bool front, Material m, float u, bool carries_radiance) {
     vec3 ng_in = front ? ng : -ng;                   // facing the arriving ray
     vec3 ns_in = dot(ns, ng_in) > 0.0 ? ns : -ns;
     uint kind = floatBitsToUint(m.color.w);
@@ -77,6 +137,9 @@ void specular_bounce(inout SpecularState s, vec3 x, vec3 ng, vec3 ns, bool front
         refracts = refract_dir(s.dir, n, eta, refracted);
     }
     if (refracts) {
+        // eta = n(side the ray comes from) / n(side it enters); the light
+        // travels the other way, from index 1/eta-side to the ray's side.
+        if (carries_radiance) s.weight *= eta * eta;
         s.dir = refracted;
         s.origin = offset_origin(x, -ng_in);
         s.inside = front;
@@ -86,6 +149,20 @@ void specular_bounce(inout SpecularState s, vec3 x, vec3 ng, vec3 ns, bool front
         s.dir = dot(r, ng_in) > 0.0 ? r : reflect(s.dir, ng_in);
         s.origin = offset_origin(x, ng_in);
     }
+}
+
+// A camera ray through a uniformly jittered point of pixel p (weight 1).
+SpecularState camera_ray(uvec2 p, inout uint rng) {
+    vec2 jitter = vec2(rng_next(rng), rng_next(rng));
+    vec2 ndc = (vec2(p) + jitter) / frame.viewport.xy * 2.0 - 1.0;
+    vec4 far = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
+    SpecularState s;
+    s.origin = frame.eye.xyz;
+    s.dir = normalize(far.xyz / far.w - s.origin);
+    s.weight = vec3(1.0);
+    s.inside = false;
+    s.inside_absorption = vec3(0.0);
+    return s;
 }
 
 #endif

@@ -13,19 +13,14 @@
 // medium event, d = |x - eye|, theta_c the angle to the optical axis and
 // A_pix the pixel's area on the image plane at unit distance; that is the
 // change of variables from image-plane area to surface area (or volume).
-#extension GL_EXT_shader_atomic_float : require
 #include "common.glsl"
 
 layout(local_size_x = 64) in;
 
-// Adds `contribution` (already divided by nothing but the photon count, which
-// the resolve pass applies) to pixel `pixel` of image `component`.
+// Adds a photon's contribution to pixel `pixel` of this pass's image
+// `component`, divided by the photons emitted this pass.
 void splat(ivec2 pixel, uint component, vec3 value) {
-    uint w = image_width(), h = image_height();
-    uint base = ((component * h + uint(pixel.y)) * w + uint(pixel.x)) * 3u;
-    atomicAdd(photon_accum[base + 0u], value.r);
-    atomicAdd(photon_accum[base + 1u], value.g);
-    atomicAdd(photon_accum[base + 2u], value.b);
+    add_pass(uint(pixel.y) * image_width() + uint(pixel.x), component, value / pc.pass_photons);
 }
 
 // Projects x into the image; returns false when it falls outside or behind.
@@ -133,6 +128,54 @@ void connect_medium(vec3 x, vec3 d, vec3 weight_sigma_s, float g, uint tag, inou
     splat(pixel, tag, weight_sigma_s * hg_phase(dot(d, to_eye), g) * measurement * tr);
 }
 
+// Progressive photon mapping, surface (Knaus & Zwicker 2011, Eq. 9 with the
+// disk kernel): a photon of flux Phi landing at x adds to every visible
+// point v within r of it, on the side of the surface v's camera path sees,
+//     L_v += W_v (albedo/pi) Phi / (pi r_i^2 N_i)
+// (W_v (albedo/pi) is stored in the point, N_i is the photons of pass i). The
+// average over passes converges as r_i shrinks (reference.rs: radius rule).
+// Normals more than 60 degrees apart mean another surface (a corner): those
+// points are skipped, which changes nothing in the limit r -> 0.
+void gather_surface(vec3 x, vec3 arrival_side, vec3 flux, uint tag) {
+    float r = pc.radius;
+    float side = 2.0 * r;
+    ivec3 lo = grid_cell(x - vec3(r), side);
+    ivec3 hi = grid_cell(x + vec3(r), side);
+    vec3 scale = flux / (PI * r * r * pc.pass_photons);
+    for (int cz = lo.z; cz <= hi.z; ++cz)
+    for (int cy = lo.y; cy <= hi.y; ++cy)
+    for (int cx = lo.x; cx <= hi.x; ++cx) {
+        ivec3 c = ivec3(cx, cy, cz);
+        uint i = surface_heads[grid_bucket(c, pc.surface_mask)];
+        // A chain holds at most every pixel once; the bound guards the loop.
+        for (uint guard = 0u; i != REFERENCE_GRID_NONE && guard < image_pixels(); ++guard) {
+            VisiblePoint vp = visible_points[i];
+            // Other cells share this bucket: count each point in its own cell only.
+            if (grid_cell(vp.position.xyz, side) == c) {
+                vec3 d = vp.position.xyz - x;
+                if (dot(d, d) < r * r && dot(vp.normal.xyz, arrival_side) > 0.5) {
+                    add_pass(i, tag, scale * vp.weight.rgb);
+                }
+            }
+            i = surface_next[i];
+        }
+    }
+}
+
+// Stores a medium collision in the volume photon map (camera_volume.comp
+// gathers it along camera paths seen through specular chains).
+void store_volume_photon(vec3 x, vec3 d, vec3 flux, uint tag) {
+    uint index = atomicAdd(volume_photon_count, 1u);
+    if (index >= pc.volume_capacity) return; // counted: the host reports the overflow
+    VolumePhoton photon;
+    photon.position = vec4(x, uintBitsToFloat(tag));
+    photon.direction = vec4(d, 0.0);
+    photon.flux = vec4(flux / pc.pass_photons, 0.0);
+    volume_photons[index] = photon;
+    uint bucket = grid_bucket(grid_cell(x, 2.0 * pc.volume_radius), pc.volume_mask);
+    volume_next[index] = atomicExchange(volume_heads[bucket], index);
+}
+
 void main() {
     uint rng = rng_seed(gl_GlobalInvocationID.x, pc.seed);
     if (frame.counts.x == 0u) return;
@@ -173,8 +216,9 @@ void main() {
                     vec3 sigma_n = vec3(majorant) - (medium.sigma_s.rgb + medium.sigma_a.rgb) * density;
                     // Every tentative collision connects: E[sum] = integral of T sigma_s along the ray.
                     if (any(greaterThan(sigma_s, vec3(0.0)))) {
-                        connect_medium(x, s.dir, s.weight * sigma_s / majorant, g,
-                                       tag_for(specular, scattered_or_bounced, true), rng);
+                        uint tag = tag_for(specular, scattered_or_bounced, true);
+                        connect_medium(x, s.dir, s.weight * sigma_s / majorant, g, tag, rng);
+                        if (pc.volume_capacity != 0u) store_volume_photon(x, s.dir, s.weight * sigma_s / majorant, tag);
                     }
                     float p_scatter = (sigma_s.r + sigma_s.g + sigma_s.b) / (3.0 * majorant);
                     float p_null = max(sigma_n.r + sigma_n.g + sigma_n.b, 0.0) / (3.0 * majorant);
@@ -205,7 +249,13 @@ void main() {
         Material m = materials[hit_material(hit)];
         if (floatBitsToUint(m.color.w) == MATERIAL_DIFFUSE) {
             vec3 ng_in = front ? ng : -ng; // the side the photon arrives on
-            connect_surface(x, ng_in, s.weight, m.color.rgb, tag_for(specular, scattered_or_bounced, false), rng);
+            uint tag = tag_for(specular, scattered_or_bounced, false);
+            connect_surface(x, ng_in, s.weight, m.color.rgb, tag, rng);
+            // A photon straight from the light is the visible points' direct
+            // light (camera.comp samples it): every other one is gathered.
+            if (pc.gather != 0u && (specular > 0u || scattered_or_bounced)) {
+                gather_surface(x, ng_in, s.weight, tag);
+            }
             if (diffuse_left == 0u) return;
             diffuse_left -= 1u;
             float survive = clamp(luminance(m.color.rgb), 0.05, 1.0);
@@ -215,7 +265,7 @@ void main() {
             s.origin = offset_origin(x, ng_in);
             scattered_or_bounced = true;
         } else {
-            specular_bounce(s, x, ng, hit_normal(hit), front, m, rng_next(rng));
+            specular_bounce(s, x, ng, hit_normal(hit), front, m, rng_next(rng), false);
             specular += 1u;
         }
         if (luminance(s.weight) <= 0.0) return;

@@ -1,0 +1,94 @@
+#version 460
+// Ground truth, camera side in the medium: in-scattered light seen through a
+// specular chain (fog behind glass, a volume caustic in a mirror: L V S+ E,
+// L S+ V S+ E). The light tracer connects medium collisions to the eye only
+// along the camera ray's first segment (no delta surface in between), so
+// this pass covers every later segment of a camera path, after at least one
+// specular bounce, by ray-marched visible points in the medium gathering the
+// volume photon map of this pass (progressive photon mapping with the
+// volume kernel, Knaus & Zwicker 2011 Sect. 5 / Jensen & Christensen 1998):
+//     L = W sum_k dt T(eye, y_k) sum_p Phi_p p(theta_p) / ((4/3) pi r_v^3 N_i)
+// over steps y_k of length dt = r_v from a jittered start (an unbiased
+// quadrature of the segment integral), Phi_p the photon flux already
+// weighted by sigma_s / majorant at its tentative collision (the collision
+// density times that weight is sigma_s times the fluence), p the HG phase.
+// The camera path is sampled afresh (its own jitter and Fresnel choices): it
+// is another unbiased sample of the same chain distribution as camera.comp.
+#include "common.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+// The volume photons within r_v of y, weighted by the phase toward the eye
+// (the camera ray travels along `dir`, so the light leaves y along -dir).
+void gather_volume(uint index, vec3 y, vec3 dir, vec3 weight) {
+    float r = pc.volume_radius;
+    float side = 2.0 * r;
+    ivec3 lo = grid_cell(y - vec3(r), side);
+    ivec3 hi = grid_cell(y + vec3(r), side);
+    float g = medium.sigma_s.w;
+    float kernel = 1.0 / (4.0 / 3.0 * PI * r * r * r);
+    uint stored = min(volume_photon_count, pc.volume_capacity);
+    vec3 sums[COMPONENT_COUNT];
+    for (uint c = 0u; c < COMPONENT_COUNT; ++c) sums[c] = vec3(0.0);
+    for (int cz = lo.z; cz <= hi.z; ++cz)
+    for (int cy = lo.y; cy <= hi.y; ++cy)
+    for (int cx = lo.x; cx <= hi.x; ++cx) {
+        ivec3 c = ivec3(cx, cy, cz);
+        uint i = volume_heads[grid_bucket(c, pc.volume_mask)];
+        for (uint guard = 0u; i != REFERENCE_GRID_NONE && guard < stored; ++guard) {
+            VolumePhoton photon = volume_photons[i];
+            if (grid_cell(photon.position.xyz, side) == c) {
+                vec3 d = photon.position.xyz - y;
+                if (dot(d, d) < r * r) {
+                    uint tag = floatBitsToUint(photon.position.w);
+                    sums[tag] += photon.flux.rgb * hg_phase(dot(photon.direction.xyz, -dir), g);
+                }
+            }
+            i = volume_next[i];
+        }
+    }
+    for (uint c = 0u; c < COMPONENT_COUNT; ++c) {
+        if (any(greaterThan(sums[c], vec3(0.0)))) add_pass(index, c, weight * kernel * sums[c]);
+    }
+}
+
+void main() {
+    uvec2 p = gl_GlobalInvocationID.xy;
+    if (p.x >= image_width() || p.y >= image_height()) return;
+    uint index = p.y * image_width() + p.x;
+    uint rng = rng_seed(index, pc.seed ^ 0x2c1b3c6du);
+    SpecularState s = camera_ray(p, rng);
+    float step_length = pc.volume_radius;
+
+    for (uint depth = 0u; depth < pc.max_depth; ++depth) {
+        Hit hit;
+        bool found = trace_closest(s.origin, s.dir, 0.0, 1e30, hit);
+        float t_hit = found ? hit.t : 1e30;
+        if (s.inside) {
+            s.weight *= exp(-s.inside_absorption * t_hit);
+        } else {
+            float t0 = 0.0, t1 = t_hit;
+            bool in_medium = clip_to_medium(s.origin, s.dir, t0, t1);
+            // Segment 0 is the light tracer's (its medium connections).
+            if (depth > 0u && in_medium) {
+                vec3 w = s.weight * medium_transmittance(s.origin, s.dir, t0, rng);
+                float t = t0 + rng_next(rng) * step_length;
+                float previous = t0;
+                for (uint k = 0u; k < 4096u && t < t1; ++k) {
+                    w *= medium_transmittance(s.origin + previous * s.dir, s.dir, t - previous, rng);
+                    gather_volume(index, s.origin + t * s.dir, s.dir, w * step_length);
+                    previous = t;
+                    t += step_length;
+                }
+            }
+            s.weight *= medium_transmittance(s.origin, s.dir, t_hit, rng);
+        }
+        if (!found) break;
+        Material m = materials[hit_material(hit)];
+        if (floatBitsToUint(m.color.w) == MATERIAL_DIFFUSE) break;
+        vec3 x = s.origin + hit.t * s.dir;
+        vec3 ng = hit_geometric_normal(hit);
+        specular_bounce(s, x, ng, hit_normal(hit), dot(s.dir, ng) < 0.0, m, rng_next(rng), true);
+        if (luminance(s.weight) <= 0.0) break;
+    }
+}
