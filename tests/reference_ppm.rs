@@ -318,3 +318,96 @@ fn photon_mapping_leaves_directly_seen_pixels_unchanged() {
     );
     assert_validation_clean(&ctx);
 }
+
+/// The medium seen in a mirror (the volume gather along camera chains):
+/// a fog box lit by a point light, seen in a mirror, equals R times the
+/// same fog seen directly from the mirror image of the camera with the
+/// light's mirror image (intensity R I) added. Light reflected into the fog
+/// by the mirror (L S V S E, volume caustics) and light straight from the
+/// lamp (L V S E, airlight) seen in the mirror are both checked:
+/// A.airlight + A.volume_caustics = R · B.airlight over the mirror pixels.
+/// Measured: 0.6% at 24 passes.
+#[test]
+fn fog_seen_in_a_mirror_matches_the_mirrored_view() {
+    let ctx = validated_context();
+    let size = 48;
+    let (intensity, reflectance) = (10.0f32, 0.8f32);
+    let light = Vec3::new(0.0, 1.5, 1.0);
+    let fog = caustics::scene::Medium {
+        sigma_s: Vec3::splat(0.4),
+        sigma_a: Vec3::splat(0.1),
+        g: 0.3,
+        bounds_min: Vec3::new(-1.5, 0.0, 0.05),
+        bounds_max: Vec3::new(1.5, 0.8, 3.0),
+        density: caustics::scene::Density::Constant(1.0),
+    };
+    let target = Vec3::new(0.0, 1.0, 0.0);
+    let cam_a = camera(Vec3::new(0.0, 3.5, 3.0), target, 30.0);
+    let mut a = scene(
+        cam_a,
+        vec![point_light(light, intensity)],
+        vec![diffuse("black", 0.0), mirror("mirror", reflectance)],
+        vec![
+            object("floor", floor_mesh(20.0, 0.0, 0)),
+            object(
+                "mirror",
+                quad(
+                    Vec3::new(-10.0, 0.0, 0.0),
+                    Vec3::new(10.0, 0.0, 0.0),
+                    Vec3::new(10.0, 10.0, 0.0),
+                    Vec3::new(-10.0, 10.0, 0.0),
+                    1,
+                ),
+            ),
+        ],
+    );
+    a.medium = Some(fog.clone());
+    // B: no mirror; the camera and the light mirrored through z = 0. The
+    // mirrored camera sees the world flipped left-right; the scene is
+    // symmetric in x, so its image is the same.
+    let mirrored = |v: Vec3| Vec3::new(v.x, v.y, -v.z);
+    let mut b = scene(
+        camera(mirrored(cam_a.eye), target, 30.0),
+        vec![
+            point_light(light, intensity),
+            point_light(mirrored(light), intensity * reflectance),
+        ],
+        vec![diffuse("black", 0.0)],
+        vec![object("floor", floor_mesh(20.0, 0.0, 0))],
+    );
+    b.medium = Some(fog);
+    let passes = 24;
+    let run = |s: Scene, components: &[Component]| {
+        let mut r = ReferenceRenderer::new(&ctx, s, size, size, 0.0, settings(1 << 17, 6)).unwrap();
+        r.trace(passes << 17, |_, _| {}).unwrap();
+        let images: Vec<Vec<f32>> = components.iter().map(|c| r.resolve(*c).unwrap()).collect();
+        images
+    };
+    // Pixels that see the mirror above the fog: their path to the mirror
+    // crosses no medium, so all the fog they show is seen in the mirror.
+    let mut mask = first_hit_mask(&a, size, false, |k| k == MaterialKind::Mirror);
+    for (i, m) in mask.iter_mut().enumerate() {
+        let (o, d) = pixel_ray(&cam_a, size, size, i as u32 % size, i as u32 / size);
+        *m = *m && o.y + d.y * (-o.z / d.z) > 0.85;
+    }
+    let ia = run(a, &[Component::Airlight, Component::VolumeCaustics]);
+    let ib = run(b, &[Component::Airlight]);
+    let (mut in_mirror, mut direct, mut caustic) = (0.0f64, 0.0f64, 0.0f64);
+    for (i, _) in mask.iter().enumerate().filter(|(_, m)| **m) {
+        in_mirror += (ia[0][i * 4] + ia[1][i * 4]) as f64;
+        caustic += ia[1][i * 4] as f64;
+        direct += (reflectance * ib[0][i * 4]) as f64;
+    }
+    let rel = (in_mirror - direct) / direct;
+    eprintln!(
+        "fog in the mirror: {} pixels, measured/expected - 1 = {rel:.4} (volume caustics {:.1}% of it)",
+        mask.iter().filter(|m| **m).count(),
+        100.0 * caustic / in_mirror
+    );
+    assert!(
+        caustic > 0.1 * in_mirror,
+        "the mirror must light the fog too"
+    );
+    assert!(rel.abs() < 0.03, "fog seen in the mirror off by {rel}");
+    assert_validation_clean(&ctx);
+}
