@@ -88,6 +88,11 @@ enum Command {
         /// footprints at the camera target's distance); it shrinks every pass.
         #[arg(long)]
         radius: Option<f32>,
+        /// The light tracer and the camera chains' direct light only: what is
+        /// seen through glass, water or mirrors lacks its caustics (for
+        /// measuring what photon mapping costs).
+        #[arg(long)]
+        no_photon_mapping: bool,
         /// Path-type component to write: direct, surface_caustics, airlight, volume_caustics, other, all.
         #[arg(long, default_value = "all")]
         component: String,
@@ -433,6 +438,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             seconds,
             seed,
             radius,
+            no_photon_mapping,
             component,
             diffuse_bounces,
             out,
@@ -461,6 +467,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 diffuse_bounces,
                 seed,
                 radius,
+                photon_mapping: !no_photon_mapping,
                 ..Default::default()
             };
             let mut reference = ReferenceRenderer::new(
@@ -594,8 +601,11 @@ fn trace_reference(
         let noise = reference.noise()?;
         let noise = noise.map_or("-".to_string(), |n| format!("{:.2}%", n * 100.0));
         let message = format!(
-            "pass {} r {:.4} m, noise {}",
-            reference.reference.passes, report.radius, noise
+            "pass {} at {:.1} s, r {:.4} m, noise {}",
+            reference.reference.passes,
+            start.elapsed().as_secs_f64(),
+            report.radius,
+            noise
         );
         match seconds {
             Some(s) => {
