@@ -2,10 +2,11 @@
 
 use anyhow::Context as _;
 use caustics::output;
+use caustics::params::Params;
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use caustics::renderer::Renderer;
 use caustics::scene::{Scene, DEFAULT_SCENE};
-use caustics::techniques::{self, Params};
+use caustics::techniques;
 use caustics::vk::{Context, ContextOptions, PassTiming};
 use clap::{Args, Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -31,6 +32,9 @@ struct DeviceArgs {
     /// Turn on the Khronos validation layer (default in debug builds); any validation error makes the command fail.
     #[arg(long)]
     validate: bool,
+    /// Also turn on the validation layer's synchronization validation (hazards between commands are errors); implies --validate; default in debug builds.
+    #[arg(long)]
+    validate_sync: bool,
 }
 
 #[derive(Args, Clone)]
@@ -177,7 +181,8 @@ fn describe(e: &anyhow::Error) -> String {
 
 fn context(args: &DeviceArgs) -> anyhow::Result<Arc<Context>> {
     let options = ContextOptions {
-        validation: args.validate || cfg!(debug_assertions),
+        validation: args.validate || args.validate_sync || cfg!(debug_assertions),
+        sync_validation: args.validate_sync || cfg!(debug_assertions),
         device: args.device.clone(),
     };
     let ctx = Context::new(&options)?;
@@ -340,6 +345,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 exit,
                 resize_test,
                 validate: device.validate,
+                validate_sync: device.validate_sync,
                 device: device.device,
             })
         }

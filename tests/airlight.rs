@@ -23,13 +23,14 @@
 
 mod common;
 
+use caustics::frame::{FrameTargets, SceneGpu};
+use caustics::params::{ParamSpec, Params};
 use caustics::passes::airlight::{self, Airlight};
 use caustics::radiometry::spot_falloff;
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
-use caustics::renderer::{FrameTargets, SceneGpu};
 use caustics::scene::{Density, LightKind, Medium, Scene};
 use caustics::techniques::direct::{self, Direct};
-use caustics::techniques::{ParamSpec, Params, Technique};
+use caustics::techniques::Technique;
 use caustics::vk::{Context, Profiler};
 use common::*;
 use glam::{DVec3, Vec3};

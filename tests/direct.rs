@@ -16,12 +16,14 @@
 //! - with the bias switched off, lit pixels are off by up to 78% (acne), so
 //!   these tests do see acne.
 
+use caustics::frame::camera_matrices;
+use caustics::params::Params;
 use caustics::radiometry::spot_falloff;
-use caustics::renderer::{camera_matrices, Renderer};
+use caustics::renderer::Renderer;
 use caustics::scene::{
     Camera, Light, LightKind, Material, MaterialKind, Mesh, Object, Output, Scene,
 };
-use caustics::techniques::{self, Params};
+use caustics::techniques;
 use caustics::vk::{Context, ContextOptions};
 use glam::{DVec3, DVec4, Mat4, Vec3};
 use std::f64::consts::PI;
@@ -140,6 +142,7 @@ fn render_with(scene: Scene, overrides: &[&str]) -> (Arc<Context>, Vec<f32>) {
     let _ = env_logger::builder().is_test(true).try_init();
     let ctx = Context::new(&ContextOptions {
         validation: true,
+        sync_validation: true,
         device: None,
     })
     .expect("Vulkan context (lavapipe)");

@@ -51,10 +51,11 @@
 
 mod common;
 
+use caustics::params::Params;
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use caustics::renderer::Renderer;
 use caustics::scene::Scene;
-use caustics::techniques::{self, Params};
+use caustics::techniques;
 use common::*;
 use std::path::Path;
 

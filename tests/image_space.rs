@@ -108,12 +108,12 @@
 
 mod common;
 
+use caustics::params::Params;
 use caustics::passes::caustic_map::GpuPhoton;
 use caustics::radiometry::fresnel_dielectric;
 use caustics::scene::{Light, LightKind, Scene};
 use caustics::shader_bindings as b;
 use caustics::techniques::image_space::PARAMS;
-use caustics::techniques::Params;
 use caustics::vk::Context;
 use common::*;
 use glam::{DVec3, Vec3};

@@ -22,10 +22,11 @@
 
 mod common;
 
+use caustics::params::Params;
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use caustics::renderer::Renderer;
 use caustics::scene::{Density, Medium, Scene};
-use caustics::techniques::{self, Params};
+use caustics::techniques;
 use common::*;
 use glam::Vec3;
 use std::path::Path;

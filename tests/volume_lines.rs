@@ -48,12 +48,13 @@
 mod common;
 
 use caustics::bvh::Bvh;
+use caustics::frame::{FrameTargets, SceneGpu};
+use caustics::params::Params;
 use caustics::passes::caustic_map::{photon_view, specular_bounds};
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
-use caustics::renderer::{FrameTargets, SceneGpu};
 use caustics::scene::{MaterialKind, Scene};
 use caustics::techniques::volume_lines::{GpuSegment, VolumeLines, PARAMS};
-use caustics::techniques::{Params, Technique};
+use caustics::techniques::Technique;
 use caustics::vk::Context;
 use common::*;
 use glam::Vec3;
@@ -319,7 +320,7 @@ fn beam_energy(scene: &Scene, segments: &[GpuSegment], gs: &[f64], samples: u32)
     let bvh = Bvh::build(&tris);
     let gpu = bvh.gpu_triangles(&tris);
     let cam = &scene.camera;
-    let (view, proj) = caustics::renderer::camera_matrices(cam, 1.0);
+    let (view, proj) = caustics::frame::camera_matrices(cam, 1.0);
     let view_proj = proj * view;
     let forward = (cam.target - cam.eye).normalize();
     let a_px = 2.0 * (cam.fov_y_deg.to_radians() * 0.5).tan() as f64 / SIZE as f64;

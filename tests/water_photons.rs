@@ -27,14 +27,15 @@
 mod common;
 
 use caustics::cascades::CascadeLayout;
+use caustics::frame::{FrameTargets, SceneGpu};
 use caustics::gpu::GpuTriangle;
-use caustics::renderer::{FrameTargets, SceneGpu};
+use caustics::params::Params;
 use caustics::scene::{MaterialKind, Scene, Water, Wave};
 use caustics::shader_bindings as b;
 use caustics::techniques::water_photons::{
     GpuWaterPhoton, WaterPhotons, GUARD_PHOTONS, GUARD_WORD, PARAMS,
 };
-use caustics::techniques::{Params, Technique};
+use caustics::techniques::Technique;
 use caustics::vk::{
     BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
     Profiler,
@@ -485,7 +486,7 @@ fn masked_energy(img: &[f32], mask: &[bool]) -> f64 {
 /// The surface-caustics component of one frame, with the trace + splat
 /// milliseconds and the denoise milliseconds of the second (timed) frame.
 fn caustic_frame(ctx: &Arc<Context>, s: Scene, overrides: &[&str]) -> (Vec<f32>, f64, f64) {
-    use caustics::reference::Component;
+    use caustics::radiometry::Component;
     use caustics::renderer::Renderer;
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let params = Params::resolve("water_photons", PARAMS, &overrides).unwrap();
@@ -969,7 +970,7 @@ fn splats_conserve_the_flux_of_a_focusing_crest() {
 /// dark (the water's shadow).
 #[test]
 fn ior_one_water_gives_back_the_direct_frame() {
-    use caustics::reference::Component;
+    use caustics::radiometry::Component;
     use caustics::renderer::Renderer;
     let ctx = validated_context();
     let light = Vec3::new(0.3, -1.0, 0.2).normalize();
@@ -1140,7 +1141,7 @@ fn a_one_frame_render_reports_overflow() {
 /// energy there).
 #[test]
 fn ocean_large_renders_with_caustics_on_the_seabed() {
-    use caustics::reference::Component;
+    use caustics::radiometry::Component;
     use caustics::renderer::Renderer;
     const PX: u32 = 96;
     let ctx = validated_context();

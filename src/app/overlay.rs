@@ -10,8 +10,8 @@
 //! once per submitted frame, so a buffer is rewritten only after the fence
 //! of the frame that last read it has been waited for.
 
-use crate::reference::Component;
-use crate::techniques::Params;
+use crate::params::Params;
+use crate::radiometry::Component;
 use crate::vk::{Context, PassTiming};
 use ash::vk;
 use std::sync::Arc;

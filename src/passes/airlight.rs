@@ -25,11 +25,11 @@
 //! [`PARAMS`] (and `direct::MEDIUM_STEPS`) into its parameter list, and
 //! records it after the pass that writes the frame's radiance.
 
+use crate::frame::SceneGpu;
+use crate::params::{ParamSpec, Params};
 use crate::passes::shadow::ShadowMaps;
-use crate::renderer::SceneGpu;
 use crate::scene::Scene;
 use crate::shader_bindings as b;
-use crate::techniques::{ParamSpec, Params};
 use crate::vk::{
     barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
     FrameRecorder, Image, ImageAccess, Sampler, VkResult,

@@ -1,46 +1,13 @@
-//! Frame orchestration: scene upload, technique selection, tonemapping,
-//! profiling and output. `render` and `bench` run frames through here.
+//! Frame orchestration: technique selection, tonemapping, profiling and
+//! output, over the scene and targets of `crate::frame`. `render` and `bench` run frames through here.
 
-mod scene_gpu;
-
-pub use scene_gpu::{camera_matrices, GeometryStats, SceneGpu};
-
+use crate::frame::{FrameTargets, SceneGpu};
+use crate::params::Params;
 use crate::passes::tonemap::Tonemap;
 use crate::scene::Scene;
-use crate::techniques::{self, Params, Technique};
-use crate::vk::{Context, Image, ImageDesc, PassTiming, Profiler, VkResult};
-use ash::vk;
+use crate::techniques::{self, Technique};
+use crate::vk::{Context, PassTiming, Profiler, VkResult};
 use std::sync::Arc;
-
-/// The images a technique renders into.
-pub struct FrameTargets {
-    /// Linear radiance, W m^-2 sr^-1 per channel (RGBA32F: storage, sampled, colour attachment).
-    pub radiance: Image,
-    pub width: u32,
-    pub height: u32,
-}
-
-impl FrameTargets {
-    pub fn new(ctx: &Arc<Context>, width: u32, height: u32) -> VkResult<Self> {
-        let radiance = Image::new(
-            ctx,
-            "radiance",
-            ImageDesc::new_2d(
-                width,
-                height,
-                vk::Format::R32G32B32A32_SFLOAT,
-                vk::ImageUsageFlags::STORAGE
-                    | vk::ImageUsageFlags::SAMPLED
-                    | vk::ImageUsageFlags::COLOR_ATTACHMENT,
-            ),
-        )?;
-        Ok(Self {
-            radiance,
-            width,
-            height,
-        })
-    }
-}
 
 pub struct Renderer {
     pub ctx: Arc<Context>,

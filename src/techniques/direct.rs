@@ -21,10 +21,11 @@
 //! midpoint rule with `medium_steps` steps for noise and grid densities
 //! (Hu Sect. 5.4). Without a medium the factors are exactly 1.
 
-use super::{ParamSpec, Params, Technique};
+use super::Technique;
+use crate::frame::{FrameTargets, SceneGpu};
+use crate::params::{ParamSpec, Params};
 use crate::passes::gbuffer::{GBuffer, GBufferContents};
 use crate::passes::shadow::ShadowMaps;
-use crate::renderer::{FrameTargets, SceneGpu};
 use crate::scene::Scene;
 use crate::shader_bindings as b;
 use crate::vk::{

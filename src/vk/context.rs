@@ -16,6 +16,13 @@ const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 pub struct ContextOptions {
     /// Turn on the Khronos validation layer and count its messages.
     pub validation: bool,
+    /// With `validation`, also turn on the layer's synchronization
+    /// validation (`VK_EXT_validation_features`,
+    /// `SYNCHRONIZATION_VALIDATION`): missing or wrong barriers between
+    /// commands are reported as errors (SYNC-HAZARD-*). Enabled only where
+    /// the layer exposes the extension; `Context::sync_validation` says
+    /// whether it is on.
+    pub sync_validation: bool,
     /// Pick a device by index (as `caustics info` lists) or by a substring of its name.
     pub device: Option<String>,
 }
@@ -112,6 +119,9 @@ pub struct Context {
     /// Valid bits of a timestamp on the queue (for wrapping subtraction).
     pub timestamp_valid_bits: u32,
     pub limits: vk::PhysicalDeviceLimits,
+    /// Synchronization validation is on (`ContextOptions::sync_validation`
+    /// asked for it and the layer offers it).
+    pub sync_validation: bool,
     allocator: ManuallyDrop<Mutex<Allocator>>,
     debug_instance: Option<ash::ext::debug_utils::Instance>,
     debug_device: Option<ash::ext::debug_utils::Device>,
@@ -229,18 +239,30 @@ fn load_entry() -> VkResult<ash::Entry> {
     unsafe { ash::Entry::load() }.map_err(|e| VkError::Loader(e.to_string()))
 }
 
+/// The validation features an instance is created with.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Validation {
+    Off,
+    On,
+    /// On, with synchronization validation.
+    Sync,
+}
+
+/// Creates the instance; returns it and whether synchronization validation
+/// is on (asked for and offered by the layer).
 fn create_instance(
     entry: &ash::Entry,
-    validation: bool,
+    validation: Validation,
     extra_extensions: &[*const std::ffi::c_char],
-) -> VkResult<ash::Instance> {
+) -> VkResult<(ash::Instance, bool)> {
     let app = vk::ApplicationInfo::default()
         .application_name(c"caustics")
         .engine_name(c"caustics")
         .api_version(vk::API_VERSION_1_3);
     let mut extensions: Vec<*const std::ffi::c_char> = extra_extensions.to_vec();
     let mut layers = Vec::new();
-    if validation {
+    let mut sync_validation = false;
+    if validation != Validation::Off {
         let available = unsafe { entry.enumerate_instance_layer_properties() }?;
         if !available
             .iter()
@@ -249,6 +271,23 @@ fn create_instance(
             return Err(VkError::NoValidationLayer);
         }
         layers.push(VALIDATION_LAYER.as_ptr());
+        if validation == Validation::Sync {
+            // The layer itself provides VK_EXT_validation_features.
+            sync_validation =
+                unsafe { entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER)) }?
+                    .iter()
+                    .any(|e| {
+                        e.extension_name_as_c_str() == Ok(ash::ext::validation_features::NAME)
+                    });
+            if sync_validation {
+                extensions.push(ash::ext::validation_features::NAME.as_ptr());
+            } else {
+                log::warn!(
+                    "the validation layer does not offer VK_EXT_validation_features: \
+                     synchronization validation stays off"
+                );
+            }
+        }
     }
     let has_debug_utils = unsafe { entry.enumerate_instance_extension_properties(None) }?
         .iter()
@@ -256,17 +295,23 @@ fn create_instance(
     if has_debug_utils {
         extensions.push(ash::ext::debug_utils::NAME.as_ptr());
     }
-    let info = vk::InstanceCreateInfo::default()
+    let enabled = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+    let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled);
+    let mut info = vk::InstanceCreateInfo::default()
         .application_info(&app)
         .enabled_layer_names(&layers)
         .enabled_extension_names(&extensions);
-    Ok(unsafe { entry.create_instance(&info, None) }?)
+    if sync_validation {
+        info = info.push_next(&mut features);
+    }
+    let instance = unsafe { entry.create_instance(&info, None) }?;
+    Ok((instance, sync_validation))
 }
 
 /// Lists every device with the features the renderer needs (`caustics info`).
 pub fn enumerate_devices() -> VkResult<Vec<DeviceInfo>> {
     let entry = load_entry()?;
-    let instance = create_instance(&entry, false, &[])?;
+    let (instance, _) = create_instance(&entry, Validation::Off, &[])?;
     let devices = unsafe { instance.enumerate_physical_devices() }?;
     let infos = devices
         .iter()
@@ -293,7 +338,12 @@ impl Context {
         instance_extensions: &[*const std::ffi::c_char],
     ) -> VkResult<Arc<Context>> {
         let entry = load_entry()?;
-        let instance = create_instance(&entry, options.validation, instance_extensions)?;
+        let validation = match (options.validation, options.sync_validation) {
+            (false, _) => Validation::Off,
+            (true, false) => Validation::On,
+            (true, true) => Validation::Sync,
+        };
+        let (instance, sync_validation) = create_instance(&entry, validation, instance_extensions)?;
         let counters = Box::new(Counters {
             errors: AtomicU32::new(0),
             warnings: AtomicU32::new(0),
@@ -486,6 +536,7 @@ impl Context {
             timestamp_period: props.limits.timestamp_period as f64,
             timestamp_valid_bits,
             limits: props.limits,
+            sync_validation,
             info,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             debug_instance,

@@ -56,10 +56,11 @@ mod refraction;
 pub use refraction::{CameraRefraction, RefractionPush};
 
 use super::direct::{self, Direct};
-use super::{ParamSpec, Params, Technique};
+use super::Technique;
+use crate::frame::{FrameTargets, SceneGpu};
+use crate::params::{ParamSpec, Params};
 use crate::passes::caustic_map::{CausticMap, PhotonPaths};
 use crate::passes::gbuffer::GBufferContents;
-use crate::renderer::{FrameTargets, SceneGpu};
 use crate::scene::Scene;
 use crate::shader_bindings as b;
 use crate::vk::{

@@ -6,9 +6,9 @@
 //! Fresnel-weighted reflection plus the twice-refracted ray, each found in
 //! the opaque frame by an image-space search, into the frame's radiance.
 
+use crate::frame::{FrameTargets, SceneGpu};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::specular_gbuffer::{SpecularGBuffer, Viewpoint};
-use crate::renderer::{FrameTargets, SceneGpu};
 use crate::shader_bindings as b;
 use crate::vk::{
     barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,

@@ -84,11 +84,12 @@
 //! two parts, airlight is A, volume_caustics is B).
 
 use super::image_space::{self, ImageSpace};
-use super::{ParamSpec, Params, Technique};
+use super::Technique;
+use crate::frame::{FrameTargets, SceneGpu};
+use crate::params::{ParamSpec, Params};
 use crate::passes::airlight::{self, Airlight};
 use crate::passes::caustic_map::{photon_view, photon_view_proj, specular_bounds, PhotonViewPush};
 use crate::passes::specular_gbuffer::{SpecularGBuffer, Viewpoint};
-use crate::renderer::{FrameTargets, SceneGpu};
 use crate::scene::{Density, Light, Scene};
 use crate::shader_bindings as b;
 use crate::vk::{

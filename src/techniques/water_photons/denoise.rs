@@ -45,9 +45,9 @@
 //! sparse photon image (an adaptive kernel that gathers wide into dark
 //! pixels and narrow at bright ones adds energy around isolated photons).
 
+use crate::params::{ParamSpec, Params};
 use crate::scene::{Camera, Light, LightKind, Scene};
 use crate::shader_bindings as b;
-use crate::techniques::{ParamSpec, Params};
 use crate::vk::{
     barrier, copy_image, Access, BindingKind, ComputePipeline, Context, DescriptorSet,
     DescriptorSetLayout, FrameRecorder, Image, ImageAccess, ImageDesc, Profiler, TimingSource,

@@ -109,11 +109,12 @@ pub use trace::{GpuWaterPhoton, PhotonCounts, Trace, GUARD_PHOTONS, GUARD_WORD};
 
 use super::direct::{self, Direct};
 use super::image_space::{CameraRefraction, RefractionPush};
-use super::{ParamSpec, Params, Technique};
+use super::Technique;
 use crate::cascades::{inner_cascade_size, light_position, CascadeLayout, LightRange};
+use crate::frame::{FrameTargets, SceneGpu};
 use crate::gpu::GpuFrame;
+use crate::params::{ParamSpec, Params};
 use crate::passes::gbuffer::GBufferContents;
-use crate::renderer::{FrameTargets, SceneGpu};
 use crate::scene::{Light, LightKind, Scene, Water};
 use crate::shader_bindings as b;
 use crate::vk::{Buffer, BufferUsage, Context, FrameRecorder, VkResult};
