@@ -228,7 +228,7 @@ fn checked_technique_run(
     frames: u32,
 ) -> anyhow::Result<(Scene, Params)> {
     let info = techniques::find(technique)?;
-    let params = Params::resolve(technique, info.params, overrides)?;
+    let params = Params::resolve(technique, info.params(), overrides)?;
     check_size(scene)?;
     if frames == 0 {
         anyhow::bail!("--frames must be at least 1");
@@ -296,10 +296,18 @@ fn list_techniques() {
         println!("  {:<14} {}", t.name, t.description);
         let components: Vec<_> = t.components.iter().map(|c| c.name()).collect();
         println!("      --component {}|all", components.join("|"));
-        for p in t.params {
+        for p in t.params() {
             println!(
-                "      --param {}=VALUE  {} [{} .. {}], default {}",
-                p.name, p.description, p.min, p.max, p.default
+                "      --param {}=VALUE  {} [{} .. {}], default {}{}",
+                p.name,
+                p.description,
+                p.min,
+                p.max,
+                p.default,
+                match p.apply {
+                    caustics::params::Apply::Live => " (live)",
+                    caustics::params::Apply::Rebuild => "",
+                }
             );
         }
     }
@@ -324,7 +332,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             device,
         } => {
             let info = techniques::find(&technique)?;
-            let params = Params::resolve(&technique, info.params, &params)?;
+            let params = Params::resolve(&technique, info.params(), &params)?;
             check_size(&SceneArgs {
                 scene: scene.clone(),
                 width,

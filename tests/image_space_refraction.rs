@@ -29,10 +29,10 @@
 
 mod common;
 
-use caustics::params::Params;
+use caustics::params::{ParamSet, Params};
 use caustics::radiometry::fresnel_dielectric;
 use caustics::scene::{Camera, Scene};
-use caustics::techniques::image_space::{ImageSpace, PARAMS};
+use caustics::techniques::image_space::{ImageSpace, ImageSpaceParams};
 use caustics::vk::Context;
 use common::*;
 use glam::Vec3;
@@ -337,7 +337,7 @@ fn bad_refraction_parameters_are_rejected() {
         ("eq_6_3_2=2", "eq_6_3_2"),
         ("search_steps=2", "search_steps"),
     ] {
-        let err = Params::resolve("image_space", PARAMS, &[p.to_string()])
+        let err = Params::resolve("image_space", ImageSpaceParams::specs(), &[p.to_string()])
             .unwrap_err()
             .to_string();
         assert!(err.contains(name), "{p}: {err}");

@@ -25,7 +25,9 @@ fn a_missing_barrier_is_reported() {
     .unwrap();
     let errors = ctx.validation_errors();
     assert!(
-        errors.iter().any(|e| e.contains("SYNC-HAZARD-WRITE-AFTER-WRITE")),
+        errors
+            .iter()
+            .any(|e| e.contains("SYNC-HAZARD-WRITE-AFTER-WRITE")),
         "expected a write-after-write hazard, got: {errors:?}"
     );
 }

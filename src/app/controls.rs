@@ -104,7 +104,7 @@ impl State {
         if info.name == self.renderer.technique_name() {
             return Ok(());
         }
-        let params = Params::resolve(info.name, info.params, &[])?;
+        let params = Params::resolve(info.name, info.params(), &[])?;
         self.ctx().wait_idle();
         self.renderer.set_technique(info.name, &params)?;
         self.renderer.scene_gpu.components = Component::All.mask();

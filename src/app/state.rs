@@ -222,8 +222,15 @@ impl State {
                 }
                 Action::Params(params) => {
                     ctx.wait_idle();
-                    let name = self.renderer.technique_name();
-                    self.renderer.set_technique(name, &params)?;
+                    let start = Instant::now();
+                    let how = match self.renderer.set_params(&params)? {
+                        true => "rebuilt",
+                        false => "live",
+                    };
+                    println!(
+                        "parameters: {how} in {:.1} ms",
+                        start.elapsed().as_secs_f64() * 1e3
+                    );
                 }
             }
         }

@@ -336,11 +336,11 @@ pub fn render_image_space(
     size: u32,
 ) -> ImageSpaceFrame {
     use caustics::frame::{FrameTargets, SceneGpu};
-    use caustics::params::Params;
-    use caustics::techniques::image_space::{ImageSpace, PARAMS};
+    use caustics::params::ParamSet;
+    use caustics::techniques::image_space::{ImageSpace, ImageSpaceParams};
     use caustics::techniques::Technique;
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let params = Params::resolve("image_space", PARAMS, &overrides).unwrap();
+    let params = ImageSpaceParams::parse("image_space", &overrides).unwrap();
     let scene_gpu = SceneGpu::new(ctx, scene, 0.0).unwrap();
     let targets = FrameTargets::new(ctx, size, size).unwrap();
     let mut tech = ImageSpace::new(ctx, &params, scene, &scene_gpu, size, size).unwrap();

@@ -41,6 +41,11 @@ pub struct CameraRefraction {
 }
 
 impl CameraRefraction {
+    /// Linear steps of the image-space search (a push constant: live).
+    pub fn set_search_steps(&mut self, steps: u32) {
+        self.push.search_steps = steps;
+    }
+
     /// `opaque` is the frame of the scene without its specular surfaces and
     /// `opaque_gbuffer` its G-buffer (positions: the depth image searched).
     pub fn new(
