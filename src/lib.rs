@@ -4,8 +4,10 @@
 pub mod app;
 pub mod bvh;
 pub mod cascades;
+pub mod frame;
 pub mod gpu;
 pub mod output;
+pub mod params;
 pub mod passes;
 pub mod radiometry;
 pub mod reference;

@@ -2,10 +2,11 @@
 
 use anyhow::Context as _;
 use caustics::output;
+use caustics::params::Params;
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use caustics::renderer::Renderer;
 use caustics::scene::{Scene, DEFAULT_SCENE};
-use caustics::techniques::{self, Params};
+use caustics::techniques;
 use caustics::vk::{Context, ContextOptions, PassTiming};
 use clap::{Args, Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -31,6 +32,9 @@ struct DeviceArgs {
     /// Turn on the Khronos validation layer (default in debug builds); any validation error makes the command fail.
     #[arg(long)]
     validate: bool,
+    /// Also turn on the validation layer's synchronization validation (hazards between commands are errors); implies --validate; default in debug builds.
+    #[arg(long)]
+    validate_sync: bool,
 }
 
 #[derive(Args, Clone)]
@@ -192,7 +196,8 @@ fn describe(e: &anyhow::Error) -> String {
 
 fn context(args: &DeviceArgs) -> anyhow::Result<Arc<Context>> {
     let options = ContextOptions {
-        validation: args.validate || cfg!(debug_assertions),
+        validation: args.validate || args.validate_sync || cfg!(debug_assertions),
+        sync_validation: args.validate_sync || cfg!(debug_assertions),
         device: args.device.clone(),
     };
     let ctx = Context::new(&options)?;
@@ -238,7 +243,7 @@ fn checked_technique_run(
     frames: u32,
 ) -> anyhow::Result<(Scene, Params)> {
     let info = techniques::find(technique)?;
-    let params = Params::resolve(technique, info.params, overrides)?;
+    let params = Params::resolve(technique, info.params(), overrides)?;
     check_size(scene)?;
     if frames == 0 {
         anyhow::bail!("--frames must be at least 1");
@@ -306,10 +311,18 @@ fn list_techniques() {
         println!("  {:<14} {}", t.name, t.description);
         let components: Vec<_> = t.components.iter().map(|c| c.name()).collect();
         println!("      --component {}|all", components.join("|"));
-        for p in t.params {
+        for p in t.params() {
             println!(
-                "      --param {}=VALUE  {} [{} .. {}], default {}",
-                p.name, p.description, p.min, p.max, p.default
+                "      --param {}=VALUE  {} [{} .. {}], default {}{}",
+                p.name,
+                p.description,
+                p.min,
+                p.max,
+                p.default,
+                match p.apply {
+                    caustics::params::Apply::Live => " (live)",
+                    caustics::params::Apply::Rebuild => "",
+                }
             );
         }
     }
@@ -334,7 +347,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             device,
         } => {
             let info = techniques::find(&technique)?;
-            let params = Params::resolve(&technique, info.params, &params)?;
+            let params = Params::resolve(&technique, info.params(), &params)?;
             check_size(&SceneArgs {
                 scene: scene.clone(),
                 width,
@@ -355,6 +368,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 exit,
                 resize_test,
                 validate: device.validate,
+                validate_sync: device.validate_sync,
                 device: device.device,
             })
         }

@@ -2,7 +2,11 @@
 //! the BVH (glsl/reference/trace.comp), plus the camera-side specular chains
 //! (glsl/reference/camera.comp), resolved into radiance per path type.
 
-use crate::renderer::{FrameTargets, SceneGpu};
+use crate::frame::{FrameTargets, SceneGpu};
+// `Component` lives in `radiometry` (frame constants and techniques use it
+// too); re-exported so `reference::Component` keeps naming the ground
+// truth's path types for the CLI and the reference tests.
+pub use crate::radiometry::Component;
 use crate::shader_bindings as b;
 use crate::vk::{
     barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline, Context,
@@ -10,76 +14,6 @@ use crate::vk::{
 };
 use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
-
-/// A path-type component of the ground truth (Heckbert's notation). Paths
-/// whose last segment to the eye passes through a specular surface are
-/// covered only as L D S+ E (see docs/ARCHITECTURE.md, "What the ground
-/// truth does not cover").
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Component {
-    /// L D (and L D S+ E through the camera-side chains).
-    Direct,
-    /// L S+ D.
-    SurfaceCaustics,
-    /// L V: single scattering straight from the light.
-    Airlight,
-    /// L S+ V.
-    VolumeCaustics,
-    /// Everything else (diffuse interreflection, multiple scattering).
-    Other,
-    /// The sum of all.
-    All,
-}
-
-impl Component {
-    pub const NAMED: [(&'static str, Component); 6] = [
-        ("direct", Component::Direct),
-        ("surface_caustics", Component::SurfaceCaustics),
-        ("airlight", Component::Airlight),
-        ("volume_caustics", Component::VolumeCaustics),
-        ("other", Component::Other),
-        ("all", Component::All),
-    ];
-
-    pub fn parse(name: &str) -> anyhow::Result<Component> {
-        Self::NAMED
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|(_, c)| *c)
-            .ok_or_else(|| {
-                let names: Vec<_> = Self::NAMED.iter().map(|(n, _)| *n).collect();
-                anyhow::anyhow!("unknown component `{name}`; one of: {}", names.join(", "))
-            })
-    }
-
-    pub fn name(self) -> &'static str {
-        Self::NAMED
-            .iter()
-            .find(|(_, c)| *c == self)
-            .map(|(n, _)| *n)
-            .unwrap_or("all")
-    }
-
-    /// This component's bit in the frame constants' component mask
-    /// (`component_weight` in glsl/common/scene.glsl); `All`: every bit.
-    pub fn mask(self) -> u32 {
-        match self {
-            Component::All => (1 << b::COMPONENT_COUNT) - 1,
-            c => 1 << c.index(),
-        }
-    }
-
-    fn index(self) -> u32 {
-        match self {
-            Component::Direct => b::COMPONENT_DIRECT,
-            Component::SurfaceCaustics => b::COMPONENT_SURFACE_CAUSTICS,
-            Component::Airlight => b::COMPONENT_AIRLIGHT,
-            Component::VolumeCaustics => b::COMPONENT_VOLUME_CAUSTICS,
-            Component::Other => b::COMPONENT_OTHER,
-            Component::All => b::COMPONENT_COUNT,
-        }
-    }
-}
 
 #[derive(Clone, Copy, Debug)]
 pub struct ReferenceSettings {

@@ -23,13 +23,14 @@
 
 mod common;
 
-use caustics::passes::airlight::{self, Airlight};
+use caustics::frame::{FrameTargets, SceneGpu};
+use caustics::params::{ParamSet, ParamSpec, Params};
+use caustics::passes::airlight::{Airlight, AirlightParams};
 use caustics::radiometry::spot_falloff;
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
-use caustics::renderer::{FrameTargets, SceneGpu};
 use caustics::scene::{Density, LightKind, Medium, Scene};
-use caustics::techniques::direct::{self, Direct};
-use caustics::techniques::{ParamSpec, Params, Technique};
+use caustics::techniques::direct::{Direct, DirectParams};
+use caustics::techniques::Technique;
 use caustics::vk::{Context, Profiler};
 use common::*;
 use glam::{DVec3, Vec3};
@@ -58,14 +59,23 @@ fn render_airlight_at(
     overrides: &[&str],
     size: u32,
 ) -> (Vec<f32>, f64) {
-    let specs: Vec<ParamSpec> = [direct::PARAMS, airlight::PARAMS].concat();
+    let specs: Vec<ParamSpec> = [DirectParams::specs(), AirlightParams::specs()].concat();
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let params = Params::resolve("airlight", &specs, &overrides).unwrap();
     let mut scene_gpu = SceneGpu::new(ctx, scene, 0.0).unwrap();
     scene_gpu.components = Component::Airlight.mask();
     let targets = FrameTargets::new(ctx, size, size).unwrap();
-    let mut direct = Direct::new(ctx, &params, scene, &scene_gpu, size, size).unwrap();
-    let mut air = Airlight::new(ctx, &params, scene, &scene_gpu, &direct.shadows).unwrap();
+    let direct_params = DirectParams::from_params(&params).unwrap();
+    let mut direct = Direct::new(ctx, &direct_params, scene, &scene_gpu, size, size).unwrap();
+    let mut air = Airlight::new(
+        ctx,
+        &AirlightParams::from_params(&params).unwrap(),
+        direct_params.medium_steps,
+        scene,
+        &scene_gpu,
+        &direct.shadows,
+    )
+    .unwrap();
     scene_gpu.update_frame(scene, size, size, 0.0, 0).unwrap();
     let profiler = Profiler::new(ctx, 64).unwrap();
     let mut ms = 0.0;

@@ -20,8 +20,8 @@
 
 mod common;
 
+use caustics::frame::SceneGpu;
 use caustics::gpu::GpuTriangle;
-use caustics::renderer::SceneGpu;
 use caustics::scene::Scene;
 use caustics::shader_bindings as b;
 use caustics::vk::{

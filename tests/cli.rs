@@ -506,7 +506,7 @@ fn unparsable_arguments_are_usage_errors() {
 fn technique_list_shows_direct_and_its_parameters() {
     let o = run(&["render", "--technique", "list"]);
     assert_eq!(o.code, Some(0), "{}", o.describe());
-    for spec in caustics::techniques::find("direct").unwrap().params {
+    for spec in caustics::techniques::find("direct").unwrap().params() {
         assert!(
             o.stdout.contains(&format!("--param {}=VALUE", spec.name)),
             "`{}` not listed: {}",

@@ -561,8 +561,8 @@ fn bad_configurations_are_refused() {
 /// synthetic plane.
 #[test]
 fn real_gbuffer_edges() {
+    use caustics::frame::SceneGpu;
     use caustics::passes::gbuffer::{GBuffer, GBufferContents};
-    use caustics::renderer::SceneGpu;
     let ctx = validated_context();
     let scene = common::scene(
         common::camera(Vec3::new(0.0, 3.0, 4.0), Vec3::ZERO, 45.0),
@@ -694,15 +694,15 @@ fn l_min_is_the_dimmest_light_irradiance() {
     assert_eq!(l(vec![]), Vec3::ZERO);
 }
 
-/// `DENOISE_PARAMS` through `Params::resolve`: the kinds map to the
+/// `DenoiseParams` through `--param` values: the kinds map to the
 /// configurations, and out-of-range values are refused naming the parameter.
 #[test]
 fn params_select_the_denoiser() {
-    use caustics::techniques::water_photons::denoise::DENOISE_PARAMS;
-    use caustics::techniques::Params;
+    use caustics::params::ParamSet;
+    use caustics::techniques::water_photons::denoise::DenoiseParams;
     let config = |overrides: &[&str]| {
         let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-        Params::resolve("water_photons", DENOISE_PARAMS, &o).map(|p| DenoiseConfig::from_params(&p))
+        DenoiseParams::parse("water_photons", &o).map(|p| DenoiseConfig::from_params(&p))
     };
     assert_eq!(config(&[]).unwrap(), Some(adaptive(1)));
     assert_eq!(config(&["denoise=0"]).unwrap(), None);

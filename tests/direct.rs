@@ -16,12 +16,14 @@
 //! - with the bias switched off, lit pixels are off by up to 78% (acne), so
 //!   these tests do see acne.
 
+use caustics::frame::camera_matrices;
+use caustics::params::{ParamSet, Params};
 use caustics::radiometry::spot_falloff;
-use caustics::renderer::{camera_matrices, Renderer};
+use caustics::renderer::Renderer;
 use caustics::scene::{
     Camera, Light, LightKind, Material, MaterialKind, Mesh, Object, Output, Scene,
 };
-use caustics::techniques::{self, Params};
+use caustics::techniques;
 use caustics::vk::{Context, ContextOptions};
 use glam::{DVec3, DVec4, Mat4, Vec3};
 use std::f64::consts::PI;
@@ -140,11 +142,17 @@ fn render_with(scene: Scene, overrides: &[&str]) -> (Arc<Context>, Vec<f32>) {
     let _ = env_logger::builder().is_test(true).try_init();
     let ctx = Context::new(&ContextOptions {
         validation: true,
+        sync_validation: true,
         device: None,
     })
     .expect("Vulkan context (lavapipe)");
     let overrides: Vec<String> = overrides.iter().map(|o| o.to_string()).collect();
-    let params = Params::resolve("direct", techniques::direct::PARAMS, &overrides).unwrap();
+    let params = Params::resolve(
+        "direct",
+        techniques::direct::DirectParams::specs(),
+        &overrides,
+    )
+    .unwrap();
     let radiance = {
         let mut renderer = Renderer::new(&ctx, scene, "direct", &params, SIZE, SIZE, 0.0).unwrap();
         renderer.render_frame(0.0).unwrap();
@@ -487,4 +495,54 @@ fn wide_pcf_on_small_maps_keeps_lit_and_shadowed_regions_exact() {
         &["shadow_map_size=256", "pcf_radius=4"],
         0.12,
     );
+}
+
+/// A live parameter (`pcf_radius`, a push constant) changes in place: no
+/// rebuild, and the frame equals, bit for bit, that of a technique built
+/// with the new value. A rebuild parameter among the changes rebuilds.
+#[test]
+fn live_parameters_apply_without_a_rebuild() {
+    let (ctx, _) = render(scene(vec![point_light()], true));
+    let specs = techniques::direct::DirectParams::specs();
+    let params = |o: &[&str]| {
+        let o: Vec<String> = o.iter().map(|s| s.to_string()).collect();
+        Params::resolve("direct", specs, &o).unwrap()
+    };
+    let frame = |r: &mut Renderer| {
+        r.render_frame(0.0).unwrap();
+        r.radiance().unwrap()
+    };
+    let s = scene(vec![point_light()], true);
+    let mut live = Renderer::new(&ctx, s.clone(), "direct", &params(&[]), SIZE, SIZE, 0.0).unwrap();
+    let before = frame(&mut live);
+    assert!(
+        !live.set_params(&params(&["pcf_radius=3"])).unwrap(),
+        "pcf_radius is live"
+    );
+    assert_eq!(live.params(), &params(&["pcf_radius=3"]));
+    let after = frame(&mut live);
+    assert_ne!(
+        before, after,
+        "a wider PCF filter changes the shadow's edge"
+    );
+    let mut built = Renderer::new(
+        &ctx,
+        s,
+        "direct",
+        &params(&["pcf_radius=3"]),
+        SIZE,
+        SIZE,
+        0.0,
+    )
+    .unwrap();
+    assert_eq!(after, frame(&mut built));
+    assert!(
+        live.set_params(&params(&["pcf_radius=2", "shadow_map_size=512"]))
+            .unwrap(),
+        "shadow_map_size needs a rebuild"
+    );
+    frame(&mut live);
+    drop((live, built));
+    let counts = ctx.validation_counts();
+    assert_eq!(counts.errors, 0, "{:?}", ctx.validation_errors());
 }

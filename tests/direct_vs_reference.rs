@@ -51,10 +51,11 @@
 
 mod common;
 
+use caustics::params::{ParamSet, Params};
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use caustics::renderer::Renderer;
 use caustics::scene::Scene;
-use caustics::techniques::{self, Params};
+use caustics::techniques;
 use common::*;
 use std::path::Path;
 
@@ -146,7 +147,7 @@ fn load() -> Scene {
 fn direct_matches_reference_direct_component() {
     let start = std::time::Instant::now();
     let ctx = validated_context();
-    let params = Params::resolve("direct", techniques::direct::PARAMS, &[]).unwrap();
+    let params = Params::resolve("direct", techniques::direct::DirectParams::specs(), &[]).unwrap();
     let (actual, actual_ldr) = {
         let mut renderer = Renderer::new(&ctx, load(), "direct", &params, SIZE, SIZE, 0.0).unwrap();
         renderer.render_frame(0.0).unwrap();

@@ -108,12 +108,12 @@
 
 mod common;
 
+use caustics::params::{ParamSet, Params};
 use caustics::passes::caustic_map::GpuPhoton;
 use caustics::radiometry::fresnel_dielectric;
 use caustics::scene::{Light, LightKind, Scene};
 use caustics::shader_bindings as b;
-use caustics::techniques::image_space::PARAMS;
-use caustics::techniques::Params;
+use caustics::techniques::image_space::ImageSpaceParams;
 use caustics::vk::Context;
 use common::*;
 use glam::{DVec3, Vec3};
@@ -571,7 +571,7 @@ fn caustics_match_reference(name: &str, photons: u64, bounds: &[Bound]) {
     let frame = |technique: &str, overrides: &[String]| {
         let params = Params::resolve(
             technique,
-            caustics::techniques::find(technique).unwrap().params,
+            caustics::techniques::find(technique).unwrap().params(),
             overrides,
         )
         .unwrap();
@@ -839,7 +839,7 @@ fn caustics_on_change_reuses_the_map_until_something_moves() {
             "caustic_map_size=128".to_string(),
             format!("caustics_on_change={on_change}"),
         ];
-        let params = Params::resolve("image_space", PARAMS, &overrides).unwrap();
+        let params = Params::resolve("image_space", ImageSpaceParams::specs(), &overrides).unwrap();
         Renderer::new(
             &ctx,
             Scene::load(&path).unwrap(),

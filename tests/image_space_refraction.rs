@@ -29,10 +29,10 @@
 
 mod common;
 
+use caustics::params::{ParamSet, Params};
 use caustics::radiometry::fresnel_dielectric;
 use caustics::scene::{Camera, Scene};
-use caustics::techniques::image_space::{ImageSpace, PARAMS};
-use caustics::techniques::Params;
+use caustics::techniques::image_space::{ImageSpace, ImageSpaceParams};
 use caustics::vk::Context;
 use common::*;
 use glam::Vec3;
@@ -337,7 +337,7 @@ fn bad_refraction_parameters_are_rejected() {
         ("eq_6_3_2=2", "eq_6_3_2"),
         ("search_steps=2", "search_steps"),
     ] {
-        let err = Params::resolve("image_space", PARAMS, &[p.to_string()])
+        let err = Params::resolve("image_space", ImageSpaceParams::specs(), &[p.to_string()])
             .unwrap_err()
             .to_string();
         assert!(err.contains(name), "{p}: {err}");
@@ -426,7 +426,7 @@ fn open_sheet_refracts_once() {
     let f = render(&ctx, &s, &[]);
     let behind = opaque(&f);
     let cover = covered(&f);
-    let (view, proj) = caustics::renderer::camera_matrices(&s.camera, 1.0);
+    let (view, proj) = caustics::frame::camera_matrices(&s.camera, 1.0);
     let eta = 1.0 / SHEET_IOR;
     let (mut n, mut worst, mut floor_min, mut floor_max) = (0, 0.0f32, f32::MAX, 0.0f32);
     let mut worst_ratio = (0.0f32, 0.0f32);
@@ -573,7 +573,7 @@ fn mirror_reflects_the_floor() {
     let f = render(&ctx, &s, &[]);
     let behind = opaque(&f);
     let floor_radiance = 0.8 / std::f32::consts::PI * 3.0;
-    let (view, proj) = caustics::renderer::camera_matrices(&s.camera, 1.0);
+    let (view, proj) = caustics::frame::camera_matrices(&s.camera, 1.0);
     let (mut n, mut worst) = (0, 0.0f32);
     for py in 0..SIZE {
         for px in 0..SIZE {

@@ -22,10 +22,11 @@
 
 mod common;
 
+use caustics::params::{ParamSet, Params};
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use caustics::renderer::Renderer;
 use caustics::scene::{Density, Medium, Scene};
-use caustics::techniques::{self, Params};
+use caustics::techniques;
 use common::*;
 use glam::Vec3;
 use std::path::Path;
@@ -38,7 +39,12 @@ const PHOTONS: u64 = 8_000_000;
 
 fn render_direct(ctx: &Arc<caustics::vk::Context>, scene: Scene, overrides: &[&str]) -> Vec<f32> {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let params = Params::resolve("direct", techniques::direct::PARAMS, &overrides).unwrap();
+    let params = Params::resolve(
+        "direct",
+        techniques::direct::DirectParams::specs(),
+        &overrides,
+    )
+    .unwrap();
     let mut renderer = Renderer::new(ctx, scene, "direct", &params, SIZE, SIZE, 0.0).unwrap();
     renderer.render_frame(0.0).unwrap();
     let radiance = renderer.radiance().unwrap();
@@ -294,7 +300,7 @@ fn image_space_caustics_are_attenuated_like_the_reference() {
     };
     let frame = |technique: &str| {
         let info = techniques::find(technique).unwrap();
-        let params = Params::resolve(technique, info.params, &[]).unwrap();
+        let params = Params::resolve(technique, info.params(), &[]).unwrap();
         let mut r = Renderer::new(&ctx, load(), technique, &params, SIZE, SIZE, 0.0).unwrap();
         r.render_frame(0.0).unwrap();
         masked(r.radiance().unwrap())

@@ -48,12 +48,13 @@
 mod common;
 
 use caustics::bvh::Bvh;
+use caustics::frame::{FrameTargets, SceneGpu};
+use caustics::params::ParamSet;
 use caustics::passes::caustic_map::{photon_view, specular_bounds};
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
-use caustics::renderer::{FrameTargets, SceneGpu};
 use caustics::scene::{MaterialKind, Scene};
-use caustics::techniques::volume_lines::{GpuSegment, VolumeLines, PARAMS};
-use caustics::techniques::{Params, Technique};
+use caustics::techniques::volume_lines::{GpuSegment, VolumeLines, VolumeLinesParams};
+use caustics::techniques::Technique;
 use caustics::vk::Context;
 use common::*;
 use glam::Vec3;
@@ -94,7 +95,7 @@ fn render(ctx: &Arc<Context>, scene: &Scene, overrides: &[&str], mask: u32) -> F
 
 fn render_at(ctx: &Arc<Context>, scene: &Scene, overrides: &[&str], mask: u32, size: u32) -> Frame {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let params = Params::resolve("volume_lines", PARAMS, &overrides).unwrap();
+    let params = VolumeLinesParams::parse("volume_lines", &overrides).unwrap();
     let mut scene_gpu = SceneGpu::new(ctx, scene, 0.0).unwrap();
     scene_gpu.components = mask;
     let targets = FrameTargets::new(ctx, size, size).unwrap();
@@ -319,7 +320,7 @@ fn beam_energy(scene: &Scene, segments: &[GpuSegment], gs: &[f64], samples: u32)
     let bvh = Bvh::build(&tris);
     let gpu = bvh.gpu_triangles(&tris);
     let cam = &scene.camera;
-    let (view, proj) = caustics::renderer::camera_matrices(cam, 1.0);
+    let (view, proj) = caustics::frame::camera_matrices(cam, 1.0);
     let view_proj = proj * view;
     let forward = (cam.target - cam.eye).normalize();
     let a_px = 2.0 * (cam.fov_y_deg.to_radians() * 0.5).tan() as f64 / SIZE as f64;
@@ -527,7 +528,7 @@ fn filter_radius_beyond_sixteen_steps_is_refused() {
     let ctx = validated_context();
     let scene = load("volume_cone");
     let overrides = ["ray_step=0.01".to_string(), "filter_radius=0.5".to_string()];
-    let params = Params::resolve("volume_lines", PARAMS, &overrides).unwrap();
+    let params = VolumeLinesParams::parse("volume_lines", &overrides).unwrap();
     let scene_gpu = SceneGpu::new(&ctx, &scene, 0.0).unwrap();
     let err = match VolumeLines::new(&ctx, &params, &scene, &scene_gpu, 64, 64) {
         Ok(_) => panic!("accepted r = 50 Delta_x"),

@@ -27,14 +27,15 @@
 mod common;
 
 use caustics::cascades::CascadeLayout;
+use caustics::frame::{FrameTargets, SceneGpu};
 use caustics::gpu::GpuTriangle;
-use caustics::renderer::{FrameTargets, SceneGpu};
+use caustics::params::{ParamSet, Params};
 use caustics::scene::{MaterialKind, Scene, Water, Wave};
 use caustics::shader_bindings as b;
 use caustics::techniques::water_photons::{
-    GpuWaterPhoton, WaterPhotons, GUARD_PHOTONS, GUARD_WORD, PARAMS,
+    GpuWaterPhoton, WaterPhotons, WaterPhotonsParams, GUARD_PHOTONS, GUARD_WORD,
 };
-use caustics::techniques::{Params, Technique};
+use caustics::techniques::Technique;
 use caustics::vk::{
     BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
     Profiler,
@@ -59,7 +60,7 @@ fn render(ctx: &Arc<Context>, scene: &Scene, overrides: &[&str], size: u32) -> R
 /// One frame with the geometry (and the GPU water surface) at `time`.
 fn render_at(ctx: &Arc<Context>, scene: &Scene, overrides: &[&str], size: u32, time: f32) -> Run {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let params = Params::resolve("water_photons", PARAMS, &overrides).unwrap();
+    let params = WaterPhotonsParams::parse("water_photons", &overrides).unwrap();
     let scene_gpu = SceneGpu::new(ctx, scene, time).unwrap();
     scene_gpu.update_frame(scene, size, size, time, 0).unwrap();
     let targets = FrameTargets::new(ctx, size, size).unwrap();
@@ -485,10 +486,10 @@ fn masked_energy(img: &[f32], mask: &[bool]) -> f64 {
 /// The surface-caustics component of one frame, with the trace + splat
 /// milliseconds and the denoise milliseconds of the second (timed) frame.
 fn caustic_frame(ctx: &Arc<Context>, s: Scene, overrides: &[&str]) -> (Vec<f32>, f64, f64) {
-    use caustics::reference::Component;
+    use caustics::radiometry::Component;
     use caustics::renderer::Renderer;
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let params = Params::resolve("water_photons", PARAMS, &overrides).unwrap();
+    let params = Params::resolve("water_photons", WaterPhotonsParams::specs(), &overrides).unwrap();
     let mut r = Renderer::new(ctx, s, "water_photons", &params, SIZE, SIZE, 0.0).unwrap();
     r.scene_gpu.components = Component::SurfaceCaustics.mask();
     // The second frame is timed: the first pays the pipelines' compilation.
@@ -868,7 +869,7 @@ fn unusable_scenes_and_parameters_are_refused() {
         Vec3::new(0.0, 5.0, 2.0),
     );
     s.lights = vec![point_light(Vec3::new(0.0, 5.0, 0.0), 100.0)];
-    let params = Params::resolve("water_photons", PARAMS, &[]).unwrap();
+    let params = WaterPhotonsParams::default();
     let scene_gpu = SceneGpu::new(&ctx, &s, 0.0).unwrap();
     let err = WaterPhotons::new(&ctx, &params, &s, &scene_gpu, 32, 32)
         .err()
@@ -895,7 +896,7 @@ fn eq_3_sizes_the_cascades_from_the_precision() {
             format!("ccm_precision={precision}"),
             format!("cascades={cascades}"),
         ];
-        let params = Params::resolve("water_photons", PARAMS, &overrides).unwrap();
+        let params = WaterPhotonsParams::parse("water_photons", &overrides).unwrap();
         let t = WaterPhotons::new(&ctx, &params, &s, &scene_gpu, 32, 32).unwrap();
         let r = t.frame.range;
         // The camera is 2 m off the water's centre along z: cascade N − 1 spans
@@ -969,7 +970,7 @@ fn splats_conserve_the_flux_of_a_focusing_crest() {
 /// dark (the water's shadow).
 #[test]
 fn ior_one_water_gives_back_the_direct_frame() {
-    use caustics::reference::Component;
+    use caustics::radiometry::Component;
     use caustics::renderer::Renderer;
     let ctx = validated_context();
     let light = Vec3::new(0.3, -1.0, 0.2).normalize();
@@ -981,7 +982,7 @@ fn ior_one_water_gives_back_the_direct_frame() {
     let frame = |s: &Scene, technique: &str, overrides: &[String], mask: u32| {
         let params = Params::resolve(
             technique,
-            caustics::techniques::find(technique).unwrap().params,
+            caustics::techniques::find(technique).unwrap().params(),
             overrides,
         )
         .unwrap();
@@ -1140,7 +1141,7 @@ fn a_one_frame_render_reports_overflow() {
 /// energy there).
 #[test]
 fn ocean_large_renders_with_caustics_on_the_seabed() {
-    use caustics::reference::Component;
+    use caustics::radiometry::Component;
     use caustics::renderer::Renderer;
     const PX: u32 = 96;
     let ctx = validated_context();
@@ -1148,7 +1149,8 @@ fn ocean_large_renders_with_caustics_on_the_seabed() {
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/ocean_large.toml");
     let frame = |overrides: &[&str], components: Option<u32>| {
         let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-        let params = Params::resolve("water_photons", PARAMS, &overrides).unwrap();
+        let params =
+            Params::resolve("water_photons", WaterPhotonsParams::specs(), &overrides).unwrap();
         let s = Scene::load(&path).unwrap();
         let mut r = Renderer::new(&ctx, s, "water_photons", &params, PX, PX, 0.0).unwrap();
         if let Some(mask) = components {

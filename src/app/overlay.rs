@@ -10,8 +10,8 @@
 //! once per submitted frame, so a buffer is rewritten only after the fence
 //! of the frame that last read it has been waited for.
 
-use crate::reference::Component;
-use crate::techniques::Params;
+use crate::params::Params;
+use crate::radiometry::Component;
 use crate::vk::{Context, PassTiming};
 use ash::vk;
 use std::sync::Arc;
@@ -285,7 +285,7 @@ mod enabled {
                     let current = pending.clone().unwrap_or_else(|| data.params.clone());
                     let mut edited = false;
                     let mut values = Vec::new();
-                    for spec in info.params {
+                    for spec in info.params() {
                         let mut v = current.get(spec.name);
                         let mut slider =
                             egui::Slider::new(&mut v, spec.min..=spec.max).text(spec.name);
@@ -296,7 +296,7 @@ mod enabled {
                         values.push(format!("{}={}", spec.name, v));
                     }
                     if edited {
-                        if let Ok(p) = Params::resolve(info.name, info.params, &values) {
+                        if let Ok(p) = Params::resolve(info.name, info.params(), &values) {
                             *pending = Some(p);
                         }
                     }

@@ -21,15 +21,15 @@
 //! per-frame random offset (`airlight_jitter` = 1: shadow edges turn into
 //! noise instead of banding) or the midpoints (0).
 //!
-//! A technique owns one `Airlight` next to its shadow maps, concatenates
-//! [`PARAMS`] (and `direct::MEDIUM_STEPS`) into its parameter list, and
-//! records it after the pass that writes the frame's radiance.
+//! A technique owns one `Airlight` next to its shadow maps, holds
+//! [`AirlightParams`] as a group of its parameter struct (and passes its
+//! `medium_steps`), and records it after the pass that writes the frame's
+//! radiance.
 
+use crate::frame::SceneGpu;
 use crate::passes::shadow::ShadowMaps;
-use crate::renderer::SceneGpu;
 use crate::scene::Scene;
 use crate::shader_bindings as b;
-use crate::techniques::{ParamSpec, Params};
 use crate::vk::{
     barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
     FrameRecorder, Image, ImageAccess, Sampler, VkResult,
@@ -38,26 +38,16 @@ use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
 
-pub const AIRLIGHT_STEPS: ParamSpec = ParamSpec {
-    name: "airlight_steps",
-    description:
-        "airlight ray-march samples per pixel (strata of the camera ray inside the medium)",
-    min: 1.0,
-    max: 1024.0,
-    default: 64.0,
-    integer: true,
-};
-pub const AIRLIGHT_JITTER: ParamSpec = ParamSpec {
-    name: "airlight_jitter",
-    description: "1: airlight samples at a random offset per pixel and frame (noise instead of banding); 0: stratum midpoints",
-    min: 0.0,
-    max: 1.0,
-    default: 1.0,
-    integer: true,
-};
-
-/// The airlight's own parameters; it also reads `direct::MEDIUM_STEPS`.
-pub const PARAMS: &[ParamSpec] = &[AIRLIGHT_STEPS, AIRLIGHT_JITTER];
+crate::declare_params! {
+    /// The airlight's parameters, a group of every technique that records
+    /// it; it also takes the technique's `medium_steps` (`DirectParams`).
+    pub struct AirlightParams {
+        airlight_steps: u32 [1, 1024] = 64, live,
+            "airlight ray-march samples per pixel (strata of the camera ray inside the medium)";
+        airlight_jitter: u32 [0, 1] = 1, live,
+            "1: airlight samples at a random offset per pixel and frame (noise instead of banding); 0: stratum midpoints";
+    }
+}
 
 /// Push constants of glsl/passes/airlight.comp.
 #[repr(C)]
@@ -82,10 +72,12 @@ pub struct Airlight {
 
 impl Airlight {
     /// An airlight pass reading `shadows` (the technique's shadow maps of
-    /// `scene`'s lights). `params` must hold [`PARAMS`] and `medium_steps`.
+    /// `scene`'s lights), with `medium_steps` midpoint steps through
+    /// inhomogeneous media (`DirectParams::medium_steps`).
     pub fn new(
         ctx: &Arc<Context>,
-        params: &Params,
+        params: &AirlightParams,
+        medium_steps: u32,
         scene: &Scene,
         scene_gpu: &SceneGpu,
         shadows: &ShadowMaps,
@@ -117,9 +109,9 @@ impl Airlight {
         Ok(Self {
             push: AirlightPush {
                 light_count: scene.lights.len().min(b::MAX_LIGHTS as usize) as u32,
-                steps: params.get(AIRLIGHT_STEPS.name) as u32,
-                medium_steps: params.get("medium_steps") as u32,
-                jitter: params.get(AIRLIGHT_JITTER.name) as u32,
+                steps: params.airlight_steps,
+                medium_steps,
+                jitter: params.airlight_jitter,
             },
             pipeline,
             set,
@@ -127,6 +119,12 @@ impl Airlight {
             _layout: layout,
             _sampler: sampler,
         })
+    }
+
+    /// Takes new airlight parameters (both are push constants).
+    pub fn set_live(&mut self, params: &AirlightParams) {
+        self.push.steps = params.airlight_steps;
+        self.push.jitter = params.airlight_jitter;
     }
 
     /// Records the "airlight" pass: adds L_A (times the airlight component's

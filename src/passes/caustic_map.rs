@@ -65,9 +65,9 @@
 //! lands only 5% of the gem's flux (it drops the photons that meet total
 //! internal reflection or no back face).
 
+use crate::frame::SceneGpu;
 use crate::passes::shadow::{shadow_views, GpuShadowLight};
 use crate::passes::specular_gbuffer::{SpecularGBuffer, Viewpoint};
-use crate::renderer::SceneGpu;
 use crate::scene::{Light, LightKind, MaterialKind, Scene};
 use crate::shader_bindings as b;
 use crate::vk::{

@@ -12,7 +12,7 @@
 //! `GBufferContents::Opaque` leaves the specular surfaces out (`image_space`
 //! sees the opaque scene behind them and adds them by image-space refraction).
 
-use crate::renderer::SceneGpu;
+use crate::frame::SceneGpu;
 use crate::vk::{
     barrier, begin_rendering, end_rendering, Access, BufferAccess, Context, DescriptorSetLayout,
     FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageAccess, ImageDesc, VkResult,

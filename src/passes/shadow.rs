@@ -19,7 +19,7 @@
 //! uniform buffer of `GpuShadowLight[MAX_LIGHTS]`. The bias is documented
 //! there.
 
-use crate::renderer::SceneGpu;
+use crate::frame::SceneGpu;
 use crate::scene::{Light, LightKind};
 use crate::shader_bindings as b;
 use crate::vk::{

@@ -17,7 +17,7 @@
 //! d_N (front) or 0 (back), -1 where nothing covers the texel; normal xyz
 //! the smooth outward normal, w = material index as a float.
 
-use crate::renderer::SceneGpu;
+use crate::frame::SceneGpu;
 use crate::shader_bindings as b;
 use crate::vk::{
     barrier, begin_rendering, end_rendering, Access, BufferAccess, Context, DescriptorSetLayout,

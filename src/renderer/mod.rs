@@ -1,46 +1,13 @@
-//! Frame orchestration: scene upload, technique selection, tonemapping,
-//! profiling and output. `render` and `bench` run frames through here.
+//! Frame orchestration: technique selection, tonemapping, profiling and
+//! output, over the scene and targets of `crate::frame`. `render` and `bench` run frames through here.
 
-mod scene_gpu;
-
-pub use scene_gpu::{camera_matrices, GeometryStats, SceneGpu};
-
+use crate::frame::{FrameTargets, SceneGpu};
+use crate::params::{Apply, Params};
 use crate::passes::tonemap::Tonemap;
 use crate::scene::Scene;
-use crate::techniques::{self, Params, Technique};
-use crate::vk::{Context, Image, ImageDesc, PassTiming, Profiler, VkResult};
-use ash::vk;
+use crate::techniques::{self, Technique};
+use crate::vk::{Context, PassTiming, Profiler, VkResult};
 use std::sync::Arc;
-
-/// The images a technique renders into.
-pub struct FrameTargets {
-    /// Linear radiance, W m^-2 sr^-1 per channel (RGBA32F: storage, sampled, colour attachment).
-    pub radiance: Image,
-    pub width: u32,
-    pub height: u32,
-}
-
-impl FrameTargets {
-    pub fn new(ctx: &Arc<Context>, width: u32, height: u32) -> VkResult<Self> {
-        let radiance = Image::new(
-            ctx,
-            "radiance",
-            ImageDesc::new_2d(
-                width,
-                height,
-                vk::Format::R32G32B32A32_SFLOAT,
-                vk::ImageUsageFlags::STORAGE
-                    | vk::ImageUsageFlags::SAMPLED
-                    | vk::ImageUsageFlags::COLOR_ATTACHMENT,
-            ),
-        )?;
-        Ok(Self {
-            radiance,
-            width,
-            height,
-        })
-    }
-}
 
 pub struct Renderer {
     pub ctx: Arc<Context>,
@@ -68,7 +35,7 @@ impl Renderer {
         let targets = FrameTargets::new(ctx, width, height)?;
         let tonemap = Tonemap::new(ctx, &targets.radiance)?;
         let technique =
-            techniques::create(ctx, technique, params, &scene, &scene_gpu, width, height)?;
+            techniques::create_named(ctx, technique, params, &scene, &scene_gpu, width, height)?;
         Ok(Self {
             ctx: ctx.clone(),
             scene,
@@ -99,7 +66,7 @@ impl Renderer {
 
     /// Switches to technique `name` with `params` (keeps the current one on error).
     pub fn set_technique(&mut self, name: &str, params: &Params) -> anyhow::Result<()> {
-        let technique = techniques::create(
+        let technique = techniques::create_named(
             &self.ctx,
             name,
             params,
@@ -113,6 +80,27 @@ impl Renderer {
         Ok(())
     }
 
+    /// New parameter values for the current technique. When every changed
+    /// parameter is live (`params::Apply::Live`) and the technique takes
+    /// them in place (`Technique::update_live`), nothing is rebuilt;
+    /// otherwise the technique is rebuilt (keeping the current one on
+    /// error). Returns whether it was rebuilt. The caller has waited for
+    /// every frame in flight.
+    pub fn set_params(&mut self, params: &Params) -> anyhow::Result<bool> {
+        let specs = self.technique_info().params();
+        let live = self.params.changed(params).all(|name| {
+            specs
+                .iter()
+                .any(|s| s.name == name && s.apply == Apply::Live)
+        });
+        if live && self.technique.update_live(params)? {
+            self.params = params.clone();
+            return Ok(false);
+        }
+        self.set_technique(self.technique.name(), params)?;
+        Ok(true)
+    }
+
     /// Replaces the scene (reload from disk, or a light moved): re-uploads it
     /// and rebuilds the technique, whose resources (shadow maps) depend on
     /// the lights. On error the old scene stays. The caller has waited for
@@ -120,7 +108,7 @@ impl Renderer {
     pub fn set_scene(&mut self, scene: Scene, time: f32) -> anyhow::Result<()> {
         let mut scene_gpu = SceneGpu::new(&self.ctx, &scene, time)?;
         scene_gpu.components = self.scene_gpu.components;
-        let technique = techniques::create(
+        let technique = techniques::create_named(
             &self.ctx,
             self.technique.name(),
             &self.params,

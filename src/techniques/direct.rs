@@ -21,10 +21,12 @@
 //! midpoint rule with `medium_steps` steps for noise and grid densities
 //! (Hu Sect. 5.4). Without a medium the factors are exactly 1.
 
-use super::{ParamSpec, Params, Technique};
+use super::{Technique, TechniqueBuild};
+use crate::frame::{FrameTargets, SceneGpu};
+use crate::params::{ParamSet, Params};
 use crate::passes::gbuffer::{GBuffer, GBufferContents};
 use crate::passes::shadow::ShadowMaps;
-use crate::renderer::{FrameTargets, SceneGpu};
+use crate::radiometry::Component;
 use crate::scene::Scene;
 use crate::shader_bindings as b;
 use crate::vk::{
@@ -35,37 +37,18 @@ use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
 
-/// The shadow-map parameters, shared by every technique built on `Direct`.
-pub const SHADOW_MAP_SIZE: ParamSpec = ParamSpec {
-    name: "shadow_map_size",
-    description: "shadow map resolution per view (texels per side)",
-    min: 64.0,
-    max: 4096.0,
-    default: 1024.0,
-    integer: true,
-};
-pub const PCF_RADIUS: ParamSpec = ParamSpec {
-    name: "pcf_radius",
-    description: "percentage-closer filter half-width in shadow texels (0: one tap)",
-    min: 0.0,
-    max: 4.0,
-    default: 1.0,
-    integer: true,
-};
-
-/// Midpoint steps of the deterministic transmittance through inhomogeneous
-/// media, shared by every technique that attenuates surface light.
-pub const MEDIUM_STEPS: ParamSpec = ParamSpec {
-    name: "medium_steps",
-    description:
-        "midpoint steps of the transmittance through noise/grid media (constant density is exact)",
-    min: 1.0,
-    max: 256.0,
-    default: 16.0,
-    integer: true,
-};
-
-pub const PARAMS: &[ParamSpec] = &[SHADOW_MAP_SIZE, PCF_RADIUS, MEDIUM_STEPS];
+crate::declare_params! {
+    /// `Direct`'s parameters (shadow maps, PCF, medium transmittance), a
+    /// group in every technique built on it.
+    pub struct DirectParams {
+        shadow_map_size: u32 [64, 4096] = 1024, rebuild,
+            "shadow map resolution per view (texels per side)";
+        pcf_radius: i32 [0, 4] = 1, live,
+            "percentage-closer filter half-width in shadow texels (0: one tap)";
+        medium_steps: u32 [1, 256] = 16, rebuild,
+            "midpoint steps of the transmittance through noise/grid media (constant density is exact)";
+    }
+}
 
 /// Push constants of glsl/direct/lighting.comp.
 #[repr(C)]
@@ -95,7 +78,7 @@ pub struct Direct {
 impl Direct {
     pub fn new(
         ctx: &Arc<Context>,
-        params: &Params,
+        params: &DirectParams,
         scene: &Scene,
         scene_gpu: &SceneGpu,
         width: u32,
@@ -116,17 +99,19 @@ impl Direct {
     /// lights the opaque scene behind its refractors).
     pub fn with_contents(
         ctx: &Arc<Context>,
-        params: &Params,
+        params: &DirectParams,
         scene: &Scene,
         scene_gpu: &SceneGpu,
         width: u32,
         height: u32,
         contents: GBufferContents,
     ) -> VkResult<Self> {
-        let shadow_map_size = params.get("shadow_map_size") as u32;
-        let pcf_radius = params.get("pcf_radius") as i32;
-        let medium_steps = params.get("medium_steps") as u32;
-        let shadows = ShadowMaps::new(ctx, &scene_gpu.layout, &scene.lights, shadow_map_size)?;
+        let shadows = ShadowMaps::new(
+            ctx,
+            &scene_gpu.layout,
+            &scene.lights,
+            params.shadow_map_size,
+        )?;
         let gbuffer = GBuffer::new(ctx, &scene_gpu.layout, width, height, contents)?;
         let layout = DescriptorSetLayout::new(
             ctx,
@@ -162,8 +147,8 @@ impl Direct {
             light_count: scene.lights.len().min(b::MAX_LIGHTS as usize) as u32,
             shadows,
             gbuffer,
-            pcf_radius,
-            medium_steps,
+            pcf_radius: params.pcf_radius,
+            medium_steps: params.medium_steps,
             lighting,
             set,
             bound_radiance: vk::ImageView::null(),
@@ -173,9 +158,40 @@ impl Direct {
     }
 }
 
+impl TechniqueBuild for Direct {
+    const NAME: &'static str = "direct";
+    const DESCRIPTION: &'static str =
+        "direct light with shadow maps (the base frame every technique adds to)";
+    const COMPONENTS: &'static [Component] = &[Component::Direct];
+    type Params = DirectParams;
+
+    fn build(
+        ctx: &Arc<Context>,
+        params: &DirectParams,
+        scene: &Scene,
+        scene_gpu: &SceneGpu,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<Self> {
+        Ok(Self::new(ctx, params, scene, scene_gpu, width, height)?)
+    }
+}
+
+impl Direct {
+    /// Takes the live parameters of `params` (`pcf_radius`).
+    pub fn set_live(&mut self, params: &DirectParams) {
+        self.pcf_radius = params.pcf_radius;
+    }
+}
+
 impl Technique for Direct {
     fn name(&self) -> &'static str {
-        "direct"
+        Self::NAME
+    }
+
+    fn update_live(&mut self, params: &Params) -> anyhow::Result<bool> {
+        self.set_live(&DirectParams::from_params(params)?);
+        Ok(true)
     }
 
     fn record(

@@ -1,98 +1,20 @@
 //! Techniques: each one owns its resources and records its passes into the
 //! frame, writing linear radiance (W m^-2 sr^-1) into the frame's radiance
-//! image. Parameters are declared once (`ParamSpec`) so the CLI, the demo
-//! overlay and the benchmarks read the same list.
+//! image. Each declares its parameters once, as a typed struct
+//! (`crate::declare_params!`), and its name, description and components once
+//! (`TechniqueBuild`); the registry `TECHNIQUES` lists one line per technique.
 
 pub mod direct;
 pub mod image_space;
 pub mod volume_lines;
 pub mod water_photons;
 
-use crate::reference::Component;
-use crate::renderer::{FrameTargets, SceneGpu};
+use crate::frame::{FrameTargets, SceneGpu};
+use crate::params::{ParamSet, ParamSpec, Params};
+use crate::radiometry::Component;
 use crate::scene::Scene;
 use crate::vk::{Context, FrameRecorder, VkResult};
-use std::collections::BTreeMap;
 use std::sync::Arc;
-
-/// One tunable parameter of a technique.
-#[derive(Clone, Copy, Debug, serde::Serialize)]
-pub struct ParamSpec {
-    pub name: &'static str,
-    pub description: &'static str,
-    pub min: f32,
-    pub max: f32,
-    pub default: f32,
-    /// Whole numbers only (resolutions, counts).
-    pub integer: bool,
-}
-
-/// Parameter values by name, validated against a technique's specs.
-#[derive(Clone, Debug, Default)]
-pub struct Params {
-    values: BTreeMap<String, f32>,
-}
-
-impl Params {
-    /// Defaults from `specs`, overridden by `overrides` ("name=value" each).
-    /// Unknown names and out-of-range values are errors naming the parameter.
-    pub fn resolve(
-        technique: &str,
-        specs: &[ParamSpec],
-        overrides: &[String],
-    ) -> anyhow::Result<Params> {
-        let mut values: BTreeMap<String, f32> = specs
-            .iter()
-            .map(|s| (s.name.to_string(), s.default))
-            .collect();
-        for o in overrides {
-            let (name, value) = o
-                .split_once('=')
-                .ok_or_else(|| anyhow::anyhow!("--param {o:?}: expected NAME=VALUE"))?;
-            let spec = specs.iter().find(|s| s.name == name).ok_or_else(|| {
-                let known: Vec<_> = specs.iter().map(|s| s.name).collect();
-                anyhow::anyhow!(
-                    "--param {name}: technique `{technique}` has no such parameter (it has: {})",
-                    if known.is_empty() {
-                        "none".to_string()
-                    } else {
-                        known.join(", ")
-                    }
-                )
-            })?;
-            let v: f32 = value
-                .trim()
-                .parse()
-                .map_err(|_| anyhow::anyhow!("--param {name}: {value:?} is not a number"))?;
-            if !v.is_finite() || v < spec.min || v > spec.max || (spec.integer && v.fract() != 0.0)
-            {
-                anyhow::bail!(
-                    "--param {name}={value}: must be {} in [{}, {}]",
-                    if spec.integer {
-                        "a whole number"
-                    } else {
-                        "a number"
-                    },
-                    spec.min,
-                    spec.max
-                );
-            }
-            values.insert(name.to_string(), v);
-        }
-        Ok(Params { values })
-    }
-
-    pub fn get(&self, name: &str) -> f32 {
-        *self
-            .values
-            .get(name)
-            .unwrap_or_else(|| panic!("parameter {name} was not declared"))
-    }
-
-    pub fn iter(&self) -> impl Iterator<Item = (&String, &f32)> {
-        self.values.iter()
-    }
-}
 
 pub trait Technique {
     fn name(&self) -> &'static str;
@@ -111,6 +33,15 @@ pub trait Technique {
         false
     }
 
+    /// Takes new values of `Live` parameters (`params::Apply`) in place:
+    /// push constants and switches read at record time. Called by
+    /// `Renderer::set_params` only when every changed parameter is live,
+    /// with no frame in flight. Returns false (the default) when the
+    /// technique cannot, and the renderer rebuilds it.
+    fn update_live(&mut self, _params: &Params) -> anyhow::Result<bool> {
+        Ok(false)
+    }
+
     /// Called once the frame recorded by `record` has completed (after the
     /// renderer's fence wait): host-visible results of that frame are
     /// current, so this is where a technique reads them back and reports.
@@ -125,42 +56,84 @@ pub trait Technique {
     }
 }
 
-/// Every real-time technique: name, one-line description, parameters.
+/// What the registry needs of a technique type: its name, description and
+/// components, its typed parameters, and its constructor. Written once, in
+/// the technique's own module.
+pub trait TechniqueBuild: Technique + Sized + 'static {
+    const NAME: &'static str;
+    /// One line: the paper and what it renders (`caustics info`).
+    const DESCRIPTION: &'static str;
+    /// The path-type components it renders (the demo's C key and
+    /// `caustics render --component` pick among them).
+    const COMPONENTS: &'static [Component];
+    type Params: ParamSet;
+
+    fn build(
+        ctx: &Arc<Context>,
+        params: &Self::Params,
+        scene: &Scene,
+        scene_gpu: &SceneGpu,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<Self>;
+}
+
+/// Builds a `T` from validated values (`TechniqueInfo::create`).
+fn create<T: TechniqueBuild>(
+    ctx: &Arc<Context>,
+    params: &Params,
+    scene: &Scene,
+    scene_gpu: &SceneGpu,
+    width: u32,
+    height: u32,
+) -> anyhow::Result<Box<dyn Technique>> {
+    let params = T::Params::from_params(params)?;
+    Ok(Box::new(T::build(
+        ctx, &params, scene, scene_gpu, width, height,
+    )?))
+}
+
+/// The constructor of a registered technique.
+pub type CreateFn =
+    fn(&Arc<Context>, &Params, &Scene, &SceneGpu, u32, u32) -> anyhow::Result<Box<dyn Technique>>;
+
+/// A real-time technique in the registry.
 pub struct TechniqueInfo {
     pub name: &'static str,
     pub description: &'static str,
-    pub params: &'static [ParamSpec],
-    /// The path-type components it renders (the demo's C key and
-    /// `caustics render --component` pick among them).
+    /// The path-type components it renders.
     pub components: &'static [Component],
+    specs: fn() -> &'static [ParamSpec],
+    /// Builds it for frames of `width` x `height` from values validated
+    /// against `params()`.
+    pub create: CreateFn,
 }
 
-pub const TECHNIQUES: &[TechniqueInfo] = &[TechniqueInfo {
-    name: "direct",
-    description: "direct light with shadow maps (the base frame every technique adds to)",
-    params: direct::PARAMS,
-    components: &[Component::Direct],
-}, TechniqueInfo {
-    name: "image_space",
-    description: "Wyman 2005-06: two-sided image-space refraction of what the camera sees through glass (and in mirrors), and caustic maps (photons through the specular objects, Gaussian splats, projected onto diffuse receivers)",
-    params: image_space::PARAMS,
-    components: &[Component::Direct, Component::SurfaceCaustics],
-}, TechniqueInfo {
-    name: "volume_lines",
-    description: "Hu et al. 2010: volume caustics as lines (light rays after one reflection or two refractions, drawn by a geometry shader, Eq. 3 per fragment), plus ray-marched airlight with volumetric shadows, over image_space's surface radiance attenuated by the medium",
-    params: volume_lines::PARAMS,
-    components: &[
-        Component::Direct,
-        Component::SurfaceCaustics,
-        Component::Airlight,
-        Component::VolumeCaustics,
-    ],
-}, TechniqueInfo {
-    name: "water_photons",
-    description: "Kougianos & Moustakas 2021: cascaded caustic maps of the water from the sun, photon differentials traced through the BVH, splats drawn indirect into a screen-space caustic buffer",
-    params: water_photons::PARAMS,
-    components: &[Component::Direct, Component::SurfaceCaustics],
-}];
+impl TechniqueInfo {
+    pub const fn of<T: TechniqueBuild>() -> TechniqueInfo {
+        TechniqueInfo {
+            name: T::NAME,
+            description: T::DESCRIPTION,
+            components: T::COMPONENTS,
+            specs: <T::Params as ParamSet>::specs,
+            create: create::<T>,
+        }
+    }
+
+    /// Its parameters (`--param`, the overlay, `caustics info`).
+    pub fn params(&self) -> &'static [ParamSpec] {
+        (self.specs)()
+    }
+}
+
+/// Every real-time technique, one line each (the demo's number keys follow
+/// this order).
+pub const TECHNIQUES: &[TechniqueInfo] = &[
+    TechniqueInfo::of::<direct::Direct>(),
+    TechniqueInfo::of::<image_space::ImageSpace>(),
+    TechniqueInfo::of::<volume_lines::VolumeLines>(),
+    TechniqueInfo::of::<water_photons::WaterPhotons>(),
+];
 
 pub fn find(name: &str) -> anyhow::Result<&'static TechniqueInfo> {
     TECHNIQUES.iter().find(|t| t.name == name).ok_or_else(|| {
@@ -188,7 +161,7 @@ impl TechniqueInfo {
 }
 
 /// Builds the technique `name` for frames of `width` x `height`.
-pub fn create(
+pub fn create_named(
     ctx: &Arc<Context>,
     name: &str,
     params: &Params,
@@ -197,23 +170,5 @@ pub fn create(
     width: u32,
     height: u32,
 ) -> anyhow::Result<Box<dyn Technique>> {
-    Ok(match name {
-        "direct" => Box::new(direct::Direct::new(
-            ctx, params, scene, scene_gpu, width, height,
-        )?),
-        "image_space" => Box::new(image_space::ImageSpace::new(
-            ctx, params, scene, scene_gpu, width, height,
-        )?),
-        "volume_lines" => Box::new(volume_lines::VolumeLines::new(
-            ctx, params, scene, scene_gpu, width, height,
-        )?),
-        "water_photons" => Box::new(water_photons::WaterPhotons::new(
-            ctx, params, scene, scene_gpu, width, height,
-        )?),
-        other => {
-            return Err(find(other)
-                .err()
-                .unwrap_or_else(|| anyhow::anyhow!("technique `{other}` not built")))
-        }
-    })
+    (find(name)?.create)(ctx, params, scene, scene_gpu, width, height)
 }

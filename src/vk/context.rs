@@ -2,6 +2,7 @@
 //! validation messenger. One `Context` per process; everything else holds an
 //! `Arc<Context>` so the device is destroyed last.
 
+use super::device::{enumerate_devices, pick_device, query_device, DeviceInfo};
 use super::{VkError, VkResult};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
@@ -16,73 +17,15 @@ const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 pub struct ContextOptions {
     /// Turn on the Khronos validation layer and count its messages.
     pub validation: bool,
+    /// With `validation`, also turn on the layer's synchronization
+    /// validation (`VK_EXT_validation_features`,
+    /// `SYNCHRONIZATION_VALIDATION`): missing or wrong barriers between
+    /// commands are reported as errors (SYNC-HAZARD-*). Enabled only where
+    /// the layer exposes the extension; `Context::sync_validation` says
+    /// whether it is on.
+    pub sync_validation: bool,
     /// Pick a device by index (as `caustics info` lists) or by a substring of its name.
     pub device: Option<String>,
-}
-
-/// Every device feature the renderer relies on, checked at start-up.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RequiredFeature {
-    Vulkan13,
-    GeometryShader,
-    FragmentStoresAndAtomics,
-    VertexPipelineStoresAndAtomics,
-    BufferFloat32AtomicAdd,
-    TimestampQueries,
-    MultiDrawIndirect,
-    DynamicRendering,
-    Synchronization2,
-}
-
-impl RequiredFeature {
-    pub const ALL: [RequiredFeature; 9] = [
-        RequiredFeature::Vulkan13,
-        RequiredFeature::GeometryShader,
-        RequiredFeature::FragmentStoresAndAtomics,
-        RequiredFeature::VertexPipelineStoresAndAtomics,
-        RequiredFeature::BufferFloat32AtomicAdd,
-        RequiredFeature::TimestampQueries,
-        RequiredFeature::MultiDrawIndirect,
-        RequiredFeature::DynamicRendering,
-        RequiredFeature::Synchronization2,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            RequiredFeature::Vulkan13 => "Vulkan 1.3",
-            RequiredFeature::GeometryShader => "geometryShader",
-            RequiredFeature::FragmentStoresAndAtomics => "fragmentStoresAndAtomics",
-            RequiredFeature::VertexPipelineStoresAndAtomics => "vertexPipelineStoresAndAtomics",
-            RequiredFeature::BufferFloat32AtomicAdd => {
-                "shaderBufferFloat32AtomicAdd (VK_EXT_shader_atomic_float)"
-            }
-            RequiredFeature::TimestampQueries => "timestampComputeAndGraphics",
-            RequiredFeature::MultiDrawIndirect => "multiDrawIndirect",
-            RequiredFeature::DynamicRendering => "dynamicRendering",
-            RequiredFeature::Synchronization2 => "synchronization2",
-        }
-    }
-}
-
-/// What `caustics info` prints for one device.
-#[derive(Clone, Debug)]
-pub struct DeviceInfo {
-    pub index: usize,
-    pub name: String,
-    pub kind: vk::PhysicalDeviceType,
-    pub api_version: (u32, u32, u32),
-    pub driver: String,
-    pub features: Vec<(RequiredFeature, bool)>,
-}
-
-impl DeviceInfo {
-    pub fn missing(&self) -> Vec<RequiredFeature> {
-        self.features
-            .iter()
-            .filter(|(_, ok)| !ok)
-            .map(|(f, _)| *f)
-            .collect()
-    }
 }
 
 /// Validation messages counted by the debug messenger since start-up.
@@ -112,6 +55,9 @@ pub struct Context {
     /// Valid bits of a timestamp on the queue (for wrapping subtraction).
     pub timestamp_valid_bits: u32,
     pub limits: vk::PhysicalDeviceLimits,
+    /// Synchronization validation is on (`ContextOptions::sync_validation`
+    /// asked for it and the layer offers it).
+    pub sync_validation: bool,
     allocator: ManuallyDrop<Mutex<Allocator>>,
     debug_instance: Option<ash::ext::debug_utils::Instance>,
     debug_device: Option<ash::ext::debug_utils::Device>,
@@ -149,98 +95,35 @@ unsafe extern "system" fn debug_callback(
     vk::FALSE
 }
 
-fn cstr_array(raw: &[std::ffi::c_char]) -> String {
-    // SAFETY: Vulkan guarantees these fixed arrays are NUL-terminated.
-    unsafe { CStr::from_ptr(raw.as_ptr()) }
-        .to_string_lossy()
-        .into_owned()
-}
-
-fn query_device(instance: &ash::Instance, pd: vk::PhysicalDevice, index: usize) -> DeviceInfo {
-    unsafe {
-        let props = instance.get_physical_device_properties(pd);
-        let mut atomic = vk::PhysicalDeviceShaderAtomicFloatFeaturesEXT::default();
-        let mut v13 = vk::PhysicalDeviceVulkan13Features::default();
-        let has_atomic_ext = instance
-            .enumerate_device_extension_properties(pd)
-            .unwrap_or_default()
-            .iter()
-            .any(|e| e.extension_name_as_c_str() == Ok(ash::ext::shader_atomic_float::NAME));
-        let api = props.api_version;
-        let is_13 = vk::api_version_major(api) > 1 || vk::api_version_minor(api) >= 3;
-        let mut features2 = vk::PhysicalDeviceFeatures2::default();
-        if is_13 {
-            features2 = features2.push_next(&mut v13);
-        }
-        if has_atomic_ext {
-            features2 = features2.push_next(&mut atomic);
-        }
-        instance.get_physical_device_features2(pd, &mut features2);
-        let f = features2.features;
-        let mut driver_props = vk::PhysicalDeviceDriverProperties::default();
-        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver_props);
-        instance.get_physical_device_properties2(pd, &mut props2);
-        let features = RequiredFeature::ALL
-            .iter()
-            .map(|&r| {
-                let ok = match r {
-                    RequiredFeature::Vulkan13 => is_13,
-                    RequiredFeature::GeometryShader => f.geometry_shader == vk::TRUE,
-                    RequiredFeature::FragmentStoresAndAtomics => {
-                        f.fragment_stores_and_atomics == vk::TRUE
-                    }
-                    RequiredFeature::VertexPipelineStoresAndAtomics => {
-                        f.vertex_pipeline_stores_and_atomics == vk::TRUE
-                    }
-                    RequiredFeature::BufferFloat32AtomicAdd => {
-                        has_atomic_ext && atomic.shader_buffer_float32_atomic_add == vk::TRUE
-                    }
-                    RequiredFeature::TimestampQueries => {
-                        props.limits.timestamp_compute_and_graphics == vk::TRUE
-                    }
-                    RequiredFeature::MultiDrawIndirect => f.multi_draw_indirect == vk::TRUE,
-                    RequiredFeature::DynamicRendering => v13.dynamic_rendering == vk::TRUE,
-                    RequiredFeature::Synchronization2 => v13.synchronization2 == vk::TRUE,
-                };
-                (r, ok)
-            })
-            .collect();
-        DeviceInfo {
-            index,
-            name: cstr_array(&props.device_name),
-            kind: props.device_type,
-            api_version: (
-                vk::api_version_major(api),
-                vk::api_version_minor(api),
-                vk::api_version_patch(api),
-            ),
-            driver: format!(
-                "{} {}",
-                cstr_array(&driver_props.driver_name),
-                cstr_array(&driver_props.driver_info)
-            ),
-            features,
-        }
-    }
-}
-
-fn load_entry() -> VkResult<ash::Entry> {
+pub(super) fn load_entry() -> VkResult<ash::Entry> {
     // SAFETY: loading the system Vulkan loader; its symbols are trusted.
     unsafe { ash::Entry::load() }.map_err(|e| VkError::Loader(e.to_string()))
 }
 
-fn create_instance(
+/// The validation features an instance is created with.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Validation {
+    Off,
+    On,
+    /// On, with synchronization validation.
+    Sync,
+}
+
+/// Creates the instance; returns it and whether synchronization validation
+/// is on (asked for and offered by the layer).
+pub(super) fn create_instance(
     entry: &ash::Entry,
-    validation: bool,
+    validation: Validation,
     extra_extensions: &[*const std::ffi::c_char],
-) -> VkResult<ash::Instance> {
+) -> VkResult<(ash::Instance, bool)> {
     let app = vk::ApplicationInfo::default()
         .application_name(c"caustics")
         .engine_name(c"caustics")
         .api_version(vk::API_VERSION_1_3);
     let mut extensions: Vec<*const std::ffi::c_char> = extra_extensions.to_vec();
     let mut layers = Vec::new();
-    if validation {
+    let mut sync_validation = false;
+    if validation != Validation::Off {
         let available = unsafe { entry.enumerate_instance_layer_properties() }?;
         if !available
             .iter()
@@ -249,6 +132,23 @@ fn create_instance(
             return Err(VkError::NoValidationLayer);
         }
         layers.push(VALIDATION_LAYER.as_ptr());
+        if validation == Validation::Sync {
+            // The layer itself provides VK_EXT_validation_features.
+            sync_validation =
+                unsafe { entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER)) }?
+                    .iter()
+                    .any(|e| {
+                        e.extension_name_as_c_str() == Ok(ash::ext::validation_features::NAME)
+                    });
+            if sync_validation {
+                extensions.push(ash::ext::validation_features::NAME.as_ptr());
+            } else {
+                log::warn!(
+                    "the validation layer does not offer VK_EXT_validation_features: \
+                     synchronization validation stays off"
+                );
+            }
+        }
     }
     let has_debug_utils = unsafe { entry.enumerate_instance_extension_properties(None) }?
         .iter()
@@ -256,25 +156,17 @@ fn create_instance(
     if has_debug_utils {
         extensions.push(ash::ext::debug_utils::NAME.as_ptr());
     }
-    let info = vk::InstanceCreateInfo::default()
+    let enabled = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+    let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled);
+    let mut info = vk::InstanceCreateInfo::default()
         .application_info(&app)
         .enabled_layer_names(&layers)
         .enabled_extension_names(&extensions);
-    Ok(unsafe { entry.create_instance(&info, None) }?)
-}
-
-/// Lists every device with the features the renderer needs (`caustics info`).
-pub fn enumerate_devices() -> VkResult<Vec<DeviceInfo>> {
-    let entry = load_entry()?;
-    let instance = create_instance(&entry, false, &[])?;
-    let devices = unsafe { instance.enumerate_physical_devices() }?;
-    let infos = devices
-        .iter()
-        .enumerate()
-        .map(|(i, &pd)| query_device(&instance, pd, i))
-        .collect();
-    unsafe { instance.destroy_instance(None) };
-    Ok(infos)
+    if sync_validation {
+        info = info.push_next(&mut features);
+    }
+    let instance = unsafe { entry.create_instance(&info, None) }?;
+    Ok((instance, sync_validation))
 }
 
 impl Context {
@@ -293,7 +185,12 @@ impl Context {
         instance_extensions: &[*const std::ffi::c_char],
     ) -> VkResult<Arc<Context>> {
         let entry = load_entry()?;
-        let instance = create_instance(&entry, options.validation, instance_extensions)?;
+        let validation = match (options.validation, options.sync_validation) {
+            (false, _) => Validation::Off,
+            (true, false) => Validation::On,
+            (true, true) => Validation::Sync,
+        };
+        let (instance, sync_validation) = create_instance(&entry, validation, instance_extensions)?;
         let counters = Box::new(Counters {
             errors: AtomicU32::new(0),
             warnings: AtomicU32::new(0),
@@ -486,6 +383,7 @@ impl Context {
             timestamp_period: props.limits.timestamp_period as f64,
             timestamp_valid_bits,
             limits: props.limits,
+            sync_validation,
             info,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             debug_instance,
@@ -600,44 +498,6 @@ impl Context {
     pub fn wait_idle(&self) {
         let _ = unsafe { self.device.device_wait_idle() };
     }
-}
-
-fn pick_device(infos: &[DeviceInfo], wanted: Option<&str>) -> VkResult<usize> {
-    if infos.is_empty() {
-        return Err(VkError::NoDevice);
-    }
-    if let Some(w) = wanted {
-        if let Ok(i) = w.parse::<usize>() {
-            return if i < infos.len() {
-                Ok(i)
-            } else {
-                Err(VkError::DeviceNotFound(w.into()))
-            };
-        }
-        let lw = w.to_lowercase();
-        return infos
-            .iter()
-            .position(|d| d.name.to_lowercase().contains(&lw))
-            .ok_or_else(|| VkError::DeviceNotFound(w.into()));
-    }
-    // Prefer a discrete GPU with every feature, then any complete device, then
-    // whatever exists (the caller reports what it lacks).
-    let rank = |d: &DeviceInfo| {
-        let complete = d.missing().is_empty();
-        let kind = match d.kind {
-            vk::PhysicalDeviceType::DISCRETE_GPU => 0,
-            vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
-            vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
-            vk::PhysicalDeviceType::CPU => 3,
-            _ => 4,
-        };
-        (!complete, kind)
-    };
-    Ok(infos
-        .iter()
-        .min_by_key(|d| rank(d))
-        .map(|d| d.index)
-        .unwrap_or(0))
 }
 
 impl Context {

@@ -9,13 +9,15 @@
 //! frame used, so `Drop` never frees what the GPU may still read.
 
 mod context;
+mod device;
 mod pipeline;
 mod profiler;
 mod resources;
 mod swapchain;
 mod sync;
 
-pub use context::{Context, ContextOptions, DeviceInfo, RequiredFeature, ValidationCounts};
+pub use context::{Context, ContextOptions, ValidationCounts};
+pub use device::{DeviceInfo, RequiredFeature};
 pub use pipeline::{
     begin_rendering, begin_rendering_with_depth, end_rendering, BindingKind, ComputePipeline,
     DescriptorSet, DescriptorSetLayout, GraphicsPipeline, GraphicsPipelineDesc, Sampler,

@@ -2,7 +2,7 @@
 //! scenes built in code, camera rays, and image statistics.
 #![allow(dead_code)]
 
-use caustics::renderer::camera_matrices;
+use caustics::frame::camera_matrices;
 use caustics::scene::*;
 use caustics::vk::{Context, ContextOptions};
 use glam::{Mat4, Vec3};
@@ -10,12 +10,20 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 /// A context with the Khronos validation layer on; tests end with `assert_validation_clean`.
+/// A context with the validation layer and its synchronization validation
+/// on: any error, a hazard between commands included, fails the test
+/// (`assert_validation_clean`).
 pub fn validated_context() -> Arc<Context> {
-    Context::new(&ContextOptions {
+    let ctx = Context::new(&ContextOptions {
         validation: true,
+        sync_validation: true,
         device: None,
     })
-    .expect("Vulkan context with validation")
+    .expect("Vulkan context with validation");
+    if !ctx.sync_validation {
+        eprintln!("note: the validation layer offers no synchronization validation");
+    }
+    ctx
 }
 
 pub fn assert_validation_clean(ctx: &Context) {
@@ -317,8 +325,8 @@ pub fn write_comparison_pngs(
 /// through the technique (no tonemap), with its resources kept for reading.
 pub struct ImageSpaceFrame {
     pub tech: caustics::techniques::image_space::ImageSpace,
-    pub scene_gpu: caustics::renderer::SceneGpu,
-    pub targets: caustics::renderer::FrameTargets,
+    pub scene_gpu: caustics::frame::SceneGpu,
+    pub targets: caustics::frame::FrameTargets,
 }
 
 pub fn render_image_space(
@@ -327,11 +335,12 @@ pub fn render_image_space(
     overrides: &[&str],
     size: u32,
 ) -> ImageSpaceFrame {
-    use caustics::renderer::{FrameTargets, SceneGpu};
-    use caustics::techniques::image_space::{ImageSpace, PARAMS};
-    use caustics::techniques::{Params, Technique};
+    use caustics::frame::{FrameTargets, SceneGpu};
+    use caustics::params::ParamSet;
+    use caustics::techniques::image_space::{ImageSpace, ImageSpaceParams};
+    use caustics::techniques::Technique;
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let params = Params::resolve("image_space", PARAMS, &overrides).unwrap();
+    let params = ImageSpaceParams::parse("image_space", &overrides).unwrap();
     let scene_gpu = SceneGpu::new(ctx, scene, 0.0).unwrap();
     let targets = FrameTargets::new(ctx, size, size).unwrap();
     let mut tech = ImageSpace::new(ctx, &params, scene, &scene_gpu, size, size).unwrap();

@@ -55,11 +55,13 @@ mod refraction;
 
 pub use refraction::{CameraRefraction, RefractionPush};
 
-use super::direct::{self, Direct};
-use super::{ParamSpec, Params, Technique};
+use super::direct::{Direct, DirectParams};
+use super::{Technique, TechniqueBuild};
+use crate::frame::{FrameTargets, SceneGpu};
+use crate::params::{ParamSet, Params};
 use crate::passes::caustic_map::{CausticMap, PhotonPaths};
 use crate::passes::gbuffer::GBufferContents;
-use crate::renderer::{FrameTargets, SceneGpu};
+use crate::radiometry::Component;
 use crate::scene::Scene;
 use crate::shader_bindings as b;
 use crate::vk::{
@@ -69,75 +71,29 @@ use crate::vk::{
 use ash::vk;
 use std::sync::Arc;
 
-pub const PARAMS: &[ParamSpec] = &[
-    direct::SHADOW_MAP_SIZE,
-    direct::PCF_RADIUS,
-    direct::MEDIUM_STEPS,
-    ParamSpec {
-        name: "photon_buffer_size",
-        description: "photon buffer resolution (photons per side of the light view)",
-        min: 64.0,
-        max: 1024.0,
-        default: 512.0,
-        integer: true,
-    },
-    ParamSpec {
-        name: "caustic_map_size",
-        description: "caustic map resolution per light view (texels per side)",
-        min: 64.0,
-        max: 1024.0,
-        default: 512.0,
-        integer: true,
-    },
-    ParamSpec {
-        name: "splat_size",
-        description: "photon splat width in caustic-map texels (odd; an even value is raised by 1)",
-        min: 1.0,
-        max: 15.0,
-        default: 7.0,
-        integer: true,
-    },
-    ParamSpec {
-        name: "photon_mode",
-        description: "0: photon paths traced exactly through the BVH; 1: Wyman's two-sided image-space refraction from light-space front/back G-buffers (Eq. 6.3.1 distance); 2: the same G-buffers, the refracted ray marched against the back-face map (exact for convex objects)",
-        min: 0.0,
-        max: 2.0,
-        default: 0.0,
-        integer: true,
-    },
-    ParamSpec {
-        name: "tir_remedy",
-        description: "total internal reflection at the approximated exit (Wyman 2006's ad hoc remedies; camera and photon_mode 1): 0 single refraction (T2 = T1), 1 clamp to the critical angle (T2 tangent to the back face), 2 reflect and ignore the refractor. Default 1, of the two Wyman recommends (the first 'behaves poorly in dynamic scenes'): a reflected ray heads back toward the camera or the light, where the image-space search has no data and photons fly up past the light, while the clamped ray goes on through, as the light does on average",
-        min: 0.0,
-        max: 2.0,
-        default: 1.0,
-        integer: true,
-    },
-    ParamSpec {
-        name: "eq_6_3_2",
-        description: "1: where d~ overshoots and the back-face texel holds no normal, use Wyman's Eq. 6.3.2 (N2 = T1 - (V.T1) V, the exit through the side); 0: drop the transmitted light there",
-        min: 0.0,
-        max: 1.0,
-        default: 1.0,
-        integer: true,
-    },
-    ParamSpec {
-        name: "search_steps",
-        description: "linear steps of the image-space search of refracted and reflected camera rays against the opaque frame (then 10 bisections)",
-        min: 4.0,
-        max: 256.0,
-        default: 32.0,
-        integer: true,
-    },
-    ParamSpec {
-        name: "caustics_on_change",
-        description: "1: recompute the caustic map only when a light moved or animated geometry changed, reusing the last one otherwise; 0: every frame (benchmarks)",
-        min: 0.0,
-        max: 1.0,
-        default: 0.0,
-        integer: true,
-    },
-];
+crate::declare_params! {
+    /// `image_space`'s parameters: `Direct`'s, then the caustic map's and
+    /// the camera refraction's.
+    pub struct ImageSpaceParams {
+        @group direct: DirectParams;
+        photon_buffer_size: u32 [64, 1024] = 512, rebuild,
+            "photon buffer resolution (photons per side of the light view)";
+        caustic_map_size: u32 [64, 1024] = 512, rebuild,
+            "caustic map resolution per light view (texels per side)";
+        splat_size: u32 [1, 15] = 7, rebuild,
+            "photon splat width in caustic-map texels (odd; an even value is raised by 1)";
+        photon_mode: u32 [0, 2] = 0, rebuild,
+            "0: photon paths traced exactly through the BVH; 1: Wyman's two-sided image-space refraction from light-space front/back G-buffers (Eq. 6.3.1 distance); 2: the same G-buffers, the refracted ray marched against the back-face map (exact for convex objects)";
+        tir_remedy: u32 [0, 2] = 1, rebuild,
+            "total internal reflection at the approximated exit (Wyman 2006's ad hoc remedies; camera and photon_mode 1): 0 single refraction (T2 = T1), 1 clamp to the critical angle (T2 tangent to the back face), 2 reflect and ignore the refractor. Default 1, of the two Wyman recommends (the first 'behaves poorly in dynamic scenes'): a reflected ray heads back toward the camera or the light, where the image-space search has no data and photons fly up past the light, while the clamped ray goes on through, as the light does on average";
+        eq_6_3_2: u32 [0, 1] = 1, rebuild,
+            "1: where d~ overshoots and the back-face texel holds no normal, use Wyman's Eq. 6.3.2 (N2 = T1 - (V.T1) V, the exit through the side); 0: drop the transmitted light there";
+        search_steps: u32 [4, 256] = 32, live,
+            "linear steps of the image-space search of refracted and reflected camera rays against the opaque frame (then 10 bisections)";
+        caustics_on_change: bool [0, 1] = 0, live,
+            "1: recompute the caustic map only when a light moved or animated geometry changed, reusing the last one otherwise; 0: every frame (benchmarks)";
+    }
+}
 
 pub struct ImageSpace {
     /// Direct light on the opaque scene (its G-buffer leaves the specular
@@ -164,7 +120,7 @@ pub struct ImageSpace {
 impl ImageSpace {
     pub fn new(
         ctx: &Arc<Context>,
-        params: &Params,
+        params: &ImageSpaceParams,
         scene: &Scene,
         scene_gpu: &SceneGpu,
         width: u32,
@@ -172,7 +128,7 @@ impl ImageSpace {
     ) -> VkResult<Self> {
         let direct = Direct::with_contents(
             ctx,
-            params,
+            &params.direct,
             scene,
             scene_gpu,
             width,
@@ -180,20 +136,20 @@ impl ImageSpace {
             GBufferContents::Opaque,
         )?;
         let opaque = FrameTargets::new(ctx, width, height)?;
-        let tir_remedy = params.get("tir_remedy") as u32;
-        let use_eq632 = params.get("eq_6_3_2") as u32;
+        let tir_remedy = params.tir_remedy;
+        let use_eq632 = params.eq_6_3_2;
         let caustics = CausticMap::new(
             ctx,
             scene,
             scene_gpu,
-            params.get("photon_buffer_size") as u32,
-            params.get("caustic_map_size") as u32,
-            params.get("splat_size") as u32,
+            params.photon_buffer_size,
+            params.caustic_map_size,
+            params.splat_size,
             PhotonPaths {
-                mode: params.get("photon_mode") as u32,
+                mode: params.photon_mode,
                 tir_remedy,
                 use_eq632: use_eq632 != 0,
-                medium_steps: params.get("medium_steps") as u32,
+                medium_steps: params.direct.medium_steps,
             },
         )?;
         let layout = DescriptorSetLayout::new(
@@ -232,7 +188,7 @@ impl ImageSpace {
             RefractionPush {
                 tir_remedy,
                 use_eq632,
-                search_steps: params.get("search_steps") as u32,
+                search_steps: params.search_steps,
                 pad: 0,
             },
         )?;
@@ -243,7 +199,7 @@ impl ImageSpace {
             refraction,
             apply,
             set,
-            caustics_on_change: params.get("caustics_on_change") != 0.0,
+            caustics_on_change: params.caustics_on_change,
             caustics_geometry_time: None,
             _layout: layout,
             _sampler: sampler,
@@ -251,9 +207,44 @@ impl ImageSpace {
     }
 }
 
+impl TechniqueBuild for ImageSpace {
+    const NAME: &'static str = "image_space";
+    const DESCRIPTION: &'static str = "Wyman 2005-06: two-sided image-space refraction of what the camera sees through glass (and in mirrors), and caustic maps (photons through the specular objects, Gaussian splats, projected onto diffuse receivers)";
+    const COMPONENTS: &'static [Component] = &[Component::Direct, Component::SurfaceCaustics];
+    type Params = ImageSpaceParams;
+
+    fn build(
+        ctx: &Arc<Context>,
+        params: &ImageSpaceParams,
+        scene: &Scene,
+        scene_gpu: &SceneGpu,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<Self> {
+        Ok(Self::new(ctx, params, scene, scene_gpu, width, height)?)
+    }
+}
+
+impl ImageSpace {
+    /// Takes the live parameters of `params`.
+    pub fn set_live(&mut self, params: &ImageSpaceParams) {
+        self.direct.set_live(&params.direct);
+        self.refraction.set_search_steps(params.search_steps);
+        if params.caustics_on_change != self.caustics_on_change {
+            self.caustics_on_change = params.caustics_on_change;
+            self.caustics_geometry_time = None;
+        }
+    }
+}
+
 impl Technique for ImageSpace {
     fn name(&self) -> &'static str {
-        "image_space"
+        Self::NAME
+    }
+
+    fn update_live(&mut self, params: &Params) -> anyhow::Result<bool> {
+        self.set_live(&ImageSpaceParams::from_params(params)?);
+        Ok(true)
     }
 
     fn record(

@@ -6,9 +6,9 @@
 //! Fresnel-weighted reflection plus the twice-refracted ray, each found in
 //! the opaque frame by an image-space search, into the frame's radiance.
 
+use crate::frame::{FrameTargets, SceneGpu};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::specular_gbuffer::{SpecularGBuffer, Viewpoint};
-use crate::renderer::{FrameTargets, SceneGpu};
 use crate::shader_bindings as b;
 use crate::vk::{
     barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
@@ -41,6 +41,11 @@ pub struct CameraRefraction {
 }
 
 impl CameraRefraction {
+    /// Linear steps of the image-space search (a push constant: live).
+    pub fn set_search_steps(&mut self, steps: u32) {
+        self.push.search_steps = steps;
+    }
+
     /// `opaque` is the frame of the scene without its specular surfaces and
     /// `opaque_gbuffer` its G-buffer (positions: the depth image searched).
     pub fn new(

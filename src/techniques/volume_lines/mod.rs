@@ -83,12 +83,14 @@
 //! `--component` writes each alone (direct and surface_caustics are C's
 //! two parts, airlight is A, volume_caustics is B).
 
-use super::image_space::{self, ImageSpace};
-use super::{ParamSpec, Params, Technique};
-use crate::passes::airlight::{self, Airlight};
+use super::image_space::{ImageSpace, ImageSpaceParams};
+use super::{Technique, TechniqueBuild};
+use crate::frame::{FrameTargets, SceneGpu};
+use crate::params::{ParamSet, Params};
+use crate::passes::airlight::{Airlight, AirlightParams};
 use crate::passes::caustic_map::{photon_view, photon_view_proj, specular_bounds, PhotonViewPush};
 use crate::passes::specular_gbuffer::{SpecularGBuffer, Viewpoint};
-use crate::renderer::{FrameTargets, SceneGpu};
+use crate::radiometry::Component;
 use crate::scene::{Density, Light, Scene};
 use crate::shader_bindings as b;
 use crate::vk::{
@@ -102,79 +104,24 @@ use glam::Vec3;
 use std::mem::size_of;
 use std::sync::Arc;
 
-pub const VOLUME_BUFFER_SIZE: ParamSpec = ParamSpec {
-    name: "volume_buffer_size",
-    description: "volume caustic buffer resolution (light rays per side of the light's view of the specular objects)",
-    min: 64.0,
-    max: 2048.0,
-    default: 512.0,
-    integer: true,
-};
-pub const RAY_STEP: ParamSpec = ParamSpec {
-    name: "ray_step",
-    description: "Delta_x (m): the regular ray-marching step the line contributions are redistributed to (Hu Eq. 3, Fig. 5)",
-    min: 0.005,
-    max: 5.0,
-    default: 0.2,
-    integer: false,
-};
-pub const FILTER_RADIUS: ParamSpec = ParamSpec {
-    name: "filter_radius",
-    description: "r (m): support of the normalised Gaussian that spreads a line's contribution over the step points (Hu uses r = Delta_x; at most 16 Delta_x; below Delta_x / 2 some lines reach no step point and are lost)",
-    min: 0.005,
-    max: 5.0,
-    default: 0.2,
-    integer: false,
-};
-pub const TRANSMITTANCE_STEPS: ParamSpec = ParamSpec {
-    name: "transmittance_steps",
-    description: "midpoint-rule samples per transmittance integral in inhomogeneous media (Hu Sect. 5.4; homogeneous media are exact)",
-    min: 1.0,
-    max: 64.0,
-    default: 4.0,
-    integer: true,
-};
-
-pub const FRONT_REFLECTION: ParamSpec = ParamSpec {
-    name: "front_reflection",
-    description: "1: also draw the light reflected off a dielectric's front face (Fresnel F0; part of L S+ V, 14% of volume_cone's volume caustic at g = 0, but long lines across the whole medium: most of the fragments); 0: Hu's two-bounce refraction only",
-    min: 0.0,
-    max: 1.0,
-    default: 1.0,
-    integer: true,
-};
-
-/// B's own parameters, then A's (`passes::airlight`).
-const OWN_PARAMS: &[ParamSpec] = &[
-    VOLUME_BUFFER_SIZE,
-    RAY_STEP,
-    FILTER_RADIUS,
-    TRANSMITTANCE_STEPS,
-    FRONT_REFLECTION,
-    airlight::AIRLIGHT_STEPS,
-    airlight::AIRLIGHT_JITTER,
-];
-const PARAM_COUNT: usize = image_space::PARAMS.len() + OWN_PARAMS.len();
-/// `a` followed by `b` (a compile-time error unless they fill all N).
-const fn concat<const N: usize>(a: &[ParamSpec], b: &[ParamSpec]) -> [ParamSpec; N] {
-    let mut out = [b[0]; N];
-    let mut i = 0;
-    while i < a.len() {
-        out[i] = a[i];
-        i += 1;
+crate::declare_params! {
+    /// `volume_lines`' parameters: image_space's (passed through to C,
+    /// whatever they are) and the airlight's (A), then B's own.
+    pub struct VolumeLinesParams {
+        @group image_space: ImageSpaceParams;
+        @group airlight: AirlightParams;
+        volume_buffer_size: u32 [64, 2048] = 512, rebuild,
+            "volume caustic buffer resolution (light rays per side of the light's view of the specular objects)";
+        ray_step: f32 [0.005, 5.0] = 0.2, rebuild,
+            "Delta_x (m): the regular ray-marching step the line contributions are redistributed to (Hu Eq. 3, Fig. 5)";
+        filter_radius: f32 [0.005, 5.0] = 0.2, rebuild,
+            "r (m): support of the normalised Gaussian that spreads a line's contribution over the step points (Hu uses r = Delta_x; at most 16 Delta_x; below Delta_x / 2 some lines reach no step point and are lost)";
+        transmittance_steps: u32 [1, 64] = 4, rebuild,
+            "midpoint-rule samples per transmittance integral in inhomogeneous media (Hu Sect. 5.4; homogeneous media are exact)";
+        front_reflection: bool [0, 1] = 1, rebuild,
+            "1: also draw the light reflected off a dielectric's front face (Fresnel F0; part of L S+ V, 14% of volume_cone's volume caustic at g = 0, but long lines across the whole medium: most of the fragments); 0: Hu's two-bounce refraction only";
     }
-    let mut j = 0;
-    while j < b.len() {
-        out[a.len() + j] = b[j];
-        j += 1;
-    }
-    out
 }
-const ALL_PARAMS: [ParamSpec; PARAM_COUNT] = concat(image_space::PARAMS, OWN_PARAMS);
-
-/// image_space's parameters (passed through to C, whatever they are)
-/// followed by B's and A's.
-pub const PARAMS: &[ParamSpec] = &ALL_PARAMS;
 
 /// Most regular step points a fragment visits (glsl/volume_lines/lines.frag).
 const MAX_RADIUS_IN_STEPS: f32 = 16.0;
@@ -252,23 +199,31 @@ pub struct VolumeLines {
 impl VolumeLines {
     pub fn new(
         ctx: &Arc<Context>,
-        params: &Params,
+        params: &VolumeLinesParams,
         scene: &Scene,
         scene_gpu: &SceneGpu,
         width: u32,
         height: u32,
     ) -> anyhow::Result<Self> {
-        let step = params.get(RAY_STEP.name);
-        let radius = params.get(FILTER_RADIUS.name);
+        let step = params.ray_step;
+        let radius = params.filter_radius;
         if radius > MAX_RADIUS_IN_STEPS * step {
             anyhow::bail!(
                 "--param filter_radius={radius}: must be at most {MAX_RADIUS_IN_STEPS} x ray_step ({})",
                 MAX_RADIUS_IN_STEPS * step
             );
         }
-        let image_space = ImageSpace::new(ctx, params, scene, scene_gpu, width, height)?;
-        let airlight = Airlight::new(ctx, params, scene, scene_gpu, &image_space.direct.shadows)?;
-        let n = params.get(VOLUME_BUFFER_SIZE.name) as u32;
+        let image_space =
+            ImageSpace::new(ctx, &params.image_space, scene, scene_gpu, width, height)?;
+        let airlight = Airlight::new(
+            ctx,
+            &params.airlight,
+            params.image_space.direct.medium_steps,
+            scene,
+            scene_gpu,
+            &image_space.direct.shadows,
+        )?;
+        let n = params.volume_buffer_size;
         let segments = Buffer::new(
             ctx,
             "volume caustic buffer",
@@ -381,7 +336,7 @@ impl VolumeLines {
         desc.topology = vk::PrimitiveTopology::POINT_LIST;
         desc.push_size = size_of::<LinePush>() as u32;
         let line_pipeline = GraphicsPipeline::new(ctx, &desc, &sets)?;
-        let transmittance_steps = params.get(TRANSMITTANCE_STEPS.name) as u32;
+        let transmittance_steps = params.transmittance_steps;
         Ok(Self {
             image_space,
             airlight,
@@ -389,7 +344,7 @@ impl VolumeLines {
             volume,
             light_view,
             buffer_size: n,
-            draw_count: if params.get(FRONT_REFLECTION.name) != 0.0 {
+            draw_count: if params.front_reflection {
                 2 * n * n
             } else {
                 n * n
@@ -403,8 +358,8 @@ impl VolumeLines {
                 .collect(),
             specular: specular_bounds(scene),
             segment_params: [
-                params.get("tir_remedy") as u32,
-                params.get("eq_6_3_2") as u32,
+                params.image_space.tir_remedy,
+                params.image_space.eq_6_3_2,
                 transmittance_steps,
                 radius.to_bits(),
             ],
@@ -438,9 +393,39 @@ impl VolumeLines {
     }
 }
 
+impl TechniqueBuild for VolumeLines {
+    const NAME: &'static str = "volume_lines";
+    const DESCRIPTION: &'static str = "Hu et al. 2010: volume caustics as lines (light rays after one reflection or two refractions, drawn by a geometry shader, Eq. 3 per fragment), plus ray-marched airlight with volumetric shadows, over image_space's surface radiance attenuated by the medium";
+    const COMPONENTS: &'static [Component] = &[
+        Component::Direct,
+        Component::SurfaceCaustics,
+        Component::Airlight,
+        Component::VolumeCaustics,
+    ];
+    type Params = VolumeLinesParams;
+
+    fn build(
+        ctx: &Arc<Context>,
+        params: &VolumeLinesParams,
+        scene: &Scene,
+        scene_gpu: &SceneGpu,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<Self> {
+        Self::new(ctx, params, scene, scene_gpu, width, height)
+    }
+}
+
 impl Technique for VolumeLines {
     fn name(&self) -> &'static str {
-        "volume_lines"
+        Self::NAME
+    }
+
+    fn update_live(&mut self, params: &Params) -> anyhow::Result<bool> {
+        let params = VolumeLinesParams::from_params(params)?;
+        self.image_space.set_live(&params.image_space);
+        self.airlight.set_live(&params.airlight);
+        Ok(true)
     }
 
     fn record(

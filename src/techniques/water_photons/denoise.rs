@@ -47,7 +47,6 @@
 
 use crate::scene::{Camera, Light, LightKind, Scene};
 use crate::shader_bindings as b;
-use crate::techniques::{ParamSpec, Params};
 use crate::vk::{
     barrier, copy_image, Access, BindingKind, ComputePipeline, Context, DescriptorSet,
     DescriptorSetLayout, FrameRecorder, Image, ImageAccess, ImageDesc, Profiler, TimingSource,
@@ -57,35 +56,17 @@ use ash::vk;
 use glam::Vec3;
 use std::sync::Arc;
 
-/// `denoise`: which denoiser runs (0 none, 1 adaptive, 2 fixed).
-pub const DENOISE: ParamSpec = ParamSpec {
-    name: "denoise",
-    description: "caustics denoiser: 0 none, 1 adaptive radius (Kougianos 2021 Eqs. 25-28), 2 fixed radius (refs [6, 10])",
-    min: 0.0,
-    max: 2.0,
-    default: 1.0,
-    integer: true,
-};
-/// `denoise_passes`: passes, each a sub-pass along x then along y.
-pub const DENOISE_PASSES: ParamSpec = ParamSpec {
-    name: "denoise_passes",
-    description: "denoise passes, each a sub-pass along x then along y",
-    min: 1.0,
-    max: 16.0,
-    default: 1.0,
-    integer: true,
-};
-/// `denoise_radius`: the fixed-radius denoiser's kernel radius.
-pub const DENOISE_RADIUS: ParamSpec = ParamSpec {
-    name: "denoise_radius",
-    description: "kernel radius in pixels of the fixed-radius denoiser",
-    min: 1.0,
-    max: 32.0,
-    default: 5.0,
-    integer: true,
-};
-/// The denoiser's parameters (the `water_photons` technique lists them).
-pub const DENOISE_PARAMS: &[ParamSpec] = &[DENOISE, DENOISE_PASSES, DENOISE_RADIUS];
+crate::declare_params! {
+    /// The denoiser's parameters, a group of `water_photons`'.
+    pub struct DenoiseParams {
+        denoise: u32 [0, 2] = 1, rebuild,
+            "caustics denoiser: 0 none, 1 adaptive radius (Kougianos 2021 Eqs. 25-28), 2 fixed radius (refs [6, 10])";
+        denoise_passes: u32 [1, 16] = 1, rebuild,
+            "denoise passes, each a sub-pass along x then along y";
+        denoise_radius: u32 [1, 32] = 5, rebuild,
+            "kernel radius in pixels of the fixed-radius denoiser";
+    }
+}
 
 /// Eq. 25's experimentally defined constant.
 pub const C_SCENE_FACTOR: f32 = 0.114;
@@ -127,17 +108,17 @@ pub struct DenoiseConfig {
 }
 
 impl DenoiseConfig {
-    /// From `DENOISE_PARAMS` values; `None` when `denoise` = 0 (off).
-    pub fn from_params(params: &Params) -> Option<DenoiseConfig> {
-        let kind = match params.get("denoise") as u32 {
+    /// From the parameters; `None` when `denoise` = 0 (off).
+    pub fn from_params(params: &DenoiseParams) -> Option<DenoiseConfig> {
+        let kind = match params.denoise {
             0 => return None,
             1 => DenoiseKind::Adaptive,
             _ => DenoiseKind::Fixed,
         };
         Some(DenoiseConfig {
             kind,
-            passes: params.get("denoise_passes") as u32,
-            fixed_radius: params.get("denoise_radius") as u32,
+            passes: params.denoise_passes,
+            fixed_radius: params.denoise_radius,
         })
     }
 }
@@ -294,7 +275,7 @@ impl Denoiser {
     /// `DenoiseConfig::from_params`, then `new`; `None` when switched off.
     pub fn from_params(
         ctx: &Arc<Context>,
-        params: &Params,
+        params: &DenoiseParams,
         caustics: &Image,
         position: &Image,
     ) -> anyhow::Result<Option<Self>> {

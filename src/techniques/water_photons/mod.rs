@@ -103,17 +103,19 @@ mod splat;
 mod trace;
 
 pub use ccm::Ccm;
-pub use denoise::{Denoiser, DENOISE, DENOISE_PASSES, DENOISE_RADIUS};
+pub use denoise::{DenoiseParams, Denoiser};
 pub use splat::{Composite, Splat};
 pub use trace::{GpuWaterPhoton, PhotonCounts, Trace, GUARD_PHOTONS, GUARD_WORD};
 
-use super::direct::{self, Direct};
+use super::direct::{Direct, DirectParams};
 use super::image_space::{CameraRefraction, RefractionPush};
-use super::{ParamSpec, Params, Technique};
+use super::{Technique, TechniqueBuild};
 use crate::cascades::{inner_cascade_size, light_position, CascadeLayout, LightRange};
+use crate::frame::{FrameTargets, SceneGpu};
 use crate::gpu::GpuFrame;
+use crate::params::{ParamSet, Params};
 use crate::passes::gbuffer::GBufferContents;
-use crate::renderer::{FrameTargets, SceneGpu};
+use crate::radiometry::Component;
 use crate::scene::{Light, LightKind, Scene, Water};
 use crate::shader_bindings as b;
 use crate::vk::{Buffer, BufferUsage, Context, FrameRecorder, VkResult};
@@ -123,134 +125,44 @@ use glam::{Mat4, Vec3};
 use std::mem::size_of;
 use std::sync::Arc;
 
-pub const PARAMS: &[ParamSpec] = &[
-    direct::SHADOW_MAP_SIZE,
-    direct::PCF_RADIUS,
-    direct::MEDIUM_STEPS,
-    ParamSpec {
-        name: "cascades",
-        description: "N, the number of cascaded caustic maps (Eqs. 4-5)",
-        min: 1.0,
-        max: b::WP_MAX_CASCADES as f32,
-        default: 2.0,
-        integer: true,
-    },
-    ParamSpec {
-        name: "cascade_scale",
-        description: "s, each cascade covers s times the extent of the previous one (Eq. 2)",
-        min: 1.25,
-        max: 8.0,
-        default: 2.0,
-        integer: false,
-    },
-    ParamSpec {
-        name: "ccm_size",
-        description: "ccm_0, texels per side of every cascade (Eq. 3 picks 256-2048 from range / precision)",
-        min: 16.0,
-        max: 2048.0,
-        default: 512.0,
-        integer: true,
-    },
-    ParamSpec {
-        name: "ccm_precision",
-        description: "p of Eq. 3 in metres per texel: ccm_0 is then the smallest of 256, 512, 1024, 2048 covering the range; 0: ccm_size decides",
-        min: 0.0,
-        max: 1000.0,
-        default: 0.0,
-        integer: false,
-    },
-    ParamSpec {
-        name: "light_range",
-        description: "width (= height) r of the innermost cascade in metres; 0: the outermost cascade just covers the water",
-        min: 0.0,
-        max: 100000.0,
-        default: 0.0,
-        integer: false,
-    },
-    ParamSpec {
-        name: "photon_capacity",
-        description: "photon buffer size; 0: twice the threads of Eq. 5 (a reflected and a refracted photon each, never overflows)",
-        min: 0.0,
-        max: 33554432.0,
-        default: 0.0,
-        integer: true,
-    },
-    ParamSpec {
-        name: "splat_mode",
-        description: "0: the photon differential's footprint (exact flux density); 1: Eqs. 16-19's quad sized by σ; 2: fixed splats (Eqs. 16-19 with σ = s^c, no differentials)",
-        min: 0.0,
-        max: 2.0,
-        default: 0.0,
-        integer: true,
-    },
-    ParamSpec {
-        name: "intensity_mode",
-        description: "0: physical (exact Fresnel, photon flux = E x texel area, absorption); 1: the paper's Eqs. 12-15 (attenuation, stylised Fresnel)",
-        min: 0.0,
-        max: 1.0,
-        default: 0.0,
-        integer: true,
-    },
-    ParamSpec {
-        name: "quad_size",
-        description: "q_0 of Eq. 16 in texel pitches (splat modes 1, 2); 1 makes the box splats tile a flat surface",
-        min: 0.25,
-        max: 16.0,
-        default: 1.0,
-        integer: false,
-    },
-    ParamSpec {
-        name: "fresnel_frac",
-        description: "F_frac of Eq. 14 (intensity_mode 1)",
-        min: 0.0,
-        max: 1.0,
-        default: 0.02,
-        integer: false,
-    },
-    ParamSpec {
-        name: "fresnel_exp",
-        description: "F_exp of Eq. 14 (intensity_mode 1)",
-        min: 0.1,
-        max: 16.0,
-        default: 5.0,
-        integer: false,
-    },
-    ParamSpec {
-        name: "attenuation_gamma",
-        description: "γ of Eq. 13, the focus bias (intensity_mode 1)",
-        min: 0.01,
-        max: 0.99,
-        default: 0.95,
-        integer: false,
-    },
-    ParamSpec {
-        name: "attenuation_t_max",
-        description: "t_max of Eq. 13 in metres (intensity_mode 1)",
-        min: 0.01,
-        max: 100000.0,
-        default: 20.0,
-        integer: false,
-    },
-    ParamSpec {
-        name: "depth_bias",
-        description: "splats move toward the camera by this fraction of their distance before the depth test (along the view ray: the image does not move); 0.001 lets ocean_large's far seabed reject its own splats",
-        min: 0.0,
-        max: 0.1,
-        default: 0.01,
-        integer: false,
-    },
-    DENOISE,
-    DENOISE_PASSES,
-    DENOISE_RADIUS,
-    ParamSpec {
-        name: "search_steps",
-        description: "linear steps of the camera refraction's image-space search (image_space)",
-        min: 4.0,
-        max: 256.0,
-        default: 32.0,
-        integer: true,
-    },
-];
+crate::declare_params! {
+    /// `water_photons`' parameters: `Direct`'s, the denoiser's, then the
+    /// cascades', photons' and splats'.
+    pub struct WaterPhotonsParams {
+        @group direct: DirectParams;
+        @group denoise: DenoiseParams;
+        cascades: u32 [1, b::WP_MAX_CASCADES] = 2, rebuild,
+            "N, the number of cascaded caustic maps (Eqs. 4-5)";
+        cascade_scale: f32 [1.25, 8.0] = 2.0, rebuild,
+            "s, each cascade covers s times the extent of the previous one (Eq. 2)";
+        ccm_size: u32 [16, 2048] = 512, rebuild,
+            "ccm_0, texels per side of every cascade (Eq. 3 picks 256-2048 from range / precision)";
+        ccm_precision: f32 [0.0, 1000.0] = 0.0, rebuild,
+            "p of Eq. 3 in metres per texel: ccm_0 is then the smallest of 256, 512, 1024, 2048 covering the range; 0: ccm_size decides";
+        light_range: f32 [0.0, 100000.0] = 0.0, rebuild,
+            "width (= height) r of the innermost cascade in metres; 0: the outermost cascade just covers the water";
+        photon_capacity: u32 [0, 33554432] = 0, rebuild,
+            "photon buffer size; 0: twice the threads of Eq. 5 (a reflected and a refracted photon each, never overflows)";
+        splat_mode: u32 [0, 2] = 0, rebuild,
+            "0: the photon differential's footprint (exact flux density); 1: Eqs. 16-19's quad sized by σ; 2: fixed splats (Eqs. 16-19 with σ = s^c, no differentials)";
+        intensity_mode: u32 [0, 1] = 0, rebuild,
+            "0: physical (exact Fresnel, photon flux = E x texel area, absorption); 1: the paper's Eqs. 12-15 (attenuation, stylised Fresnel)";
+        quad_size: f32 [0.25, 16.0] = 1.0, rebuild,
+            "q_0 of Eq. 16 in texel pitches (splat modes 1, 2); 1 makes the box splats tile a flat surface";
+        fresnel_frac: f32 [0.0, 1.0] = 0.02, rebuild,
+            "F_frac of Eq. 14 (intensity_mode 1)";
+        fresnel_exp: f32 [0.1, 16.0] = 5.0, rebuild,
+            "F_exp of Eq. 14 (intensity_mode 1)";
+        attenuation_gamma: f32 [0.01, 0.99] = 0.95, rebuild,
+            "γ of Eq. 13, the focus bias (intensity_mode 1)";
+        attenuation_t_max: f32 [0.01, 100000.0] = 20.0, rebuild,
+            "t_max of Eq. 13 in metres (intensity_mode 1)";
+        depth_bias: f32 [0.0, 0.1] = 0.01, rebuild,
+            "splats move toward the camera by this fraction of their distance before the depth test (along the view ray: the image does not move); 0.001 lets ocean_large's far seabed reject its own splats";
+        search_steps: u32 [4, 256] = 32, live,
+            "linear steps of the camera refraction's image-space search (image_space)";
+    }
+}
 
 /// The uniform block `WpParams` of glsl/water_photons/common.glsl (std140).
 #[repr(C)]
@@ -395,7 +307,7 @@ fn first_directional(lights: &[Light]) -> Option<&Light> {
 impl WaterPhotons {
     pub fn new(
         ctx: &Arc<Context>,
-        params: &Params,
+        params: &WaterPhotonsParams,
         scene: &Scene,
         scene_gpu: &SceneGpu,
         width: u32,
@@ -408,10 +320,10 @@ impl WaterPhotons {
             .context("water_photons needs a `water` object in the scene")?;
         let light = *first_directional(&scene.lights)
             .context("water_photons needs a directional light (the paper's sun)")?;
-        let levels = params.get("cascades") as u32;
-        let scale = params.get("cascade_scale");
-        let range_param = params.get("light_range");
-        let precision = params.get("ccm_precision");
+        let levels = params.cascades;
+        let scale = params.cascade_scale;
+        let range_param = params.light_range;
+        let precision = params.ccm_precision;
         let size = if precision > 0.0 {
             // Eq. 3 from the range, which does not depend on ccm_0.
             let probe = CascadeLayout::new([256, 256], levels, scale)?;
@@ -424,7 +336,7 @@ impl WaterPhotons {
             );
             inner_cascade_size(&frame.range, precision)
         } else {
-            params.get("ccm_size") as u32
+            params.ccm_size
         };
         let layout = CascadeLayout::new([size, size], levels, scale)?;
         let frame = CascadeFrame::new(
@@ -439,7 +351,7 @@ impl WaterPhotons {
         let photon_bytes = size_of::<GpuWaterPhoton>() as u64;
         let device_max =
             ctx.limits.max_storage_buffer_range as u64 / photon_bytes - GUARD_PHOTONS as u64;
-        let capacity = match params.get("photon_capacity") as u64 {
+        let capacity = match params.photon_capacity as u64 {
             0 => {
                 let wanted = 2 * layout.total_threads();
                 if wanted > device_max {
@@ -459,7 +371,7 @@ impl WaterPhotons {
         let capacity = capacity as u32;
         let direct = Direct::with_contents(
             ctx,
-            params,
+            &params.direct,
             scene,
             scene_gpu,
             width,
@@ -491,8 +403,12 @@ impl WaterPhotons {
             width,
             height,
         )?;
-        let denoiser =
-            Denoiser::from_params(ctx, params, &splat.caustics, &direct.gbuffer.position)?;
+        let denoiser = Denoiser::from_params(
+            ctx,
+            &params.denoise,
+            &splat.caustics,
+            &direct.gbuffer.position,
+        )?;
         let scene_sphere = scene.bounding_sphere(0.0);
         // The composite reads the splat's caustic buffer (denoised in place).
         let composite = Composite::new(
@@ -510,7 +426,7 @@ impl WaterPhotons {
             RefractionPush {
                 tir_remedy: b::TIR_CLAMP_CRITICAL,
                 use_eq632: 1,
-                search_steps: params.get("search_steps") as u32,
+                search_steps: params.search_steps,
                 pad: 0,
             },
         )?;
@@ -523,21 +439,21 @@ impl WaterPhotons {
             modes: [
                 layout.border[0],
                 layout.border[1],
-                params.get("intensity_mode") as u32,
-                params.get("splat_mode") as u32,
+                params.intensity_mode,
+                params.splat_mode,
             ],
             cascade: [
                 layout.scale,
-                params.get("quad_size"),
-                params.get("fresnel_frac"),
-                params.get("fresnel_exp"),
+                params.quad_size,
+                params.fresnel_frac,
+                params.fresnel_exp,
             ],
             paper: [
-                params.get("attenuation_gamma"),
-                params.get("attenuation_t_max"),
+                params.attenuation_gamma,
+                params.attenuation_t_max,
                 // ε of Eq. 19.
                 1e-3,
-                params.get("depth_bias"),
+                params.depth_bias,
             ],
             water: [water.material, 0, 0, 0],
         };
@@ -590,9 +506,34 @@ impl WaterPhotons {
     }
 }
 
+impl TechniqueBuild for WaterPhotons {
+    const NAME: &'static str = "water_photons";
+    const DESCRIPTION: &'static str = "Kougianos & Moustakas 2021: cascaded caustic maps of the water from the sun, photon differentials traced through the BVH, splats drawn indirect into a screen-space caustic buffer";
+    const COMPONENTS: &'static [Component] = &[Component::Direct, Component::SurfaceCaustics];
+    type Params = WaterPhotonsParams;
+
+    fn build(
+        ctx: &Arc<Context>,
+        params: &WaterPhotonsParams,
+        scene: &Scene,
+        scene_gpu: &SceneGpu,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<Self> {
+        Self::new(ctx, params, scene, scene_gpu, width, height)
+    }
+}
+
 impl Technique for WaterPhotons {
     fn name(&self) -> &'static str {
-        "water_photons"
+        Self::NAME
+    }
+
+    fn update_live(&mut self, params: &Params) -> anyhow::Result<bool> {
+        let params = WaterPhotonsParams::from_params(params)?;
+        self.direct.set_live(&params.direct);
+        self.refraction.set_search_steps(params.search_steps);
+        Ok(true)
     }
 
     fn record(

@@ -10,8 +10,8 @@
 //! (the caustic buffer, or a denoised copy of it).
 
 use super::WpParamsBuffer;
+use crate::frame::SceneGpu;
 use crate::passes::gbuffer::{GBuffer, DEPTH_FORMAT};
-use crate::renderer::SceneGpu;
 use crate::shader_bindings as b;
 use crate::vk::{
     barrier, begin_rendering_with_depth, end_rendering, Access, BindingKind, Buffer, BufferAccess,

@@ -11,7 +11,7 @@
 
 use super::WpParamsBuffer;
 use crate::cascades::CascadeLayout;
-use crate::renderer::SceneGpu;
+use crate::frame::SceneGpu;
 use crate::shader_bindings as b;
 use crate::vk::{
     barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline, Context,

@@ -4,7 +4,7 @@
 
 use crate::bvh::Bvh;
 use crate::gpu::{GpuFrame, GpuLight, GpuMaterial, GpuMedium, GpuTriangle};
-use crate::reference::Component;
+use crate::radiometry::Component;
 use crate::scene::{Camera, Density, MaterialKind, Scene, Triangle};
 use crate::shader_bindings as b;
 use crate::vk::{

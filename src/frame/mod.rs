@@ -1,0 +1,12 @@
+//! What every pass of a frame reads and writes besides its own resources:
+//! the scene on the GPU (descriptor set 0) and the frame's targets.
+//!
+//! Layer rule: `frame` sits below `passes`; it imports `vk`, `scene`, `bvh`,
+//! `gpu`, `radiometry` and `shader_bindings`, never `passes`, `techniques`,
+//! `renderer` or `reference` (docs/ARCHITECTURE.md, "Layers").
+
+mod scene_gpu;
+mod targets;
+
+pub use scene_gpu::{camera_matrices, GeometryStats, SceneGpu};
+pub use targets::FrameTargets;

@@ -1,0 +1,266 @@
+//! The scene file schema: reading the spanned TOML tree into the resolved
+//! model, validating every value (docs/SCENES.md lists the fields).
+
+mod materials;
+mod medium;
+mod objects;
+mod values;
+mod water_surface;
+
+use super::error::Source;
+use super::node::{self, Tbl, R};
+use super::types::*;
+use crate::shader_bindings::MAX_LIGHTS;
+use glam::Vec3;
+use materials::Materials;
+use std::path::Path;
+use values::{direction, non_negative_rgb, unit_rgb};
+
+/// Default vertical field of view, degrees.
+pub const DEFAULT_FOV_Y_DEG: f32 = 45.0;
+
+/// Parses and validates `text`, read from `path` (relative paths inside resolve against its folder).
+pub(crate) fn parse(text: &str, path: &Path) -> R<Scene> {
+    let src = Source { path, text };
+    let entries = node::parse_document(text).map_err(|e| {
+        let span = e.span().unwrap_or(0..0);
+        src.err(
+            &span,
+            "syntax",
+            e.message()
+                .trim()
+                .lines()
+                .map(str::trim)
+                .collect::<Vec<_>>()
+                .join("; "),
+        )
+    })?;
+    let root = Tbl::root(&src, &entries);
+    root.check_keys(
+        &["camera", "light", "material", "object", "medium", "output"],
+        "the scene",
+    )?;
+    let dir = path.parent().unwrap_or(Path::new(""));
+
+    let camera = match root.opt_table("camera")? {
+        Some(t) => camera(&t)?,
+        None => return Err(root.err("camera", "missing required table [camera]")),
+    };
+
+    let light_tables = root.tables("light")?;
+    if light_tables.is_empty() {
+        return Err(root.err("light", "at least one [[light]] is required"));
+    }
+    if light_tables.len() > MAX_LIGHTS as usize {
+        let extra = &light_tables[MAX_LIGHTS as usize];
+        return Err(src.err(
+            &extra.span,
+            &extra.path,
+            format!(
+                "too many lights: {}, at most {MAX_LIGHTS} are supported",
+                light_tables.len()
+            ),
+        ));
+    }
+    let lights = light_tables.iter().map(light).collect::<R<Vec<_>>>()?;
+
+    let mut materials = Materials::default();
+    for t in root.tables("material")? {
+        let m = material(&t)?;
+        let name = m.name.clone();
+        if let Err(first) = materials.define(m) {
+            return Err(t.err(
+                "name",
+                format!("duplicate material name `{name}` (also material[{first}])"),
+            ));
+        }
+    }
+
+    let object_tables = root.tables("object")?;
+    if object_tables.is_empty() {
+        return Err(root.err("object", "at least one [[object]] is required"));
+    }
+    let mut objects = Vec::with_capacity(object_tables.len());
+    for (i, t) in object_tables.iter().enumerate() {
+        objects.push(objects::object(t, i, dir, &mut materials)?);
+    }
+
+    let medium = root
+        .opt_table("medium")?
+        .map(|t| medium::medium(&t, dir))
+        .transpose()?;
+    let output = match root.opt_table("output")? {
+        Some(t) => {
+            t.check_keys(&["exposure"], "[output]")?;
+            let exposure = t.f32_or("exposure", 1.0)?;
+            if exposure <= 0.0 {
+                return Err(t.err("exposure", format!("must be positive, got {exposure}")));
+            }
+            Output { exposure }
+        }
+        None => Output { exposure: 1.0 },
+    };
+
+    Ok(Scene {
+        source: path.to_path_buf(),
+        camera,
+        lights,
+        materials: materials.into_vec(),
+        objects,
+        medium,
+        output,
+    })
+}
+
+fn camera(t: &Tbl) -> R<Camera> {
+    t.check_keys(&["eye", "target", "up", "fov_y"], "[camera]")?;
+    let eye = t.vec3("eye")?;
+    let target = t.vec3("target")?;
+    let up = direction(t, "up", Some(Vec3::Y))?;
+    let fov_y_deg = t.f32_or("fov_y", DEFAULT_FOV_Y_DEG)?;
+    let view = target - eye;
+    if view.length() <= 1e-6 {
+        return Err(t.err(
+            "target",
+            format!("must differ from camera.eye, both are {eye}"),
+        ));
+    }
+    if view.normalize().cross(up).length() < 1e-4 {
+        return Err(t.err(
+            "up",
+            format!(
+                "must not be parallel to the view direction {}",
+                view.normalize()
+            ),
+        ));
+    }
+    if !(fov_y_deg > 0.0 && fov_y_deg < 180.0) {
+        return Err(t.err(
+            "fov_y",
+            format!("must be within (0, 180) degrees, got {fov_y_deg}"),
+        ));
+    }
+    Ok(Camera {
+        eye,
+        target,
+        up,
+        fov_y_deg,
+    })
+}
+
+fn light(t: &Tbl) -> R<Light> {
+    let kind = t.str("kind")?;
+    let mut l = Light {
+        kind: LightKind::Point,
+        position: Vec3::ZERO,
+        direction: Vec3::NEG_Y,
+        intensity: Vec3::ZERO,
+        cone_angle_deg: 0.0,
+        cone_falloff_deg: 0.0,
+    };
+    match kind {
+        "point" => {
+            t.check_keys(&["kind", "position", "intensity"], "a point light")?;
+            l.position = t.vec3("position")?;
+            l.intensity = non_negative_rgb(t, "intensity", None)?;
+        }
+        "spot" => {
+            t.check_keys(
+                &[
+                    "kind",
+                    "position",
+                    "direction",
+                    "intensity",
+                    "cone_angle",
+                    "cone_falloff",
+                ],
+                "a spot light",
+            )?;
+            l.kind = LightKind::Spot;
+            l.position = t.vec3("position")?;
+            l.direction = direction(t, "direction", None)?;
+            l.intensity = non_negative_rgb(t, "intensity", None)?;
+            l.cone_angle_deg = t.f32("cone_angle")?;
+            if !(l.cone_angle_deg > 0.0 && l.cone_angle_deg <= 90.0) {
+                return Err(t.err(
+                    "cone_angle",
+                    format!("must be within (0, 90] degrees, got {}", l.cone_angle_deg),
+                ));
+            }
+            l.cone_falloff_deg = t.f32_or("cone_falloff", 0.0)?;
+            if l.cone_falloff_deg < 0.0 {
+                return Err(t.err(
+                    "cone_falloff",
+                    format!("must not be negative, got {}", l.cone_falloff_deg),
+                ));
+            }
+            if l.cone_falloff_deg > l.cone_angle_deg {
+                return Err(t.err(
+                    "cone_falloff",
+                    format!(
+                        "must not exceed cone_angle ({}), got {}",
+                        l.cone_angle_deg, l.cone_falloff_deg
+                    ),
+                ));
+            }
+        }
+        "directional" => {
+            t.check_keys(&["kind", "direction", "irradiance"], "a directional light")?;
+            l.kind = LightKind::Directional;
+            l.direction = direction(t, "direction", None)?;
+            l.intensity = non_negative_rgb(t, "irradiance", None)?;
+        }
+        other => {
+            return Err(t.err(
+                "kind",
+                format!("unknown light kind `{other}`; expected point, spot or directional"),
+            ))
+        }
+    }
+    Ok(l)
+}
+
+fn material(t: &Tbl) -> R<Material> {
+    let name = t.str("name")?;
+    if name.trim().is_empty() {
+        return Err(t.err("name", "must not be empty"));
+    }
+    let kind = t.str("kind")?;
+    let mut m = Material {
+        name: name.to_owned(),
+        kind: MaterialKind::Diffuse,
+        color: Vec3::ONE,
+        ior: 1.0,
+        absorption: Vec3::ZERO,
+    };
+    match kind {
+        "diffuse" => {
+            t.check_keys(&["name", "kind", "albedo"], "a diffuse material")?;
+            m.color = unit_rgb(t, "albedo", Vec3::splat(0.8))?;
+        }
+        "mirror" => {
+            t.check_keys(&["name", "kind", "reflectance"], "a mirror material")?;
+            m.kind = MaterialKind::Mirror;
+            m.color = unit_rgb(t, "reflectance", Vec3::ONE)?;
+        }
+        "dielectric" => {
+            t.check_keys(
+                &["name", "kind", "ior", "absorption"],
+                "a dielectric material",
+            )?;
+            m.kind = MaterialKind::Dielectric;
+            m.ior = t.f32_or("ior", 1.5)?;
+            if m.ior < 1.0 {
+                return Err(t.err("ior", format!("must be at least 1, got {}", m.ior)));
+            }
+            m.absorption = non_negative_rgb(t, "absorption", Some(Vec3::ZERO))?;
+        }
+        other => {
+            return Err(t.err(
+                "kind",
+                format!("unknown material kind `{other}`; expected diffuse, mirror or dielectric"),
+            ))
+        }
+    }
+    Ok(m)
+}

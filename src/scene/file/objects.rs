@@ -1,0 +1,296 @@
+//! `[[object]]` tables: procedural shapes, OBJ meshes (with their MTL
+//! materials), transforms and animation.
+
+use super::materials::Materials;
+use super::values::{direction, positive, size2};
+use super::water_surface::{water_surface, WATER_KEYS};
+use crate::scene::node::Tbl;
+use crate::scene::node::R;
+use crate::scene::types::*;
+use crate::scene::{obj, shapes};
+use glam::{Mat4, Quat, Vec3};
+use std::path::Path;
+
+const COMMON_OBJECT_KEYS: [&str; 7] = [
+    "shape",
+    "name",
+    "material",
+    "translate",
+    "rotate",
+    "scale",
+    "animate",
+];
+
+fn segments(t: &Tbl) -> R<u32> {
+    let s = t.opt_u32("segments")?.unwrap_or(shapes::DEFAULT_SEGMENTS);
+    if !(shapes::MIN_SEGMENTS..=shapes::MAX_SEGMENTS).contains(&s) {
+        return Err(t.err(
+            "segments",
+            format!(
+                "must be within [{}, {}], got {s}",
+                shapes::MIN_SEGMENTS,
+                shapes::MAX_SEGMENTS
+            ),
+        ));
+    }
+    Ok(s)
+}
+
+/// Reads `[[object]]` number `index`; MTL materials it brings are added to `materials`.
+pub(super) fn object(t: &Tbl, index: usize, dir: &Path, materials: &mut Materials) -> R<Object> {
+    let shape = t.str("shape")?;
+    let extra: &[&str] = match shape {
+        "sphere" => &["center", "radius", "segments"],
+        "plane" => &["center", "normal", "size", "tangent"],
+        "box" => &["min", "max"],
+        "torus" => &["center", "axis", "radii", "segments"],
+        "cylinder" => &["p0", "p1", "radius", "caps", "segments"],
+        "mesh" => &["path"],
+        "water" => &[],
+        other => {
+            return Err(t.err(
+                "shape",
+                format!(
+                    "unknown shape `{other}`; expected sphere, plane, box, torus, cylinder, mesh or water"
+                ),
+            ))
+        }
+    };
+    let allowed: Vec<&str> = if shape == "water" {
+        // Water lies in world space (its waves are world x/z functions), so it
+        // takes no transform or animation: `center` and `base_height` place it.
+        WATER_KEYS.to_vec()
+    } else {
+        COMMON_OBJECT_KEYS.iter().chain(extra).copied().collect()
+    };
+    t.check_keys(&allowed, &format!("a {shape} object"))?;
+
+    let name = t
+        .opt_str("name")?
+        .map_or_else(|| format!("{shape}{index}"), str::to_owned);
+    let material = match t.opt_str("material")? {
+        Some(m) => match materials.defined_index(m) {
+            Some(i) => Some(i as u32),
+            None => {
+                let known = materials.defined_names();
+                let known = if known.is_empty() {
+                    "none".to_owned()
+                } else {
+                    known.join(", ")
+                };
+                return Err(t.err(
+                    "material",
+                    format!("unknown material `{m}`; defined: {known}"),
+                ));
+            }
+        },
+        None if shape == "mesh" => None,
+        None => return Err(t.err("material", "missing required field (the material name)")),
+    };
+
+    let mut mesh = match shape {
+        "sphere" => shapes::sphere(
+            t.vec3_or("center", Vec3::ZERO)?,
+            positive(t, "radius")?,
+            segments(t)?,
+        ),
+        "plane" => {
+            let normal = direction(t, "normal", Some(Vec3::Y))?;
+            let tangent = match t.opt_vec3("tangent")? {
+                Some(tan) => {
+                    let off = tan - normal * normal.dot(tan);
+                    if off.length() <= 1e-6 * tan.length().max(1e-30) || tan.length() <= 1e-12 {
+                        return Err(t.err(
+                            "tangent",
+                            format!("must be non-zero and not parallel to normal, got {tan}"),
+                        ));
+                    }
+                    Some(tan)
+                }
+                None => None,
+            };
+            let size = size2(t, "size")?;
+            shapes::plane(t.vec3_or("center", Vec3::ZERO)?, normal, tangent, size)
+        }
+        "box" => {
+            let (min, max) = (t.vec3("min")?, t.vec3("max")?);
+            if min.cmpge(max).any() {
+                return Err(t.err(
+                    "max",
+                    format!("must exceed min in every component: min {min}, max {max}"),
+                ));
+            }
+            shapes::cuboid(min, max)
+        }
+        "torus" => {
+            let axis = direction(t, "axis", Some(Vec3::Y))?;
+            let [major, minor] = size2(t, "radii")?;
+            if minor >= major {
+                return Err(t.err(
+                    "radii",
+                    format!("minor radius must be below major radius, got [{major}, {minor}]"),
+                ));
+            }
+            shapes::torus(
+                t.vec3_or("center", Vec3::ZERO)?,
+                axis,
+                major,
+                minor,
+                segments(t)?,
+            )
+        }
+        "cylinder" => {
+            let (p0, p1) = (t.vec3("p0")?, t.vec3("p1")?);
+            if (p1 - p0).length() <= 1e-6 {
+                return Err(t.err("p1", format!("must differ from p0, both are {p0}")));
+            }
+            let radius = positive(t, "radius")?;
+            let caps = t.opt_bool("caps")?.unwrap_or(true);
+            shapes::cylinder(p0, p1, radius, caps, segments(t)?)
+        }
+        "water" => {
+            let surface = water_surface(t, material.unwrap_or_default())?;
+            return Ok(Object {
+                name,
+                mesh: surface.mesh(0.0),
+                transform: Mat4::IDENTITY,
+                animation: None,
+                water: Some(surface),
+            });
+        }
+        _ => return mesh_object(t, name, dir, material, materials),
+    };
+    let material = material.unwrap_or_default();
+    mesh.materials = vec![material; mesh.indices.len()];
+    Ok(Object {
+        name,
+        mesh,
+        transform: transform(t)?,
+        animation: animation(t)?,
+        water: None,
+    })
+}
+
+fn mesh_object(
+    t: &Tbl,
+    name: String,
+    dir: &Path,
+    material: Option<u32>,
+    materials: &mut Materials,
+) -> R<Object> {
+    let rel = t.str("path")?;
+    let full = dir.join(rel);
+    let loaded = obj::load(&full).map_err(|e| t.err("path", e))?;
+    let mut mesh = loaded.mesh;
+    match material {
+        Some(m) => mesh.materials.iter_mut().for_each(|x| *x = m),
+        None => {
+            if let Some((mtl, why)) = loaded.mtl_errors.first() {
+                return Err(t.err(
+                    "path",
+                    format!(
+                        "cannot read MTL file {} named by OBJ file {}: {why} (set `material` on the object to ignore the MTL)",
+                        mtl.display(),
+                        full.display()
+                    ),
+                ));
+            }
+            if mesh.materials.contains(&obj::NO_MATERIAL) {
+                return Err(t.err(
+                    "material",
+                    format!(
+                        "OBJ file {} has faces without an MTL material: set `material` on the object",
+                        full.display()
+                    ),
+                ));
+            }
+            // Map the OBJ's materials to scene materials, sharing identical ones
+            // (the same OBJ used twice).
+            let mut map = vec![None; loaded.materials.len()];
+            for x in &mut mesh.materials {
+                let slot = &mut map[*x as usize];
+                let index = match *slot {
+                    Some(i) => i,
+                    None => {
+                        let m = &loaded.materials[*x as usize];
+                        let i = materials.add_mtl(m).ok_or_else(|| {
+                            t.err(
+                                "path",
+                                format!(
+                                    "MTL material name `{}` collides with another material",
+                                    m.name
+                                ),
+                            )
+                        })?;
+                        *slot = Some(i);
+                        i
+                    }
+                };
+                *x = index as u32;
+            }
+        }
+    }
+    Ok(Object {
+        name,
+        mesh,
+        transform: transform(t)?,
+        animation: animation(t)?,
+        water: None,
+    })
+}
+
+/// `translate * rotate_z * rotate_y * rotate_x * scale`: scale first, then X, Y, Z rotations, then translation.
+fn transform(t: &Tbl) -> R<Mat4> {
+    let translate = t.vec3_or("translate", Vec3::ZERO)?;
+    let rotate = t.vec3_or("rotate", Vec3::ZERO)?;
+    let scale = t.opt_rgb("scale")?.unwrap_or(Vec3::ONE);
+    if scale.abs().min_element() < 1e-12 {
+        return Err(t.err(
+            "scale",
+            format!("must not be zero in any component, got {scale}"),
+        ));
+    }
+    let r = rotate * (std::f32::consts::PI / 180.0);
+    let q = Quat::from_rotation_z(r.z) * Quat::from_rotation_y(r.y) * Quat::from_rotation_x(r.x);
+    Ok(Mat4::from_translation(translate) * Mat4::from_quat(q) * Mat4::from_scale(scale))
+}
+
+fn animation(t: &Tbl) -> R<Option<Animation>> {
+    let Some(a) = t.opt_table("animate")? else {
+        return Ok(None);
+    };
+    a.check_keys(
+        &[
+            "spin",
+            "spin_axis",
+            "orbit_radius",
+            "orbit_speed",
+            "orbit_center",
+            "bob_amplitude",
+            "bob_frequency",
+        ],
+        "animate",
+    )?;
+    let anim = Animation {
+        spin_deg_per_s: a.f32_or("spin", 0.0)?,
+        spin_axis: direction(&a, "spin_axis", Some(Vec3::Y))?,
+        orbit_center: a.vec3_or("orbit_center", Vec3::ZERO)?,
+        orbit_radius: a.f32_or("orbit_radius", 0.0)?,
+        orbit_deg_per_s: a.f32_or("orbit_speed", 0.0)?,
+        bob_amplitude: a.f32_or("bob_amplitude", 0.0)?,
+        bob_hz: a.f32_or("bob_frequency", 0.0)?,
+    };
+    if anim.orbit_radius < 0.0 {
+        return Err(a.err(
+            "orbit_radius",
+            format!("must not be negative, got {}", anim.orbit_radius),
+        ));
+    }
+    if anim.bob_hz < 0.0 {
+        return Err(a.err(
+            "bob_frequency",
+            format!("must not be negative, got {}", anim.bob_hz),
+        ));
+    }
+    Ok(Some(anim))
+}
