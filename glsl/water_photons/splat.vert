@@ -30,7 +30,8 @@
 // passes through a pixel centre, which a bare box (weight 1 up to the
 // edge) would count twice or not at all. The quad is moved toward the
 // camera by a small fraction of its distance (the paper's depth bias) and
-// tested against the camera's depth.
+// tested against the camera's depth; the fragment stage keeps it only on
+// the side of the surface the photon arrived at (splat.frag).
 #include "scene.glsl"
 #include "optics.glsl"
 #include "common.glsl"
@@ -40,6 +41,7 @@ layout(set = 1, binding = WP_BINDING_PHOTONS, std430) readonly buffer PhotonBloc
 layout(location = 0) out vec2 v_local;
 layout(location = 1) flat out vec3 v_irradiance;
 layout(location = 2) flat out float v_ramp;
+layout(location = 3) flat out vec3 v_normal;
 
 // h: the kernel's ramp half-width in cascade-0 texels (see above).
 const float RAMP_TEXELS = 0.25;
@@ -84,6 +86,7 @@ void main() {
     x += (frame.eye.xyz - x) * wp.paper.w;
     v_local = lp;
     v_ramp = r;
+    v_normal = n;
     v_irradiance = area > 0.0 ? p.flux.rgb / area : vec3(0.0);
     gl_Position = frame.view_proj * vec4(x, 1.0);
 }

@@ -17,8 +17,15 @@
 //!    draw's instance count, clamped to the capacity (overflow reported).
 //! 3. "photon splat" (`splat`): one instanced quad per photon by
 //!    vkCmdDrawIndirect, on the tangent plane, depth-tested against the
-//!    camera's depth, additive into the screen-space caustic buffer of
-//!    irradiance E (W/m²).
+//!    camera's depth and kept only on pixels whose surface shows the
+//!    camera the side the photon arrived on (the G-buffer normal, faced to
+//!    the camera, against the photon's, faced to its ray: dot > 0), additive
+//!    into the screen-space caustic buffer of irradiance E (W/m²). The
+//!    depth test alone let a photon on one face of a surface thinner than
+//!    the depth bias (an open quad: zero) light the other face: a thin wall
+//!    lit through itself (GUIDE §2; tests/water_photons.rs measures 201 of
+//!    202 W/m² on the dark side before, 0 after). It also stops splats
+//!    spilling across creases (floor onto wall, dot = 0).
 //! 4. "denoise <kind> <k> x|y" (`denoise`, glsl/water_photons/denoise.comp):
 //!    the adaptive-radius cross-bilateral filter of §3.3 (Eqs. 21-28,
 //!    Algorithm 4) or the fixed-radius one it improves on, `denoise_passes`
@@ -488,6 +495,7 @@ impl WaterPhotons {
             scene_gpu,
             &params_buffer,
             &trace.photons,
+            &direct.gbuffer,
             width,
             height,
         )?;
