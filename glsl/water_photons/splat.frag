@@ -15,6 +15,9 @@
 // covers the pixel the G-buffer normal is 0 and nothing is deposited
 // (the composite ignores those pixels anyway).
 #include "bindings.glsl"
+// splat_weight only: kernel.glsl's other function needs the parameters.
+#define WATER_PHOTONS_KERNEL_WEIGHT_ONLY
+#include "kernel.glsl"
 
 layout(set = 1, binding = WP_BINDING_GBUFFER_NORMAL) uniform sampler2D g_normal;
 
@@ -28,8 +31,6 @@ layout(location = 0) out vec4 out_caustic;
 void main() {
     vec3 seen = texelFetch(g_normal, ivec2(gl_FragCoord.xy), 0).xyz;
     if (dot(seen, v_normal) <= 0.0) discard;
-    // 1 on |a| <= 1 - r, 0 at |a| = 1 + r, linear between (integral 2).
-    vec2 k = clamp((1.0 + v_ramp - abs(v_local)) / (2.0 * v_ramp), 0.0, 1.0);
-    float w = k.x * k.y;
+    float w = splat_weight(v_local, v_ramp);
     out_caustic = vec4(v_irradiance * w, w);
 }

@@ -35,6 +35,7 @@
 #include "scene.glsl"
 #include "optics.glsl"
 #include "common.glsl"
+#include "kernel.glsl"
 
 layout(set = 1, binding = WP_BINDING_PHOTONS, std430) readonly buffer PhotonBlock { Photon photons[]; };
 
@@ -43,9 +44,6 @@ layout(location = 1) flat out vec3 v_irradiance;
 layout(location = 2) flat out float v_ramp;
 layout(location = 3) flat out vec3 v_normal;
 
-// h: the kernel's ramp half-width in cascade-0 texels (see above).
-const float RAMP_TEXELS = 0.25;
-
 const vec2 LP[4] = vec2[4](vec2(-1.0, 1.0), vec2(1.0, 1.0), vec2(-1.0, -1.0), vec2(1.0, -1.0)); // Eq. 17
 
 void main() {
@@ -53,33 +51,8 @@ void main() {
     vec3 hit = p.position.xyz;
     vec3 n = p.normal.xyz;
     vec3 u, v;
-    // The box's half-width B in cascade-0 texels.
-    float half_texels;
-    if (wp.modes.w == WP_SPLAT_DIFFERENTIAL) {
-        u = 0.5 * p.axis_u.xyz;
-        v = 0.5 * p.axis_v.xyz;
-        half_texels = 0.5 * pow(wp.cascade.x, p.position.w);
-    } else {
-        float c = p.position.w;
-        float sigma = (wp.modes.w == WP_SPLAT_FIXED ? 1.0 : p.normal.w) * pow(wp.cascade.x, c); // Eq. 11
-        float grid = sqrt(wp.range.x / float(wp.size.x) * wp.range.y / float(wp.size.y));
-        float q = grid * wp.cascade.y * sigma; // Eq. 16
-        vec3 w = p.dir.xyz;
-        float a = 1.0 / (max(-dot(w, n), 0.0) + wp.paper.z); // Eq. 19
-        vec3 lp_f = w - dot(w, n) * n;
-        vec3 lp_r;
-        if (dot(lp_f, lp_f) < 1e-12) {
-            basis(n, lp_f, lp_r);
-        } else {
-            lp_f = normalize(lp_f);
-            lp_r = cross(n, lp_f);
-        }
-        u = 0.5 * q * a * lp_f; // Eq. 18
-        v = 0.5 * q * lp_r;
-        half_texels = 0.5 * wp.cascade.y * sigma;
-    }
-    // At most 1: the flat top keeps the trapezoid's integral the box's.
-    float r = min(RAMP_TEXELS / half_texels, 1.0);
+    float r;
+    splat_axes(p, u, v, r);
     float area = 4.0 * length(cross(u, v));
     vec2 lp = LP[gl_VertexIndex] * (1.0 + r);
     vec3 x = hit + lp.x * u + lp.y * v;
