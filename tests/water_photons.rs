@@ -24,7 +24,9 @@
 //!   connecting diffuse hits to the camera) cannot connect: it renders that
 //!   floor black, so the comparison needs the camera under water.
 //! - Flat water seen from above: the frame's radiance on the floor is the
-//!   analytic T(θ_s) T(θ_v) albedo E cos θ_s / (π n²) (GUIDE §2).
+//!   analytic T(θ_s) T(θ_v) albedo E cos θ_s / (π n²) (GUIDE §2), on floor
+//!   the camera also sees directly and on floor a near wall hides from it
+//!   (seen only through the water: the water view's photon gather).
 //! - A thin open wall lit on one side under the water: the caustic on the
 //!   lit side is analytic, the other side (same depth) stays dark.
 
