@@ -158,6 +158,13 @@ pub const WP_BINDING_CAUSTICS: u32 = 6;
 pub const WP_BINDING_GBUFFER_POSITION: u32 = 7;
 pub const WP_BINDING_GBUFFER_NORMAL: u32 = 8;
 pub const WP_BINDING_RADIANCE: u32 = 9;
+// water_photons "water view": the photon slot per (texel, cascade, ray
+// type) written by the trace, and the camera's view of the water.
+pub const WP_BINDING_PHOTON_SLOTS: u32 = 10;
+pub const WP_BINDING_OPAQUE_RADIANCE: u32 = 11;
+pub const WP_BINDING_FRONT_POSITION: u32 = 12;
+pub const WP_BINDING_FRONT_NORMAL: u32 = 13;
+pub const WP_BINDING_BACK_POSITION: u32 = 14;
 /// Most cascades of a cascaded caustic map (Kougianos & Moustakas 2021 use 1-4).
 pub const WP_MAX_CASCADES: u32 = 4;
 /// Trace threads per workgroup, and workgroups per dispatch row.

@@ -23,6 +23,12 @@
 //!   through the surface, an L S D S E path the reference (a light tracer
 //!   connecting diffuse hits to the camera) cannot connect: it renders that
 //!   floor black, so the comparison needs the camera under water.
+//! - Flat water seen from above: the frame's radiance on the floor is the
+//!   analytic T(θ_s) T(θ_v) albedo E cos θ_s / (π n²) (GUIDE §2), on floor
+//!   the camera also sees directly and on floor a near wall hides from it
+//!   (seen only through the water: the water view's photon gather).
+//! - A thin open wall lit on one side under the water: the caustic on the
+//!   lit side is analytic, the other side (same depth) stays dark.
 
 mod common;
 
@@ -1257,5 +1263,225 @@ fn a_floor_facing_away_takes_the_same_photons() {
         assert_eq!(p.normal[1], q.normal[1]);
         assert!((p.normal[3] - q.normal[3]).abs() < 1e-4);
     }
+    assert_validation_clean(&ctx);
+}
+
+/// Exact unpolarised Fresnel transmittance 1 − F from air into a medium of
+/// index `n` at incidence cos θ = `cos_i`.
+fn fresnel_transmittance(cos_i: f64, n: f64) -> f64 {
+    let eta = 1.0 / n;
+    let cos_t = (1.0 - eta * eta * (1.0 - cos_i * cos_i)).sqrt();
+    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    1.0 - 0.5 * (rs * rs + rp * rp)
+}
+
+/// Flat, non-absorbing water (n = 1.33) over a diffuse floor under the sun,
+/// seen from above (GUIDE §2): on every floor pixel the camera sees through
+/// the water, the frame's radiance is
+///   L = T(θ_s) T(θ_v) albedo E cos θ_s / (π n²),
+/// T the Fresnel transmittance at the sun's and the view's zenith angle
+/// (the photon's flux through the surface, then the radiance leaving it)
+/// and 1/n² the radiance law across the interface. The reflected sky is
+/// black, so nothing else adds. A wall at the water's near edge (as the
+/// pool's) hides from the camera a strip of floor that it sees through the
+/// water (the refracted ray bends down behind the wall's edge): those
+/// pixels ("hidden") are shaded by the water view's own photon gather,
+/// the others ("visible") read the splatted frame; both must give L.
+/// Pixels are those whose refracted camera ray meets the floor inside the
+/// uniformly lit square (away from the beam's edges and the wall).
+#[test]
+fn flat_water_seen_from_above_has_the_analytic_radiance() {
+    use caustics::reference::Component;
+    use caustics::renderer::Renderer;
+    use glam::DVec3;
+    const N: u32 = 64;
+    let ctx = validated_context();
+    let light = Vec3::new(0.3, -1.0, 0.2).normalize();
+    let mut s = water_scene(
+        water(Vec2::new(6.0, 6.0), [12, 12], 1.0, vec![]),
+        light,
+        Vec3::new(0.3, 4.0, 5.5),
+    );
+    s.camera.target = Vec3::new(0.3, 0.0, 0.5);
+    let (wall_lo, wall_hi) = (Vec3::new(-3.3, 0.0, 3.0), Vec3::new(3.3, 1.3, 3.3));
+    // A darker wall than the floor: a pixel that shows the wall's top in
+    // place of the hidden floor is off by far more than the bounds.
+    s.materials.push(diffuse("wall", 0.3));
+    s.objects
+        .push(object("near wall", box_mesh(wall_lo, wall_hi, 2)));
+    let (wall_lo, wall_hi) = (wall_lo.as_dvec3(), wall_hi.as_dvec3());
+    let ior = 1.33f64;
+    let albedo = 0.8f64;
+    let cos_s = -light.y as f64;
+    let t_s = fresnel_transmittance(cos_s, ior);
+    let refract = |d: DVec3| {
+        // Into the water through a surface of normal +y.
+        let eta = 1.0 / ior;
+        let cos_i = -d.y;
+        let cos_t = (1.0 - eta * eta * (1.0 - cos_i * cos_i)).sqrt();
+        (eta * d + (eta * cos_i - cos_t) * DVec3::Y).normalize()
+    };
+    // The square of floor the refracted sunlight covers: the water's
+    // square moved along the refracted ray by the water's height.
+    let ts = refract(light.as_dvec3());
+    let lit_centre = ts * (1.0 / -ts.y);
+    // Measured: see the asserts.
+    for (overrides, mean_bound, worst_bound) in [
+        (&["ccm_size=128", "cascades=1"][..], 0.005, 0.01),
+        (&[][..], 0.005, 0.03),
+    ] {
+        let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        let params = Params::resolve("water_photons", PARAMS, &overrides).unwrap();
+        let mut r = Renderer::new(&ctx, s.clone(), "water_photons", &params, N, N, 0.0).unwrap();
+        r.scene_gpu.components = Component::All.mask();
+        r.render_frame(0.0).unwrap();
+        let img = r.radiance().unwrap();
+        assert_finite(&img);
+        // (pixels, sum of relative errors, worst) for visible and hidden floor.
+        let mut stats = [(0usize, 0.0f64, 0.0f64); 2];
+        for py in 0..N {
+            for px in 0..N {
+                let (o, d) = pixel_ray(&s.camera, N, N, px, py);
+                let (o, d) = (o.as_dvec3(), d.as_dvec3());
+                if d.y >= 0.0 {
+                    continue;
+                }
+                let at_water = o + d * ((1.0 - o.y) / d.y);
+                if at_water.x.abs() > 2.8
+                    || at_water.z.abs() > 2.8
+                    || length_in_box(o, at_water, wall_lo, wall_hi) > 0.0
+                {
+                    continue;
+                }
+                let dt = refract(d);
+                let floor = at_water + dt * (1.0 / -dt.y);
+                if (floor.x - lit_centre.x).abs() > 2.6 || (floor.z - lit_centre.z).abs() > 2.6 {
+                    continue;
+                }
+                let hidden = length_in_box(o, floor, wall_lo, wall_hi) > 0.0;
+                let t_v = fresnel_transmittance(-d.y, ior);
+                let expected =
+                    t_s * t_v * albedo * 1000.0 * cos_s / (std::f64::consts::PI * ior * ior);
+                let i = 4 * (py * N + px) as usize;
+                let rel = img[i] as f64 / expected - 1.0;
+                let st = &mut stats[hidden as usize];
+                st.0 += 1;
+                st.1 += rel;
+                if rel.abs() > st.2.abs() {
+                    st.2 = rel;
+                }
+            }
+        }
+        for (k, name) in ["visible", "hidden"].iter().enumerate() {
+            let (n, sum, worst) = stats[k];
+            let mean = sum / n as f64;
+            println!(
+                "flat water from above, {overrides:?}: {n} {name} floor pixels, T(θ_s) = {t_s:.5}, mean relative error {mean:+.5}, worst {worst:+.5}"
+            );
+            assert!(
+                n > if k == 0 { 300 } else { 40 },
+                "{n} {name} pixels checked"
+            );
+            assert!(
+                mean.abs() < mean_bound && worst.abs() < worst_bound,
+                "{overrides:?}, {name}: mean {mean}, worst {worst}"
+            );
+        }
+    }
+    assert_validation_clean(&ctx);
+}
+
+/// GUIDE §2: a two-sided diffuse surface is lit on the side the light
+/// arrives at and never through itself. A thin wall (one open quad, x =
+/// −0.5, 0.6 m high) stands under flat water; the refracted sunlight
+/// (travelling toward +x) lands on its −x face. Seen from a camera on the
+/// −x side, the wall's pixels of the caustic buffer hold the analytic
+/// E cos θ_s T(θ_s) |t_x| / |t_y| (t the refracted direction; pixels at
+/// least a footprint, ~0.1 m up the wall, from its top edge, where fewer
+/// boxes overlap); seen from a camera on the +x side, at the same depth,
+/// they hold nothing (the splat's arrival side test: before it, the dark
+/// side took the lit side's 201 W/m²).
+#[test]
+fn a_thin_wall_lit_on_one_side_stays_dark_on_the_other() {
+    let ctx = validated_context();
+    let light = Vec3::new(0.3, -1.0, 0.2).normalize();
+    let mut s = water_scene(
+        water(Vec2::new(4.0, 4.0), [8, 8], 1.0, vec![]),
+        light,
+        Vec3::ZERO,
+    );
+    let x = -0.5;
+    let wall = caustics::scene::Mesh {
+        positions: vec![
+            Vec3::new(x, 0.0, -1.0),
+            Vec3::new(x, 0.0, 1.0),
+            Vec3::new(x, 0.6, 1.0),
+            Vec3::new(x, 0.6, -1.0),
+        ],
+        normals: vec![Vec3::X; 4],
+        indices: vec![[0, 1, 2], [0, 2, 3]],
+        materials: vec![0; 2],
+    };
+    s.objects.push(object("thin wall", wall));
+    let (cos_s, t_s) = {
+        let cos_s = -light.y as f64;
+        (cos_s, fresnel_transmittance(cos_s, 1.33))
+    };
+    let t = {
+        let eta = 1.0 / 1.33f64;
+        let cos_t = (1.0 - eta * eta * (1.0 - cos_s * cos_s)).sqrt();
+        (eta * light.as_dvec3() + (eta * cos_s - cos_t) * glam::DVec3::Y).normalize()
+    };
+    let expected = 1000.0 * cos_s * t_s * t.x.abs() / t.y.abs();
+    let target = Vec3::new(x, 0.3, 0.0);
+    let mut results = vec![];
+    for (side, eye) in [
+        ("lit", Vec3::new(-3.0, 3.0, 0.4)),
+        ("dark", Vec3::new(2.0, 3.0, 0.4)),
+    ] {
+        s.camera = camera(eye, target, 50.0);
+        let run = render(&ctx, &s, &["ccm_size=128", "cascades=1", "denoise=0"], 64);
+        let caustics = run.technique.splat.caustics.download_rgba32f().unwrap();
+        let position = run
+            .technique
+            .direct
+            .gbuffer
+            .position
+            .download_rgba32f()
+            .unwrap();
+        let (mut n, mut sum, mut max) = (0usize, 0.0f64, 0.0f64);
+        for i in 0..64 * 64 {
+            let p = Vec3::from_slice(&position[4 * i..4 * i + 3]);
+            if position[4 * i + 3] == 0.0
+                || (p.x - x).abs() > 1e-3
+                || !(0.1..0.4).contains(&p.y)
+                || p.z.abs() > 0.7
+            {
+                continue;
+            }
+            let e = caustics[4 * i] as f64;
+            sum += e;
+            max = max.max(e);
+            n += 1;
+        }
+        println!(
+            "thin wall, {side} side: {n} pixels, mean E {:.3} W/m², max {max:.3} (lit side analytic {expected:.3})",
+            sum / n as f64
+        );
+        assert!(n > 40, "{side}: {n} wall pixels");
+        results.push((sum / n as f64, max));
+    }
+    let (lit, _) = results[0];
+    let (_, dark_max) = results[1];
+    // Measured: lit 202.266 vs 202.263 W/m² (+0.002%), dark 0.
+    assert!(
+        (lit / expected - 1.0).abs() < 0.01,
+        "lit side: {lit} vs {expected}"
+    );
+    assert!(
+        dark_max < 1e-3 * expected,
+        "dark side: up to {dark_max} W/m²"
+    );
     assert_validation_clean(&ctx);
 }

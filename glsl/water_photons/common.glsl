@@ -14,7 +14,7 @@ layout(set = 1, binding = WP_BINDING_PARAMS, std140) uniform WpParams {
     uvec4 modes;       // x, y: border (ΔX, ΔY) of Eq. 6; z: WP_INTENSITY_*; w: WP_SPLAT_*
     vec4 cascade;      // x: scale s; y: q_0 (Eq. 16); z: F_frac, w: F_exp (Eq. 14)
     vec4 paper;        // x: γ, y: t_max (Eq. 13); z: ε (Eq. 19); w: depth bias (relative)
-    uvec4 water;       // x: the water's material index
+    uvec4 water;       // x: the water's material index; y, z, w (f32 bits): rest height h, slope bound, Σ amplitude (view.comp)
 } wp;
 
 // One photon (Algorithm 3 lines 36-41), 96 bytes.

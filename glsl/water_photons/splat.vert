@@ -30,19 +30,19 @@
 // passes through a pixel centre, which a bare box (weight 1 up to the
 // edge) would count twice or not at all. The quad is moved toward the
 // camera by a small fraction of its distance (the paper's depth bias) and
-// tested against the camera's depth.
+// tested against the camera's depth; the fragment stage keeps it only on
+// the side of the surface the photon arrived at (splat.frag).
 #include "scene.glsl"
 #include "optics.glsl"
 #include "common.glsl"
+#include "kernel.glsl"
 
 layout(set = 1, binding = WP_BINDING_PHOTONS, std430) readonly buffer PhotonBlock { Photon photons[]; };
 
 layout(location = 0) out vec2 v_local;
 layout(location = 1) flat out vec3 v_irradiance;
 layout(location = 2) flat out float v_ramp;
-
-// h: the kernel's ramp half-width in cascade-0 texels (see above).
-const float RAMP_TEXELS = 0.25;
+layout(location = 3) flat out vec3 v_normal;
 
 const vec2 LP[4] = vec2[4](vec2(-1.0, 1.0), vec2(1.0, 1.0), vec2(-1.0, -1.0), vec2(1.0, -1.0)); // Eq. 17
 
@@ -51,39 +51,15 @@ void main() {
     vec3 hit = p.position.xyz;
     vec3 n = p.normal.xyz;
     vec3 u, v;
-    // The box's half-width B in cascade-0 texels.
-    float half_texels;
-    if (wp.modes.w == WP_SPLAT_DIFFERENTIAL) {
-        u = 0.5 * p.axis_u.xyz;
-        v = 0.5 * p.axis_v.xyz;
-        half_texels = 0.5 * pow(wp.cascade.x, p.position.w);
-    } else {
-        float c = p.position.w;
-        float sigma = (wp.modes.w == WP_SPLAT_FIXED ? 1.0 : p.normal.w) * pow(wp.cascade.x, c); // Eq. 11
-        float grid = sqrt(wp.range.x / float(wp.size.x) * wp.range.y / float(wp.size.y));
-        float q = grid * wp.cascade.y * sigma; // Eq. 16
-        vec3 w = p.dir.xyz;
-        float a = 1.0 / (max(-dot(w, n), 0.0) + wp.paper.z); // Eq. 19
-        vec3 lp_f = w - dot(w, n) * n;
-        vec3 lp_r;
-        if (dot(lp_f, lp_f) < 1e-12) {
-            basis(n, lp_f, lp_r);
-        } else {
-            lp_f = normalize(lp_f);
-            lp_r = cross(n, lp_f);
-        }
-        u = 0.5 * q * a * lp_f; // Eq. 18
-        v = 0.5 * q * lp_r;
-        half_texels = 0.5 * wp.cascade.y * sigma;
-    }
-    // At most 1: the flat top keeps the trapezoid's integral the box's.
-    float r = min(RAMP_TEXELS / half_texels, 1.0);
+    float r;
+    splat_axes(p, u, v, r);
     float area = 4.0 * length(cross(u, v));
     vec2 lp = LP[gl_VertexIndex] * (1.0 + r);
     vec3 x = hit + lp.x * u + lp.y * v;
     x += (frame.eye.xyz - x) * wp.paper.w;
     v_local = lp;
     v_ramp = r;
+    v_normal = n;
     v_irradiance = area > 0.0 ? p.flux.rgb / area : vec3(0.0);
     gl_Position = frame.view_proj * vec4(x, 1.0);
 }

@@ -49,6 +49,10 @@ layout(set = 1, binding = WP_BINDING_DRAW, std430) buffer DrawBlock {
     uint first_instance;
     uint requested;
 } draw;
+// Layer 2 c + (type − WP_RAY_REFLECTED): the slot of the photon the texel
+// sent along that ray type, ~0 where none (cleared before the trace): the
+// water view gathers photons by texel (view.comp).
+layout(set = 1, binding = WP_BINDING_PHOTON_SLOTS, r32ui) uniform writeonly uimage2DArray photon_slots;
 
 bool ccm_fetch(ivec2 t, uint c, out vec3 x, out vec3 n) {
     x = vec3(0.0);
@@ -190,6 +194,7 @@ void main() {
         p.flux = vec4(flux, area_surface);
         p.dir = vec4(dir, 0.0);
         photons[slot] = p;
+        imageStore(photon_slots, ivec3(t, int(2u * c + type - WP_RAY_REFLECTED)), uvec4(slot));
         atomicAdd(draw.instance_count, 1u);
     }
 }

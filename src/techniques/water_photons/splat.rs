@@ -2,8 +2,11 @@
 //!
 //! "photon splat": `vkCmdDrawIndirect` with the trace's draw buffer, one
 //! instanced 4-vertex strip per photon (glsl/water_photons/splat.*), depth
-//! tested (not written) against the camera G-buffer's depth, added into the
-//! screen-space caustic buffer: RGBA32F, rgb the caustic irradiance E
+//! tested (not written) against the camera G-buffer's depth and kept only
+//! where the G-buffer's surface shows the camera the side the photon
+//! arrived on (its normal, faced to the camera, against the photon's,
+//! faced to the ray: a thin wall is not lit through itself), added into
+//! the screen-space caustic buffer: RGBA32F, rgb the caustic irradiance E
 //! (W/m²) on the visible receiver, a the sum of kernel weights.
 //! "caustic composite" (glsl/water_photons/composite.comp): L += albedo/π · E
 //! on diffuse pixels, reading whichever image `Composite::new` was given
@@ -16,7 +19,7 @@ use crate::shader_bindings as b;
 use crate::vk::{
     barrier, begin_rendering_with_depth, end_rendering, Access, BindingKind, Buffer, BufferAccess,
     ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
-    GraphicsPipelineDesc, Image, ImageAccess, ImageDesc, VkResult,
+    GraphicsPipelineDesc, Image, ImageAccess, ImageDesc, Sampler, VkResult,
 };
 use ash::vk;
 use std::sync::Arc;
@@ -28,6 +31,7 @@ pub struct Splat {
     pub caustics: Image,
     pipeline: GraphicsPipeline,
     set: DescriptorSet,
+    _sampler: Sampler,
     _layout: DescriptorSetLayout,
 }
 
@@ -37,6 +41,7 @@ impl Splat {
         scene_gpu: &SceneGpu,
         params: &WpParamsBuffer,
         photons: &Buffer,
+        gbuffer: &GBuffer,
         width: u32,
         height: u32,
     ) -> VkResult<Self> {
@@ -57,11 +62,20 @@ impl Splat {
             &[
                 (b::WP_BINDING_PARAMS, BindingKind::Uniform),
                 (b::WP_BINDING_PHOTONS, BindingKind::Storage),
+                (b::WP_BINDING_GBUFFER_NORMAL, BindingKind::Sampled),
             ],
         )?;
+        // Nearest: splat.frag fetches the G-buffer texel under the fragment.
+        let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
         let set = DescriptorSet::new(ctx, &layout)?;
         set.write_buffer(b::WP_BINDING_PARAMS, &params.0)
-            .write_buffer(b::WP_BINDING_PHOTONS, photons);
+            .write_buffer(b::WP_BINDING_PHOTONS, photons)
+            .write_sampled_image(
+                b::WP_BINDING_GBUFFER_NORMAL,
+                &gbuffer.normal,
+                &sampler,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            );
         let mut desc =
             GraphicsPipelineDesc::new("water_photons/splat.vert", "water_photons/splat.frag");
         desc.color_formats = vec![CAUSTIC_BUFFER_FORMAT];
@@ -75,6 +89,7 @@ impl Splat {
             caustics,
             pipeline,
             set,
+            _sampler: sampler,
             _layout: layout,
         })
     }
@@ -93,14 +108,16 @@ impl Splat {
         rec.pass("photon splat", |cmd| {
             // The trace's atomics (instanceCount) must be visible to the
             // indirect read, its photon writes to the vertex shader; the
-            // G-buffer's depth is tested (read), the caustic buffer
-            // overwritten after last frame's composite read it.
+            // G-buffer's depth is tested (read) and its normals read by
+            // the fragment stage (the arrival side test), the caustic
+            // buffer overwritten after last frame's composite read it.
             barrier(
                 &ctx,
                 cmd,
                 &[
                     ImageAccess::discard(&self.caustics, Access::ColorAttachment),
                     ImageAccess::new(&gbuffer.depth, Access::DepthAttachment),
+                    ImageAccess::new(&gbuffer.normal, Access::FragmentRead),
                 ],
                 &[
                     BufferAccess::new(draw, Access::IndirectRead),

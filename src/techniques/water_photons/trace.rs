@@ -15,7 +15,7 @@ use crate::frame::SceneGpu;
 use crate::shader_bindings as b;
 use crate::vk::{
     barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline, Context,
-    DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageAccess, VkResult,
+    DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageAccess, ImageDesc, VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -78,6 +78,10 @@ pub const GUARD_WORD: u32 = 0xDEAD_BEEF;
 pub struct Trace {
     /// `capacity + GUARD_PHOTONS` photons.
     pub photons: Buffer,
+    /// R32UI, ccm_0² × 2N layers: layer 2 c + type holds, per texel of
+    /// cascade c, the slot of the photon it sent along ray type `type`
+    /// (`WP_RAY_*`), `u32::MAX` where none: the water view's gather index.
+    pub slots: Image,
     /// `DrawCounters`: indirect arguments and counters.
     pub draw: Buffer,
     /// Host-visible copy of `draw`, written at the end of each trace.
@@ -119,6 +123,17 @@ impl Trace {
             &[DrawCounters::zeroed()],
             BufferUsage::Readback,
         )?;
+        let slots = Image::new_array(
+            ctx,
+            "water photon slots",
+            ImageDesc {
+                width: layout_c.size[0],
+                height: layout_c.size[1],
+                layers: 2 * layout_c.levels,
+                format: vk::Format::R32_UINT,
+                usage: vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_DST,
+            },
+        )?;
         let layout = DescriptorSetLayout::new(
             ctx,
             &[
@@ -127,6 +142,7 @@ impl Trace {
                 (b::WP_BINDING_CCM_NORMAL, BindingKind::StorageImage),
                 (b::WP_BINDING_PHOTONS, BindingKind::Storage),
                 (b::WP_BINDING_DRAW, BindingKind::Storage),
+                (b::WP_BINDING_PHOTON_SLOTS, BindingKind::StorageImage),
             ],
         )?;
         let set = DescriptorSet::new(ctx, &layout)?;
@@ -134,7 +150,8 @@ impl Trace {
             .write_storage_image(b::WP_BINDING_CCM_POSITION, ccm_position)
             .write_storage_image(b::WP_BINDING_CCM_NORMAL, ccm_normal)
             .write_buffer(b::WP_BINDING_PHOTONS, &photons)
-            .write_buffer(b::WP_BINDING_DRAW, &draw);
+            .write_buffer(b::WP_BINDING_DRAW, &draw)
+            .write_storage_image(b::WP_BINDING_PHOTON_SLOTS, &slots);
         let pipeline = ComputePipeline::new(
             ctx,
             "water_photons/trace.comp",
@@ -143,6 +160,7 @@ impl Trace {
         )?;
         Ok(Self {
             photons,
+            slots,
             draw,
             readback,
             capacity,
@@ -178,19 +196,40 @@ impl Trace {
         rec.pass("photon trace", |cmd| {
             // Reset by a transfer write, after last frame's indirect read
             // and copy (write-after-read).
+            // The slots are cleared the same way, after last frame's
+            // water view read them: a texel that sends no photon this
+            // frame (and the inner texels of cascades ≥ 1, never written)
+            // must read "none".
             barrier(
                 &ctx,
                 cmd,
-                &[],
+                &[ImageAccess::discard(&self.slots, Access::TransferWrite)],
                 &[BufferAccess::new(&self.draw, Access::TransferWrite)],
             );
             let reset = DrawCounters {
                 vertex_count: 4,
                 ..Zeroable::zeroed()
             };
+            let none = vk::ClearColorValue {
+                uint32: [u32::MAX; 4],
+            };
+            let all_layers = vk::ImageSubresourceRange {
+                aspect_mask: vk::ImageAspectFlags::COLOR,
+                base_mip_level: 0,
+                level_count: 1,
+                base_array_layer: 0,
+                layer_count: vk::REMAINING_ARRAY_LAYERS,
+            };
             unsafe {
                 ctx.device
-                    .cmd_update_buffer(cmd, self.draw.raw, 0, bytemuck::bytes_of(&reset))
+                    .cmd_update_buffer(cmd, self.draw.raw, 0, bytemuck::bytes_of(&reset));
+                ctx.device.cmd_clear_color_image(
+                    cmd,
+                    self.slots.raw,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &none,
+                    &[all_layers],
+                );
             };
             // The reset before the atomics; the CCM attachments before the
             // storage-image reads; the photon slots after last frame's
@@ -201,6 +240,7 @@ impl Trace {
                 &[
                     ImageAccess::new(ccm_position, Access::ComputeRead),
                     ImageAccess::new(ccm_normal, Access::ComputeRead),
+                    ImageAccess::new(&self.slots, Access::ComputeWrite),
                 ],
                 &[
                     BufferAccess::new(&self.draw, Access::ComputeWrite),

@@ -1,0 +1,125 @@
+//! "water view" (glsl/water_photons/view.comp): the camera's view of the
+//! water surface, recomputed after image_space's `CameraRefraction` on the
+//! pixels whose nearest specular surface is the traced water (one
+//! interface): the reflected and refracted camera rays traced through the
+//! BVH; a hit the camera sees directly takes the opaque frame's radiance
+//! (direct + splatted caustics), a hit hidden from it (behind a wall,
+//! outside the view) is shaded there, its caustic gathered from the
+//! photons through the trace's slot image with the splat's kernel.
+
+use super::WpParamsBuffer;
+use crate::passes::gbuffer::GBuffer;
+use crate::passes::specular_gbuffer::SpecularGBuffer;
+use crate::renderer::{FrameTargets, SceneGpu};
+use crate::shader_bindings as b;
+use crate::vk::{
+    barrier, Access, BindingKind, Buffer, BufferAccess, ComputePipeline, Context, DescriptorSet,
+    DescriptorSetLayout, FrameRecorder, Image, ImageAccess, VkResult,
+};
+use ash::vk;
+use std::sync::Arc;
+
+pub struct WaterView {
+    pipeline: ComputePipeline,
+    set: DescriptorSet,
+    bound_radiance: vk::ImageView,
+    _layout: DescriptorSetLayout,
+}
+
+impl WaterView {
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene_gpu: &SceneGpu,
+        params: &WpParamsBuffer,
+        photons: &Buffer,
+        slots: &Image,
+        opaque: &Image,
+        opaque_gbuffer: &GBuffer,
+        specular: &SpecularGBuffer,
+    ) -> VkResult<Self> {
+        let layout = DescriptorSetLayout::new(
+            ctx,
+            &[
+                (b::WP_BINDING_PARAMS, BindingKind::Uniform),
+                (b::WP_BINDING_PHOTONS, BindingKind::Storage),
+                (b::WP_BINDING_PHOTON_SLOTS, BindingKind::StorageImage),
+                (b::WP_BINDING_OPAQUE_RADIANCE, BindingKind::StorageImage),
+                (b::WP_BINDING_GBUFFER_POSITION, BindingKind::StorageImage),
+                (b::WP_BINDING_FRONT_POSITION, BindingKind::StorageImage),
+                (b::WP_BINDING_FRONT_NORMAL, BindingKind::StorageImage),
+                (b::WP_BINDING_BACK_POSITION, BindingKind::StorageImage),
+                (b::WP_BINDING_RADIANCE, BindingKind::StorageImage),
+            ],
+        )?;
+        let set = DescriptorSet::new(ctx, &layout)?;
+        set.write_buffer(b::WP_BINDING_PARAMS, &params.0)
+            .write_buffer(b::WP_BINDING_PHOTONS, photons)
+            .write_storage_image(b::WP_BINDING_PHOTON_SLOTS, slots)
+            .write_storage_image(b::WP_BINDING_OPAQUE_RADIANCE, opaque)
+            .write_storage_image(b::WP_BINDING_GBUFFER_POSITION, &opaque_gbuffer.position)
+            .write_storage_image(b::WP_BINDING_FRONT_POSITION, &specular.front_position)
+            .write_storage_image(b::WP_BINDING_FRONT_NORMAL, &specular.front_normal)
+            .write_storage_image(b::WP_BINDING_BACK_POSITION, &specular.back_position);
+        let pipeline = ComputePipeline::new(
+            ctx,
+            "water_photons/view.comp",
+            &[&scene_gpu.layout, &layout],
+            0,
+        )?;
+        Ok(Self {
+            pipeline,
+            set,
+            bound_radiance: vk::ImageView::null(),
+            _layout: layout,
+        })
+    }
+
+    /// Records "water view": reads the photons and their slots (the trace),
+    /// the opaque frame (composite) and the specular G-buffer (refraction
+    /// pass), rewrites the water's pixels of `targets.radiance`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &mut self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        photons: &Buffer,
+        slots: &Image,
+        opaque: &Image,
+        opaque_gbuffer: &GBuffer,
+        specular: &SpecularGBuffer,
+        targets: &FrameTargets,
+    ) {
+        if self.bound_radiance != targets.radiance.view {
+            // Legal: the renderer waits for every frame before the next.
+            self.set
+                .write_storage_image(b::WP_BINDING_RADIANCE, &targets.radiance);
+            self.bound_radiance = targets.radiance.view;
+        }
+        let ctx = rec.ctx().clone();
+        rec.pass("water view", |cmd| {
+            // The trace's photon and slot writes, the composite's radiance
+            // writes and the refraction pass's radiance writes (this pass
+            // rewrites some of its pixels: write after write) before these
+            // reads; the specular G-buffer's attachments were made visible
+            // to compute by the refraction pass's barrier.
+            barrier(
+                &ctx,
+                cmd,
+                &[
+                    ImageAccess::new(slots, Access::ComputeRead),
+                    ImageAccess::new(opaque, Access::ComputeRead),
+                    ImageAccess::new(&opaque_gbuffer.position, Access::ComputeRead),
+                    ImageAccess::new(&specular.front_position, Access::ComputeRead),
+                    ImageAccess::new(&specular.front_normal, Access::ComputeRead),
+                    ImageAccess::new(&specular.back_position, Access::ComputeRead),
+                    ImageAccess::new(&targets.radiance, Access::ComputeWrite),
+                ],
+                &[BufferAccess::new(photons, Access::ComputeRead)],
+            );
+            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
+            self.pipeline
+                .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
+        });
+    }
+}
