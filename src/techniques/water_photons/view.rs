@@ -10,7 +10,7 @@
 use super::WpParamsBuffer;
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::specular_gbuffer::SpecularGBuffer;
-use crate::renderer::{FrameTargets, SceneGpu};
+use crate::frame::{FrameTargets, SceneGpu};
 use crate::shader_bindings as b;
 use crate::vk::{
     barrier, Access, BindingKind, Buffer, BufferAccess, ComputePipeline, Context, DescriptorSet,
