@@ -44,6 +44,10 @@ pub struct ReferenceSettings {
     pub alpha: f32,
     /// Medium collisions stored per pass for the volume gather.
     pub volume_capacity: u32,
+    /// Share of the photons aimed at the bounding sphere of the specular
+    /// objects (a mixture with the light's own distribution, unbiased for
+    /// any share below 1; 0: none aimed).
+    pub aim_share: f32,
 }
 
 /// The volume radius starts this many surface radii wide: a 3D density
@@ -62,6 +66,7 @@ impl Default for ReferenceSettings {
             volume_radius: None,
             alpha: 2.0 / 3.0,
             volume_capacity: 1 << 21,
+            aim_share: 0.5,
         }
     }
 }
@@ -75,6 +80,23 @@ pub fn default_radius(camera: &crate::scene::Camera, height: u32) -> f32 {
     let distance = (camera.target - camera.eye).length().max(1e-3);
     let footprint = 2.0 * (camera.fov_y_deg.to_radians() * 0.5).tan() * distance / height as f32;
     1.5 * footprint
+}
+
+/// A sphere around every mirror and dielectric triangle of `scene` at
+/// `time` (the box's centre and half diagonal), or None without any.
+pub fn specular_sphere(scene: &crate::scene::Scene, time: f32) -> Option<(glam::Vec3, f32)> {
+    use crate::scene::MaterialKind;
+    let mut lo = glam::Vec3::splat(f32::INFINITY);
+    let mut hi = glam::Vec3::splat(f32::NEG_INFINITY);
+    for t in scene.triangles(time) {
+        if scene.materials[t.material as usize].kind != MaterialKind::Diffuse {
+            for p in t.positions {
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+    }
+    (lo.x <= hi.x).then(|| ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-4)))
 }
 
 /// Knaus & Zwicker 2011 (probabilistic progressive photon mapping), Eq. 15
@@ -104,6 +126,9 @@ struct Push {
     volume_mask: u32,
     volume_capacity: u32,
     gather: u32,
+    aim: [f32; 4],
+    aim_share: f32,
+    pad: [u32; 3],
 }
 
 /// What one pass leaves behind, for the progress report.
@@ -139,6 +164,8 @@ pub struct Reference {
     surface_table: u32,
     volume_table: u32,
     volume_capacity: u32,
+    /// Where photons are aimed: centre and radius (0: nowhere).
+    aim: [f32; 4],
     /// Radii of the next pass.
     radius: f32,
     volume_radius: f32,
@@ -152,7 +179,8 @@ pub struct Reference {
 }
 
 impl Reference {
-    /// `radius`: the first pass's surface gather radius (m).
+    /// `radius`: the first pass's surface gather radius (m); `aim`: the
+    /// bounding sphere photons are aimed at (`specular_sphere`).
     pub fn new(
         ctx: &Arc<Context>,
         scene_gpu: &SceneGpu,
@@ -160,10 +188,17 @@ impl Reference {
         settings: ReferenceSettings,
         radius: f32,
         has_medium: bool,
+        aim: Option<(glam::Vec3, f32)>,
     ) -> anyhow::Result<Self> {
         let accum_bytes = check_image_size(ctx, targets.width, targets.height)?;
         if !(radius.is_finite() && radius > 0.0) {
             anyhow::bail!("the photon-mapping radius must be positive and finite, got {radius}");
+        }
+        if !(0.0..1.0).contains(&settings.aim_share) {
+            anyhow::bail!(
+                "the aimed share of photons must lie in [0, 1), got {}",
+                settings.aim_share
+            );
         }
         if !(settings.alpha > 0.0 && settings.alpha < 1.0) {
             anyhow::bail!("alpha must lie in (0, 1), got {}", settings.alpha);
@@ -230,6 +265,7 @@ impl Reference {
             surface_table,
             volume_table,
             volume_capacity,
+            aim: aim.map_or([0.0; 4], |(c, r)| [c.x, c.y, c.z, r]),
             radius,
             volume_radius: settings
                 .volume_radius
@@ -280,6 +316,9 @@ impl Reference {
             volume_mask: self.volume_table - 1,
             volume_capacity: self.volume_capacity,
             gather: self.settings.photon_mapping as u32,
+            aim: self.aim,
+            aim_share: self.settings.aim_share,
+            pad: [0; 3],
         }
     }
 
@@ -539,6 +578,7 @@ impl ReferenceRenderer {
             settings,
             radius,
             scene.medium.is_some(),
+            specular_sphere(&scene, time),
         )?;
         let profiler = crate::vk::Profiler::new(ctx, 16)?;
         profiler.frame(|rec| {

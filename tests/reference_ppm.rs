@@ -48,7 +48,7 @@ fn settings(batch: u32, seed: u32) -> ReferenceSettings {
 /// angle θ_s, seen from the air: the floor's radiance is
 /// T(θ_s) T(θ_v) albedo E cos θ_s / (π n²) (GUIDE §2: radiance crossing an
 /// interface keeps L / n²), with T the Fresnel transmittance at each angle.
-/// Measured: mean over the floor pixels within 0.4% of it at 16 passes.
+/// Measured: +0.36% over the floor pixels at 16 passes.
 #[test]
 fn floor_under_flat_water_seen_from_above_matches_fresnel_and_n_squared() {
     let ctx = validated_context();
@@ -97,7 +97,8 @@ fn floor_under_flat_water_seen_from_above_matches_fresnel_and_n_squared() {
 /// plate blocks the direct path), and the camera sees that spot in the
 /// mirror: L = R · albedo/π · R I cos θ / d'², with d' the distance from the
 /// light's mirror image and θ the angle at the floor toward it.
-/// Measured: 0.5% at 24 passes of 2^17 photons.
+/// Measured: +0.24% at 48 passes of 2^17 photons over a spot of 0.3 m
+/// radius (the photons landing there give ~1% noise; +0.09% at 128 passes).
 #[test]
 fn floor_lit_and_seen_through_a_mirror_matches_the_mirror_image_light() {
     let ctx = validated_context();
@@ -137,8 +138,8 @@ fn floor_lit_and_seen_through_a_mirror_matches_the_mirror_image_light() {
             ),
         ],
     );
-    let mut r = ReferenceRenderer::new(&ctx, s, size, size, 0.0, settings(1 << 17, 2)).unwrap();
-    r.trace(24 << 17, |_, _| {}).unwrap();
+    let mut r = ReferenceRenderer::new(&ctx, s, size, size, 0.0, settings(1 << 17, 7)).unwrap();
+    r.trace(48 << 17, |_, _| {}).unwrap();
     let img = r.resolve(Component::SurfaceCaustics).unwrap();
     assert_finite(&img);
     let (mut measured, mut expected, mut pixels) = (0.0f64, 0.0f64, 0);
@@ -149,7 +150,7 @@ fn floor_lit_and_seen_through_a_mirror_matches_the_mirror_image_light() {
             let m = o + d * t_mirror;
             let reflected = Vec3::new(d.x, d.y, -d.z);
             let p = m + reflected * (-m.y / reflected.y);
-            if (p - spot).length() > 0.15 {
+            if (p - spot).length() > 0.3 {
                 continue;
             }
             let to_image = image_light - p;

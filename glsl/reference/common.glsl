@@ -66,6 +66,9 @@ layout(push_constant) uniform Push {
     uint volume_mask;      // volume hash table size - 1
     uint volume_capacity;  // volume photons stored at most (0: no volume photon map)
     uint gather;           // 1: progressive photon mapping on (0: light tracer only)
+    vec4 aim;              // bounding sphere of the specular triangles (w = 0: none)
+    float aim_share;       // share of photons aimed at it
+    uint pad0, pad1, pad2;
 } pc;
 
 uint image_width() { return uint(frame.viewport.x); }

@@ -8,9 +8,9 @@
 //! photons through the trace's slot image with the splat's kernel.
 
 use super::WpParamsBuffer;
+use crate::frame::{FrameTargets, SceneGpu};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::specular_gbuffer::SpecularGBuffer;
-use crate::frame::{FrameTargets, SceneGpu};
 use crate::shader_bindings as b;
 use crate::vk::{
     barrier, Access, BindingKind, Buffer, BufferAccess, ComputePipeline, Context, DescriptorSet,
