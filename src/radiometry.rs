@@ -58,10 +58,10 @@ pub fn henyey_greenstein(cos_theta: f32, g: f32) -> f32 {
     (1.0 - g * g) / (4.0 * PI * denom * denom.sqrt())
 }
 
-/// A path-type component of the ground truth (Heckbert's notation). Paths
-/// whose last segment to the eye passes through a specular surface are
-/// covered only as L D S+ E (see docs/ARCHITECTURE.md, "What the ground
-/// truth does not cover").
+/// A path-type component of the ground truth (Heckbert's notation), named
+/// by the light's path up to the diffuse surface or medium point seen:
+/// a caustic seen through water is still a surface caustic
+/// (docs/ARCHITECTURE.md, "The ground truth").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Component {
     /// L D (and L D S+ E through the camera-side chains).

@@ -186,10 +186,10 @@ struct Bound {
 /// volume_caustics component with `photons` photons (two halves, to report
 /// the reference's own noise).
 fn matches_reference(ctx: &Arc<Context>, label: &str, scene: &Scene, photons: u64, bound: Bound) {
-    // Neither the reference nor the lines show the medium seen through
-    // glass (docs/ARCHITECTURE.md, "What the ground truth does not cover";
-    // Hu Sect. 5.3): pixels whose camera ray meets a specular surface first
-    // are zeroed in both images.
+    // The lines do not show the medium seen through glass (Hu Sect. 5.3:
+    // B is drawn along camera rays only), while the reference does (its
+    // volume gather along camera chains): pixels whose camera ray meets a
+    // specular surface first are zeroed in both images.
     let mask = first_hit_mask(scene, SIZE, true, |k| k == MaterialKind::Diffuse);
     let mut reference = ReferenceRenderer::new(
         ctx,

@@ -19,10 +19,9 @@
 //! - water_pool seen from a camera below the surface (module docs of
 //!   `water_photons`): the surface-caustics energy within 4% of the
 //!   reference's L S+ D component, over the pixels whose camera ray meets
-//!   a diffuse surface under the water without crossing the surface. A camera above the water sees the floor
-//!   through the surface, an L S D S E path the reference (a light tracer
-//!   connecting diffuse hits to the camera) cannot connect: it renders that
-//!   floor black, so the comparison needs the camera under water.
+//!   a diffuse surface under the water without crossing the surface. This test keeps the camera
+//!   under water, where the floor is seen directly; the view from above
+//!   (L S D S E, photon mapping in the reference) is tests/views.rs.
 //! - Flat water seen from above: the frame's radiance on the floor is the
 //!   analytic T(θ_s) T(θ_v) albedo E cos θ_s / (π n²) (GUIDE §2), on floor
 //!   the camera also sees directly and on floor a near wall hides from it
@@ -559,8 +558,8 @@ fn pool_caustics_from_below_match_the_reference() {
 
     // The compared pixels: those whose first hit is a diffuse surface
     // below the water plane (reached without crossing the water; a pixel
-    // whose ray crosses the surface shows the opaque frame directly, an
-    // L S D S E path the reference cannot connect); and of those, the
+    // whose ray crosses the surface sees through it, an L S D S E path
+    // compared in tests/views.rs); and of those, the
     // inner cascade's region of the 2-cascade default.
     let s = below();
     let w = s.objects.iter().find_map(|o| o.water.clone()).unwrap();

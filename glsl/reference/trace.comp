@@ -165,8 +165,12 @@ void connect_medium(vec3 x, vec3 d, vec3 weight_sigma_s, float g, uint tag, inou
 // disk kernel): a photon of flux Phi landing at x adds to every visible
 // point v within r of it, on the side of the surface v's camera path sees,
 //     L_v += W_v (albedo/pi) Phi / (pi r_i^2 N_i)
-// (W_v (albedo/pi) is stored in the point, N_i is the photons of pass i). The
-// average over passes converges as r_i shrinks (reference.rs: radius rule).
+// (W_v (albedo/pi) is stored in the point, N_i is the photons of pass i).
+// Each pass is an independent estimate with its own radius, shrunk after
+// pass i by Knaus & Zwicker's Eq. 15, r_{i+1}^2 = r_i^2 (i + alpha)/(i + 1)
+// (alpha = 2/3; reference.rs `next_radius`): the mean over passes converges
+// to the exact radiance: the bias of pass i goes as r_i^2, and the
+// variance of the mean still vanishes since r_i shrinks that slowly.
 // Normals more than 60 degrees apart mean another surface (a corner): those
 // points are skipped, which changes nothing in the limit r -> 0.
 void gather_surface(vec3 x, vec3 arrival_side, vec3 flux, uint tag) {
