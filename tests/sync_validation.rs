@@ -2,11 +2,13 @@
 //! (`common::validated_context`, `ContextOptions::sync_validation`): every
 //! test that asserts a clean validation log also asserts that no two
 //! commands race. This canary checks the layer really reports a missing
-//! barrier, so a silent suite means no hazard rather than no checking.
+//! barrier, so a silent suite means no hazard rather than no checking, also
+//! between two passes of a frame (on lavapipe the profiler then records the
+//! frame into one command buffer instead of waiting after every pass).
 
 mod common;
 
-use caustics::vk::{Buffer, BufferUsage};
+use caustics::vk::{Buffer, BufferUsage, Profiler, TimingSource};
 
 #[test]
 fn a_missing_barrier_is_reported() {
@@ -29,5 +31,35 @@ fn a_missing_barrier_is_reported() {
             .iter()
             .any(|e| e.contains("SYNC-HAZARD-WRITE-AFTER-WRITE")),
         "expected a write-after-write hazard, got: {errors:?}"
+    );
+}
+
+#[test]
+fn a_missing_barrier_between_passes_is_reported() {
+    let ctx = common::validated_context();
+    let buffer = Buffer::new(&ctx, "canary", 256, BufferUsage::Storage).unwrap();
+    let profiler = Profiler::new(&ctx, 4).unwrap();
+    if ctx.is_cpu() {
+        assert_eq!(profiler.source, TimingSource::ValidatedFrame);
+    }
+    profiler
+        .frame(|rec| {
+            // Each pass alone is fine; the second lacks the barrier that
+            // orders it after the first.
+            rec.pass("first write", |cmd| unsafe {
+                ctx.device.cmd_fill_buffer(cmd, buffer.raw, 0, 256, 1)
+            });
+            rec.pass("second write", |cmd| unsafe {
+                ctx.device.cmd_fill_buffer(cmd, buffer.raw, 0, 256, 2)
+            });
+            Ok(())
+        })
+        .unwrap();
+    let errors = ctx.validation_errors();
+    assert!(
+        errors
+            .iter()
+            .any(|e| e.contains("SYNC-HAZARD-WRITE-AFTER-WRITE")),
+        "expected a write-after-write hazard between the passes, got: {errors:?}"
     );
 }

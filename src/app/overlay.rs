@@ -94,6 +94,7 @@ pub use enabled::Overlay;
 #[cfg(feature = "overlay")]
 mod enabled {
     use super::*;
+    use crate::params::Apply;
     use crate::techniques::TECHNIQUES;
     use egui_ash_renderer::{DynamicRendering, Options, RenderMode, Renderer};
 
@@ -286,9 +287,14 @@ mod enabled {
                     let mut edited = false;
                     let mut values = Vec::new();
                     for spec in info.params() {
-                        let mut v = current.get(spec.name);
+                        // The values belong to this technique's specs; a
+                        // missing one shows its default.
+                        let mut v = current.value(spec.name).unwrap_or(spec.default);
                         let mut slider =
                             egui::Slider::new(&mut v, spec.min..=spec.max).text(spec.name);
+                        if spec.apply == Apply::Live {
+                            slider = slider.suffix(" (live)");
+                        }
                         if spec.integer {
                             slider = slider.integer();
                         }

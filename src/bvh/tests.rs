@@ -1,4 +1,5 @@
-//! BVH invariants and CPU traversal against brute force.
+//! BVH invariants and CPU traversal against brute force. (Over 600 lines:
+//! unit tests only, one per invariant, kept beside the code they test.)
 
 use super::*;
 use crate::gpu::GpuTriangle;

@@ -7,6 +7,11 @@
 //! timestamps do not measure compute dispatches (GUIDE §8), one submission
 //! per pass timed by the host clock. The source in use is reported with
 //! every timing.
+//!
+//! Under synchronization validation a CPU device records the frame into one
+//! command buffer too (`TimingSource::ValidatedFrame`): the host wait after
+//! every pass of the wall-clock mode would order each pass after the last
+//! and hide a missing barrier between two passes from the layer.
 
 use super::{Context, VkResult};
 use ash::vk;
@@ -19,6 +24,9 @@ pub enum TimingSource {
     Timestamps,
     /// One submission per pass, host wall clock from submit to fence.
     WallClock,
+    /// A CPU device under synchronization validation: the whole frame in one
+    /// command buffer with timestamps, which miss compute dispatches there.
+    ValidatedFrame,
 }
 
 impl TimingSource {
@@ -27,6 +35,9 @@ impl TimingSource {
             TimingSource::Timestamps => "GPU timestamp queries",
             TimingSource::WallClock => {
                 "wall clock per pass submission (CPU device: its timestamps miss compute)"
+            }
+            TimingSource::ValidatedFrame => {
+                "GPU timestamp queries in one command buffer for synchronization validation (CPU device: they miss compute)"
             }
         }
     }
@@ -56,17 +67,36 @@ pub struct FrameRecorder<'a> {
 }
 
 impl Profiler {
+    /// The profiler for frames: timestamps in one command buffer on a GPU;
+    /// on a CPU device one submission per pass timed by the host clock, or
+    /// one command buffer per frame when synchronization validation is on
+    /// (see the module doc).
     pub fn new(ctx: &Arc<Context>, max_passes: u32) -> VkResult<Self> {
-        let capacity = max_passes * 2;
-        let info = vk::QueryPoolCreateInfo::default()
-            .query_type(vk::QueryType::TIMESTAMP)
-            .query_count(capacity);
-        let pool = unsafe { ctx.device.create_query_pool(&info, None) }?;
+        let source = match (ctx.is_cpu(), ctx.sync_validation) {
+            (false, _) => TimingSource::Timestamps,
+            (true, false) => TimingSource::WallClock,
+            (true, true) => TimingSource::ValidatedFrame,
+        };
+        Self::with_source(ctx, max_passes, source)
+    }
+
+    /// A profiler for measurements that need each pass's time whatever the
+    /// validation: per-pass host clock on a CPU device, timestamps on a GPU.
+    pub fn for_timing(ctx: &Arc<Context>, max_passes: u32) -> VkResult<Self> {
         let source = if ctx.is_cpu() {
             TimingSource::WallClock
         } else {
             TimingSource::Timestamps
         };
+        Self::with_source(ctx, max_passes, source)
+    }
+
+    fn with_source(ctx: &Arc<Context>, max_passes: u32, source: TimingSource) -> VkResult<Self> {
+        let capacity = max_passes * 2;
+        let info = vk::QueryPoolCreateInfo::default()
+            .query_type(vk::QueryType::TIMESTAMP)
+            .query_count(capacity);
+        let pool = unsafe { ctx.device.create_query_pool(&info, None) }?;
         Ok(Self {
             ctx: ctx.clone(),
             pool,
@@ -103,7 +133,7 @@ impl Profiler {
                     .map(|(name, ms)| PassTiming { name, ms })
                     .collect())
             }
-            TimingSource::Timestamps => {
+            TimingSource::Timestamps | TimingSource::ValidatedFrame => {
                 let pool = self.pool;
                 let capacity = self.capacity;
                 ctx.submit_and_wait(|cmd| {
