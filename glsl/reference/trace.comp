@@ -88,6 +88,10 @@ uint pick_light(float u, out float probability) {
 void emit(uint l, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) {
     Light light = lights[l];
     uint kind = floatBitsToUint(light.position.w);
+    // A random choice per photon. (Stratifying it by invocation, aimed
+    // photons first, measured 2x slower on ball_lens at 128^2: the aimed
+    // photons then land together and their float atomics on the caustic's
+    // few pixels contend.)
     float choice = rng_next(rng);
     vec2 u = vec2(rng_next(rng), rng_next(rng));
     vec3 aim_center = pc.aim.xyz;
