@@ -1331,7 +1331,8 @@ fn flat_water_seen_from_above_has_the_analytic_radiance() {
         (&[][..], 0.005, 0.03),
     ] {
         let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-        let params = Params::resolve("water_photons", PARAMS, &overrides).unwrap();
+        let params =
+            Params::resolve("water_photons", WaterPhotonsParams::specs(), &overrides).unwrap();
         let mut r = Renderer::new(&ctx, s.clone(), "water_photons", &params, N, N, 0.0).unwrap();
         r.scene_gpu.components = Component::All.mask();
         r.render_frame(0.0).unwrap();
