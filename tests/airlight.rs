@@ -429,18 +429,7 @@ fn against_reference(path: &str, g: Option<f32>, name: &str) -> (f64, f32, f32, 
     let comparable = first_hit_mask(&s, REF_SIZE, true, |k| {
         k == caustics::scene::MaterialKind::Diffuse
     });
-    let keep = |img: Vec<f32>| -> Vec<f32> {
-        img.chunks(4)
-            .zip(&comparable)
-            .flat_map(|(p, &k)| {
-                if k {
-                    [p[0], p[1], p[2], p[3]]
-                } else {
-                    [0.0; 4]
-                }
-            })
-            .collect()
-    };
+    let keep = |img: Vec<f32>| masked(&img, &comparable);
     let (actual, ms) = render_airlight_at(&ctx, &s, &[], REF_SIZE);
     let actual = keep(actual);
     let mut reference = ReferenceRenderer::new(

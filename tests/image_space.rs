@@ -536,11 +536,6 @@ fn ball_lens_focus() {
     assert_validation_clean(&ctx);
 }
 
-/// rgb summed over the image.
-fn energy(img: &[f32]) -> f64 {
-    img.chunks(4).map(|p| (p[0] + p[1] + p[2]) as f64).sum()
-}
-
 /// The bound of one photon mode against the reference on one scene.
 struct Bound {
     photon_mode: u32,
@@ -582,18 +577,7 @@ fn caustics_match_reference(name: &str, photons: u64, bounds: &[Bound]) {
     let mask = first_hit_mask(&load(), SIZE, false, |k| {
         k == caustics::scene::MaterialKind::Diffuse
     });
-    let masked = |img: Vec<f32>| -> Vec<f32> {
-        img.chunks(4)
-            .zip(&mask)
-            .flat_map(|(p, &keep)| {
-                if keep {
-                    [p[0], p[1], p[2], p[3]]
-                } else {
-                    [0.0; 4]
-                }
-            })
-            .collect()
-    };
+    let masked = |img: Vec<f32>| masked(&img, &mask);
     let mut reference =
         ReferenceRenderer::new(&ctx, load(), SIZE, SIZE, 0.0, ReferenceSettings::default())
             .unwrap();

@@ -286,18 +286,7 @@ fn image_space_caustics_are_attenuated_like_the_reference() {
     let mask = first_hit_mask(&load(), SIZE, false, |k| {
         k == caustics::scene::MaterialKind::Diffuse
     });
-    let masked = |img: Vec<f32>| -> Vec<f32> {
-        img.chunks(4)
-            .zip(&mask)
-            .flat_map(|(p, &keep)| {
-                if keep {
-                    [p[0], p[1], p[2], 0.0]
-                } else {
-                    [0.0; 4]
-                }
-            })
-            .collect()
-    };
+    let masked = |img: Vec<f32>| masked(&img, &mask);
     let frame = |technique: &str| {
         let info = techniques::find(technique).unwrap();
         let params = Params::resolve(technique, info.params(), &[]).unwrap();

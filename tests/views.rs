@@ -26,10 +26,6 @@ fn load(name: &str) -> Scene {
     Scene::load(&path).unwrap()
 }
 
-fn energy(img: &[f32]) -> f64 {
-    img.chunks(4).map(|p| (p[0] + p[1] + p[2]) as f64).sum()
-}
-
 /// Bounds on one comparison: |relative energy| and FLIP mean, per
 /// component (direct, surface caustics) and for the full frame's FLIP.
 struct Bounds {

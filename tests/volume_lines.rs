@@ -117,11 +117,6 @@ fn volume_caustic(ctx: &Arc<Context>, scene: &Scene, overrides: &[&str]) -> Vec<
     render(ctx, scene, overrides, Component::VolumeCaustics.mask()).radiance()
 }
 
-/// rgb summed over the image.
-fn energy(img: &[f32]) -> f64 {
-    img.chunks(4).map(|p| (p[0] + p[1] + p[2]) as f64).sum()
-}
-
 fn set_medium(scene: &mut Scene, sigma_s: f32, sigma_a: f32, g: f32) {
     let m = scene.medium.as_mut().expect("scene has a medium");
     m.sigma_s = Vec3::splat(sigma_s);
@@ -159,19 +154,6 @@ fn optically_thin_volume_caustic_is_linear_in_sigma_s() {
     assert!(one > 0.0);
     assert!((ratio / 2.0 - 1.0).abs() < 0.05, "ratio {ratio}");
     assert_validation_clean(&ctx);
-}
-
-fn masked(img: &[f32], mask: &[bool]) -> Vec<f32> {
-    img.chunks(4)
-        .zip(mask)
-        .flat_map(|(p, &keep)| {
-            if keep {
-                [p[0], p[1], p[2], 0.0]
-            } else {
-                [0.0; 4]
-            }
-        })
-        .collect()
 }
 
 /// Bounds of one comparison with the reference.

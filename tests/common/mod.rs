@@ -264,6 +264,26 @@ pub fn assert_finite(rgba: &[f32]) {
     assert!(rgba.iter().all(|v| v.is_finite()), "image has NaN or Inf");
 }
 
+/// rgb summed over an RGBA f32 image.
+pub fn energy(img: &[f32]) -> f64 {
+    img.chunks(4).map(|p| (p[0] + p[1] + p[2]) as f64).sum()
+}
+
+/// An RGBA f32 image with the pixels outside `mask` set to 0 (the rgb of
+/// those inside kept, alpha 0): comparisons restricted to comparable pixels.
+pub fn masked(img: &[f32], mask: &[bool]) -> Vec<f32> {
+    img.chunks(4)
+        .zip(mask)
+        .flat_map(|(p, &keep)| {
+            if keep {
+                [p[0], p[1], p[2], 0.0]
+            } else {
+                [0.0; 4]
+            }
+        })
+        .collect()
+}
+
 /// RGB bytes of an RGBA8 image.
 pub fn rgb8(rgba: &[u8]) -> Vec<u8> {
     rgba.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect()
