@@ -29,7 +29,7 @@ use caustics::passes::airlight::{Airlight, AirlightParams};
 use caustics::radiometry::spot_falloff;
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use caustics::scene::{Density, LightKind, Medium, Scene};
-use caustics::techniques::direct::{Direct, DirectParams};
+use caustics::passes::direct_light::{DirectLight, DirectParams};
 use caustics::techniques::Technique;
 use caustics::vk::{Context, Profiler};
 use common::*;
@@ -66,7 +66,7 @@ fn render_airlight_at(
     scene_gpu.components = Component::Airlight.mask();
     let targets = FrameTargets::new(ctx, size, size).unwrap();
     let direct_params = DirectParams::from_params(&params).unwrap();
-    let mut direct = Direct::new(ctx, &direct_params, scene, &scene_gpu, size, size).unwrap();
+    let mut direct = DirectLight::new(ctx, &direct_params, scene, &scene_gpu, size, size).unwrap();
     let mut air = Airlight::new(
         ctx,
         &AirlightParams::from_params(&params).unwrap(),

@@ -66,18 +66,23 @@
 //! internal reflection or no back face).
 
 use crate::frame::SceneGpu;
+use crate::passes::camera_refraction::RefractionPush;
+use crate::passes::direct_light::DirectParams;
+use crate::passes::surface_frame::SurfaceFrame;
+use crate::passes::gbuffer::GBuffer;
+use crate::passes::light_views::{LightView, LightViewConsumer, LightViews};
 use crate::passes::shadow::{shadow_views, GpuShadowLight};
-use crate::passes::specular_gbuffer::{SpecularGBuffer, Viewpoint};
-use crate::scene::{Light, LightKind, MaterialKind, Scene};
+use crate::passes::specular_gbuffer::SpecularGBuffer;
+use crate::scene::{Light, LightKind};
 use crate::shader_bindings as b;
 use crate::vk::{
     barrier, begin_rendering, end_rendering, Access, BindingKind, Buffer, BufferAccess,
     BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder,
-    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageAccess, ImageDesc, VkResult,
+    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageAccess, ImageDesc, Sampler, VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use std::mem::size_of;
 use std::sync::Arc;
 
@@ -96,7 +101,8 @@ pub struct GpuPhoton {
 }
 const _: () = assert!(size_of::<GpuPhoton>() == 48);
 
-/// Push constants of photons.comp.
+/// Push constants of photons.comp: the light's view (`LightView`) and how
+/// its photons find their paths.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct PhotonViewPush {
@@ -120,87 +126,68 @@ struct SplatPush {
     splat_size: u32,
 }
 
-/// The light-space photon view of `light` fitted to the sphere `(centre,
-/// radius)` around the specular objects, at `size` texels; `None` when a
-/// point or spot light sits inside the sphere (no frustum can hold it).
-pub fn photon_view(
-    light: &Light,
-    light_index: u32,
-    specular: (Vec3, f32),
-    size: u32,
-) -> Option<PhotonViewPush> {
-    let (centre, radius) = specular;
-    let (origin, forward, half, mode) = match light.kind {
-        LightKind::Directional => {
-            let f = light.direction.normalize_or(Vec3::NEG_Y);
-            let extent = radius * 1.01;
-            (centre - f * (2.0 * extent), f, extent, b::SHADOW_PLANAR)
-        }
-        LightKind::Point | LightKind::Spot => {
-            let to = centre - light.position;
-            let d = to.length();
-            if d <= radius * 1.0001 {
-                return None;
-            }
-            let alpha = ((radius / d).asin() * 1.01).min(1.5);
-            (light.position, to / d, alpha.tan(), b::SHADOW_RADIAL)
-        }
-    };
-    let up0 = if forward.y.abs() > 0.99 {
-        Vec3::Z
-    } else {
-        Vec3::Y
-    };
-    let right = forward.cross(up0).normalize();
-    let up = right.cross(forward);
-    Some(PhotonViewPush {
-        origin: origin.extend(half).to_array(),
-        right: right.extend(f32::from_bits(light_index)).to_array(),
-        up: up.extend(f32::from_bits(size)).to_array(),
-        forward: forward.extend(f32::from_bits(mode)).to_array(),
-        mode: [b::PHOTON_MODE_TRACED, 0, 0, 0],
-    })
+crate::declare_params! {
+    /// Wyman's image-space parameters: `DirectLight`'s, then the caustic
+    /// map's and the camera refraction's (the `image_space` technique's
+    /// parameters, and a group of `volume_lines'`).
+    pub struct ImageSpaceParams {
+        @group direct: DirectParams;
+        photon_buffer_size: u32 [64, 1024] = 512, rebuild,
+            "photon buffer resolution (photons per side of the light view)";
+        caustic_map_size: u32 [64, 1024] = 512, rebuild,
+            "caustic map resolution per light view (texels per side)";
+        splat_size: u32 [1, 15] = 7, rebuild,
+            "photon splat width in caustic-map texels (odd; an even value is raised by 1)";
+        photon_mode: u32 [0, 2] = 0, rebuild,
+            "0: photon paths traced exactly through the BVH; 1: Wyman's two-sided image-space refraction from light-space front/back G-buffers (Eq. 6.3.1 distance); 2: the same G-buffers, the refracted ray marched against the back-face map (exact for convex objects)";
+        tir_remedy: u32 [0, 2] = 1, rebuild,
+            "total internal reflection at the approximated exit (Wyman 2006's ad hoc remedies; camera and photon_mode 1): 0 single refraction (T2 = T1), 1 clamp to the critical angle (T2 tangent to the back face), 2 reflect and ignore the refractor. Default 1, of the two Wyman recommends (the first 'behaves poorly in dynamic scenes'): a reflected ray heads back toward the camera or the light, where the image-space search has no data and photons fly up past the light, while the clamped ray goes on through, as the light does on average";
+        eq_6_3_2: u32 [0, 1] = 1, rebuild,
+            "1: where d~ overshoots and the back-face texel holds no normal, use Wyman's Eq. 6.3.2 (N2 = T1 - (V.T1) V, the exit through the side); 0: drop the transmitted light there";
+        search_steps: u32 [4, 256] = 32, live,
+            "linear steps of the image-space search of refracted and reflected camera rays against the opaque frame (then 10 bisections)";
+        caustics_on_change: bool [0, 1] = 0, live,
+            "1: recompute the caustic map only when a light moved or animated geometry changed, reusing the last one otherwise; 0: every frame (benchmarks)";
+    }
 }
 
-/// World -> clip of a photon view (rasteriser's view of the same texel grid:
-/// texel (i, j) of the raster is photon (i, j)), for specular objects in
-/// the sphere `specular`.
-pub fn photon_view_proj(v: &PhotonViewPush, specular: (Vec3, f32)) -> Mat4 {
-    let origin = Vec3::from_slice(&v.origin[..3]);
-    let forward = Vec3::from_slice(&v.forward[..3]);
-    let up = Vec3::from_slice(&v.up[..3]);
-    let h = v.origin[3];
-    let (centre, radius) = specular;
-    let view = Mat4::look_at_rh(origin, origin + forward, up);
-    let proj = if v.forward[3].to_bits() == b::SHADOW_PLANAR {
-        let far = (centre - origin).dot(forward) + 2.0 * radius;
-        Mat4::orthographic_rh(-h, h, -h, h, 0.0, far)
-    } else {
-        let d = (centre - origin).length();
-        let far = d + 1.05 * radius;
-        let near = (d - 1.05 * radius).max(far * 1e-4);
-        Mat4::perspective_rh(2.0 * h.atan(), 1.0, near, far)
-    };
-    proj * view
-}
-
-/// Bounding sphere of every non-diffuse triangle of `scene` at time 0.
-pub fn specular_bounds(scene: &Scene) -> Option<(Vec3, f32)> {
-    let mut lo = Vec3::splat(f32::MAX);
-    let mut hi = Vec3::splat(f32::MIN);
-    let mut any = false;
-    for t in scene.triangles(0.0) {
-        let kind = scene.materials.get(t.material as usize).map(|m| m.kind);
-        if matches!(kind, Some(MaterialKind::Diffuse) | None) {
-            continue;
-        }
-        any = true;
-        for p in t.positions {
-            lo = lo.min(p);
-            hi = hi.max(p);
+impl ImageSpaceParams {
+    /// The camera refraction's push constants.
+    pub fn refraction(&self) -> RefractionPush {
+        RefractionPush {
+            tir_remedy: self.tir_remedy,
+            use_eq632: self.eq_6_3_2,
+            search_steps: self.search_steps,
+            pad: 0,
         }
     }
-    any.then(|| ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-4)))
+
+    /// The caustic map of these parameters over `surface`'s opaque frame,
+    /// its photons from `light_views`.
+    pub fn caustic_map(
+        &self,
+        ctx: &Arc<Context>,
+        scene_gpu: &SceneGpu,
+        light_views: &LightViews,
+        surface: &SurfaceFrame,
+    ) -> VkResult<CausticMap> {
+        CausticMap::new(
+            ctx,
+            scene_gpu,
+            light_views,
+            self.caustic_map_size,
+            self.splat_size,
+            PhotonPaths {
+                mode: self.photon_mode,
+                tir_remedy: self.tir_remedy,
+                use_eq632: self.eq_6_3_2 != 0,
+                medium_steps: self.direct.medium_steps,
+                on_change: self.caustics_on_change,
+            },
+            surface.gbuffer(),
+            surface.opaque(),
+        )
+    }
 }
 
 /// How photons find their refracted paths.
@@ -215,6 +202,8 @@ pub struct PhotonPaths {
     /// Midpoint steps of the transmittance through inhomogeneous media
     /// along the photons' air segments (`medium_steps`).
     pub medium_steps: u32,
+    /// `caustics_on_change`: recompute only when a light or the geometry moved.
+    pub on_change: bool,
 }
 
 pub struct CausticMap {
@@ -233,36 +222,44 @@ pub struct CausticMap {
     pub refraction: [u32; 2],
     /// Midpoint steps of the medium transmittance (`PhotonPaths::medium_steps`).
     pub medium_steps: u32,
-    /// Light-space G-buffer of the specular objects (photon modes 1, 2),
-    /// N x N, one light at a time.
-    pub light_view: SpecularGBuffer,
-    lights: Vec<Light>,
-    specular: Option<(Vec3, f32)>,
+    /// Lights with caustic views (`MAX_LIGHTS` at most).
+    pub light_count: u32,
+    /// This frame's caustic views (`begin`), read by each light's splat.
+    frame_views: Vec<GpuShadowLight>,
     photon_pipeline: ComputePipeline,
     splat_pipeline: GraphicsPipeline,
     pub set: DescriptorSet,
     _layout: DescriptorSetLayout,
+    apply: ComputePipeline,
+    apply_set: DescriptorSet,
+    /// `caustics_on_change`: reuse the caustic map while nothing it depends
+    /// on moved (Wyman 2006, "Putting it Together": "we only update the
+    /// caustic map after changes to the light or scene geometry").
+    on_change: bool,
+    /// Geometry time the caustic map was computed for; `None` when it must
+    /// be recomputed (never computed, or a light moved).
+    geometry_time: Option<f32>,
+    _apply_layout: DescriptorSetLayout,
+    _sampler: Sampler,
 }
 
 impl CausticMap {
-    /// `photon_size`^2 photon texels, `map_size`^2 caustic texels per view,
-    /// sprites of `splat_size` (odd) texels.
+    /// `light_views`' resolution of photon texels, `map_size`^2 caustic
+    /// texels per view, sprites of `splat_size` (odd) texels; `apply` adds
+    /// the caustic radiance on `gbuffer`'s diffuse receivers to `radiance`.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: &Arc<Context>,
-        scene: &Scene,
         scene_gpu: &SceneGpu,
-        photon_size: u32,
+        light_views: &LightViews,
         map_size: u32,
         splat_size: u32,
         paths: PhotonPaths,
+        gbuffer: &GBuffer,
+        radiance: &Image,
     ) -> VkResult<Self> {
-        let lights: Vec<Light> = scene
-            .lights
-            .iter()
-            .take(b::MAX_LIGHTS as usize)
-            .copied()
-            .collect();
-        let layers = b::SHADOW_LAYERS_PER_LIGHT * (lights.len() as u32).max(1);
+        let photon_size = light_views.size;
+        let layers = b::SHADOW_LAYERS_PER_LIGHT * (light_views.lights().len() as u32).max(1);
         let map = Image::new(
             ctx,
             "caustic map (flux per texel)",
@@ -300,7 +297,7 @@ impl CausticMap {
                 (b::CAUSTIC_BINDING_BACK_NORMAL, BindingKind::StorageImage),
             ],
         )?;
-        let light_view = SpecularGBuffer::new(ctx, &scene_gpu.layout, photon_size, photon_size)?;
+        let light_view = &light_views.gbuffer;
         let set = DescriptorSet::new(ctx, &layout)?;
         set.write_buffer(b::CAUSTIC_BINDING_PHOTONS, &photons)
             .write_buffer(b::CAUSTIC_BINDING_VIEWS, &views)
@@ -324,7 +321,35 @@ impl CausticMap {
         desc.topology = vk::PrimitiveTopology::POINT_LIST;
         desc.push_size = size_of::<SplatPush>() as u32;
         let splat_pipeline = GraphicsPipeline::new(ctx, &desc, &[&scene_gpu.layout, &layout])?;
-        let specular = specular_bounds(scene);
+        let apply_layout = DescriptorSetLayout::new(
+            ctx,
+            &[
+                (b::CAUSTIC_BINDING_VIEWS, BindingKind::Uniform),
+                (b::CAUSTIC_BINDING_MAP, BindingKind::Sampled),
+                (b::CAUSTIC_BINDING_POSITION, BindingKind::StorageImage),
+                (b::CAUSTIC_BINDING_NORMAL, BindingKind::StorageImage),
+                (b::CAUSTIC_BINDING_RADIANCE, BindingKind::StorageImage),
+            ],
+        )?;
+        let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
+        let apply_set = DescriptorSet::new(ctx, &apply_layout)?;
+        apply_set
+            .write_buffer(b::CAUSTIC_BINDING_VIEWS, &views)
+            .write_sampled_image(
+                b::CAUSTIC_BINDING_MAP,
+                &map,
+                &sampler,
+                vk::ImageLayout::GENERAL,
+            )
+            .write_storage_image(b::CAUSTIC_BINDING_POSITION, &gbuffer.position)
+            .write_storage_image(b::CAUSTIC_BINDING_NORMAL, &gbuffer.normal)
+            .write_storage_image(b::CAUSTIC_BINDING_RADIANCE, radiance);
+        let apply = ComputePipeline::new(
+            ctx,
+            "caustic_map/apply.comp",
+            &[&scene_gpu.layout, &apply_layout],
+            size_of::<[u32; 2]>() as u32,
+        )?;
         Ok(Self {
             photons,
             map,
@@ -335,13 +360,18 @@ impl CausticMap {
             mode: paths.mode,
             refraction: [paths.tir_remedy, u32::from(paths.use_eq632)],
             medium_steps: paths.medium_steps,
-            light_view,
-            lights,
-            specular,
+            light_count: light_views.lights().len() as u32,
+            frame_views: Vec::new(),
             photon_pipeline,
             splat_pipeline,
             set,
             _layout: layout,
+            apply,
+            apply_set,
+            on_change: paths.on_change,
+            geometry_time: None,
+            _apply_layout: apply_layout,
+            _sampler: sampler,
         })
     }
 
@@ -350,8 +380,8 @@ impl CausticMap {
     /// Specular objects send its light outside its cone (the gemstone's
     /// facets throw 23% of the landing flux there), and a photon outside
     /// every view is culled by the splat.
-    pub fn views(&self, sphere: (Vec3, f32)) -> Vec<GpuShadowLight> {
-        self.lights
+    pub fn views(&self, lights: &[Light], sphere: (Vec3, f32)) -> Vec<GpuShadowLight> {
+        lights
             .iter()
             .enumerate()
             .map(|(l, light)| {
@@ -372,46 +402,57 @@ impl CausticMap {
             .collect()
     }
 
-    /// The scene's lights moved (same count and kinds): the next `record`
-    /// shoots from the new positions. False if the lights cannot be taken in
-    /// place (the technique is rebuilt then).
-    pub fn set_lights(&mut self, lights: &[Light]) -> bool {
-        if lights.len() != self.lights.len()
-            || lights
-                .iter()
-                .zip(&self.lights)
-                .any(|(a, b)| a.kind != b.kind)
-        {
-            return false;
+    /// `caustics_on_change` (live).
+    pub fn set_on_change(&mut self, on_change: bool) {
+        if on_change != self.on_change {
+            self.on_change = on_change;
+            self.geometry_time = None;
         }
-        self.lights.copy_from_slice(lights);
-        true
     }
 
-    pub fn light_count(&self) -> u32 {
-        self.lights.len() as u32
+    /// A light moved: the next frame recomputes the map.
+    pub fn invalidate(&mut self) {
+        self.geometry_time = None;
     }
 
-    /// Photon view of light `l`, if it has one.
-    pub fn photon_view(&self, l: usize) -> Option<PhotonViewPush> {
-        let mut v = photon_view(&self.lights[l], l as u32, self.specular?, self.photon_size)?;
-        v.mode = [
-            self.mode,
-            self.refraction[0],
-            self.refraction[1],
-            self.medium_steps,
-        ];
-        Some(v)
+    /// Whether this frame recomputes the map (always, unless
+    /// `caustics_on_change` and nothing moved since the last one); if so
+    /// `begin` must be called and the map take part in the light loop.
+    pub fn needs_update(&self, scene: &SceneGpu) -> bool {
+        !self.on_change || self.geometry_time != Some(scene.geometry_time)
     }
 
-    /// Records "caustic photons" and "caustic splat" for every light; the
-    /// photon buffer is reused, so each light's splat waits for its photons
-    /// and the next light's photons wait for that splat.
-    pub fn record(&self, rec: &mut FrameRecorder, scene: &SceneGpu) -> VkResult<()> {
-        let views = self.views(scene.sphere);
+    /// The photon push of `view`: the light view and the photon paths.
+    pub fn photon_push(&self, view: &LightView) -> PhotonViewPush {
+        PhotonViewPush {
+            origin: view.origin,
+            right: view.right,
+            up: view.up,
+            forward: view.forward,
+            mode: [
+                self.mode,
+                self.refraction[0],
+                self.refraction[1],
+                self.medium_steps,
+            ],
+        }
+    }
+
+    /// Records "caustic map clear" and takes this frame's views of
+    /// `light_views`' lights; the lights' passes follow in
+    /// `LightViews::record` (this map as a consumer).
+    pub fn begin(
+        &mut self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        light_views: &LightViews,
+    ) -> VkResult<()> {
+        let views = self.views(light_views.lights(), scene.sphere);
         // Host write while recording: the renderer waits for each frame
         // before recording the next, so no earlier frame still reads it.
         self.views.upload(bytemuck::cast_slice(&views))?;
+        self.frame_views = views;
+        self.geometry_time = Some(scene.geometry_time);
         let ctx = rec.ctx().clone();
         rec.pass("caustic map clear", |cmd| {
             barrier(
@@ -426,92 +467,130 @@ impl CausticMap {
                 end_rendering(&ctx, cmd);
             }
         });
-        for (l, v) in views.iter().enumerate() {
-            let Some(push) = self.photon_view(l) else {
-                if self.specular.is_some() {
-                    log::warn!("light {l} lies inside the specular objects' bounds: no caustics");
-                }
-                continue;
-            };
-            if self.mode != b::PHOTON_MODE_TRACED {
-                let view_proj = photon_view_proj(&push, self.specular.unwrap_or_default());
-                let view = Viewpoint::Light {
-                    view_proj,
-                    origin: Vec3::from_slice(&push.origin[..3]),
-                    forward: Vec3::from_slice(&push.forward[..3]),
-                    orthographic: push.forward[3].to_bits() == b::SHADOW_PLANAR,
-                };
-                rec.pass("caustic light view", |cmd| {
-                    // Overwritten entirely; the barriers inside wait for the
-                    // previous reader (last light's photons).
-                    self.light_view.draw(&ctx, cmd, scene, &view);
-                });
+        Ok(())
+    }
+
+    /// Records "caustic apply": E = Phi_texel / A_texel(x) on the diffuse
+    /// receivers of `gbuffer`, added to `radiance` (the ones given to `new`).
+    pub fn apply(
+        &self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        gbuffer: &GBuffer,
+        radiance: &Image,
+    ) {
+        let ctx = rec.ctx().clone();
+        // apply.comp's push constants: light count, medium steps.
+        let push = [self.light_count, self.medium_steps];
+        let extent = radiance.extent();
+        rec.pass("caustic apply", |cmd| {
+            // The splats' attachment writes and the direct pass's radiance
+            // writes must be visible to this read-modify-write.
+            barrier(
+                &ctx,
+                cmd,
+                &[
+                    ImageAccess::new(&self.map, Access::ComputeRead),
+                    ImageAccess::new(&gbuffer.position, Access::ComputeRead),
+                    ImageAccess::new(&gbuffer.normal, Access::ComputeRead),
+                    ImageAccess::new(radiance, Access::ComputeWrite),
+                ],
+                &[],
+            );
+            let groups = [extent.width.div_ceil(8), extent.height.div_ceil(8), 1];
+            self.apply.dispatch(
+                cmd,
+                &[&scene.set, &self.apply_set],
+                bytemuck::bytes_of(&push),
+                groups,
+            );
+        });
+    }
+
+}
+
+impl LightViewConsumer for CausticMap {
+    fn reads_gbuffer(&self) -> bool {
+        self.mode != b::PHOTON_MODE_TRACED
+    }
+
+    /// Records "caustic photons" and "caustic splat" for light `l`; the
+    /// photon buffer is reused, so each light's splat waits for its photons
+    /// and the next light's photons wait for that splat.
+    fn record_light(
+        &mut self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        l: usize,
+        view: &LightView,
+        light_view: &SpecularGBuffer,
+    ) {
+        let ctx = rec.ctx().clone();
+        let push = self.photon_push(view);
+        let v = self.frame_views[l];
+        rec.pass("caustic photons", |cmd| {
+            // Write-after-read against the previous light's splat (or last frame's readers).
+            barrier(
+                &ctx,
+                cmd,
+                &[],
+                &[
+                    BufferAccess::new(&self.photons, Access::ComputeWrite),
+                    BufferAccess::new(&scene.triangles, Access::ComputeRead),
+                ],
+            );
+            {
+                // The light-view attachments, read as storage images
+                // (in GENERAL layout even in traced mode: the shader
+                // declares them, so they must be in the bound layout).
+                barrier(&ctx, cmd, &light_view.compute_reads(), &[]);
             }
-            rec.pass("caustic photons", |cmd| {
-                // Write-after-read against the previous light's splat (or last frame's readers).
-                barrier(
+            let groups = [
+                self.photon_size.div_ceil(8),
+                self.photon_size.div_ceil(8),
+                1,
+            ];
+            self.photon_pipeline.dispatch(
+                cmd,
+                &[&scene.set, &self.set],
+                bytemuck::bytes_of(&push),
+                groups,
+            );
+        });
+        rec.pass("caustic splat", |cmd| {
+            // The photons written by compute are pulled by the vertex shader.
+            barrier(
+                &ctx,
+                cmd,
+                &[ImageAccess::new(&self.map, Access::ColorAttachment)],
+                &[BufferAccess::new(&self.photons, Access::VertexRead)],
+            );
+            let extent = self.map.extent();
+            let count = 2 * self.photon_size * self.photon_size;
+            for face in 0..v.info[1] {
+                let layer = (v.info[2] + face) as usize;
+                begin_rendering(
                     &ctx,
                     cmd,
-                    &[],
-                    &[
-                        BufferAccess::new(&self.photons, Access::ComputeWrite),
-                        BufferAccess::new(&scene.triangles, Access::ComputeRead),
-                    ],
+                    extent,
+                    &[(self.map.layer_views[layer], None)],
+                    None,
                 );
-                {
-                    // The light-view attachments, read as storage images
-                    // (in GENERAL layout even in traced mode: the shader
-                    // declares them, so they must be in the bound layout).
-                    barrier(&ctx, cmd, &self.light_view.compute_reads(), &[]);
-                }
-                let groups = [
-                    self.photon_size.div_ceil(8),
-                    self.photon_size.div_ceil(8),
-                    1,
-                ];
-                self.photon_pipeline.dispatch(
+                let push = SplatPush {
+                    light: l as u32,
+                    view: face,
+                    size: self.map_size,
+                    splat_size: self.splat_size,
+                };
+                self.splat_pipeline.bind(
                     cmd,
                     &[&scene.set, &self.set],
                     bytemuck::bytes_of(&push),
-                    groups,
+                    extent,
                 );
-            });
-            rec.pass("caustic splat", |cmd| {
-                // The photons written by compute are pulled by the vertex shader.
-                barrier(
-                    &ctx,
-                    cmd,
-                    &[ImageAccess::new(&self.map, Access::ColorAttachment)],
-                    &[BufferAccess::new(&self.photons, Access::VertexRead)],
-                );
-                let extent = self.map.extent();
-                let count = 2 * self.photon_size * self.photon_size;
-                for face in 0..v.info[1] {
-                    let layer = (v.info[2] + face) as usize;
-                    begin_rendering(
-                        &ctx,
-                        cmd,
-                        extent,
-                        &[(self.map.layer_views[layer], None)],
-                        None,
-                    );
-                    let push = SplatPush {
-                        light: l as u32,
-                        view: face,
-                        size: self.map_size,
-                        splat_size: self.splat_size,
-                    };
-                    self.splat_pipeline.bind(
-                        cmd,
-                        &[&scene.set, &self.set],
-                        bytemuck::bytes_of(&push),
-                        extent,
-                    );
-                    unsafe { ctx.device.cmd_draw(cmd, count, 1, 0, 0) };
-                    end_rendering(&ctx, cmd);
-                }
-            });
-        }
-        Ok(())
+                unsafe { ctx.device.cmd_draw(cmd, count, 1, 0, 0) };
+                end_rendering(&ctx, cmd);
+            }
+        });
     }
 }

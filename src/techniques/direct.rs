@@ -1,161 +1,19 @@
-//! `direct`: direct light with shadow maps, the base frame every technique
-//! adds to. Radiometrically the ground truth's L D component for diffuse
-//! surfaces seen directly: L = albedo / pi * sum over lights of E * V, with
-//! E the light's irradiance (I cos / r^2 with spot falloff, or E cos for a
-//! directional light) and V the shadow-map visibility.
-//!
-//! Passes (each through `FrameRecorder::pass`):
-//! 1. "shadow maps" (`passes::shadow`): every light's views, linear distance;
-//! 2. "gbuffer" (`passes::gbuffer`): world position, normal, material;
-//! 3. "direct lighting" (glsl/direct/lighting.comp): per pixel, into the
-//!    frame's radiance image.
-//!
-//! Specular surfaces seen directly and the background read 0.
-//!
-//! In a scene with a medium the surface radiance is attenuated as the
-//! ground truth attenuates it (Hu et al. 2010 Sect. 5.3, Fig. 2 C): each
-//! light's irradiance by the transmittance tau(s, x) from the light to x and
-//! the result by tau(x, v) to the eye. Transmittance is deterministic
-//! (glsl/common/medium.glsl `medium_transmittance_steps`): Beer-Lambert on
-//! the segment clipped to the medium's bounds for constant density, the
-//! midpoint rule with `medium_steps` steps for noise and grid densities
-//! (Hu Sect. 5.4). Without a medium the factors are exactly 1.
+//! `direct`: direct light with shadow maps (`passes::direct_light`) alone,
+//! the base frame every technique adds to; the ground truth's L D
+//! component for diffuse surfaces seen directly.
 
 use super::{Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::params::{ParamSet, Params};
-use crate::passes::gbuffer::{GBuffer, GBufferContents};
-use crate::passes::shadow::ShadowMaps;
+pub use crate::passes::direct_light::DirectParams;
+use crate::passes::direct_light::DirectLight;
 use crate::radiometry::Component;
 use crate::scene::Scene;
-use crate::shader_bindings as b;
-use crate::vk::{
-    barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
-    FrameRecorder, ImageAccess, Sampler, VkResult,
-};
-use ash::vk;
-use bytemuck::{Pod, Zeroable};
+use crate::vk::{Context, FrameRecorder, VkResult};
 use std::sync::Arc;
 
-crate::declare_params! {
-    /// `Direct`'s parameters (shadow maps, PCF, medium transmittance), a
-    /// group in every technique built on it.
-    pub struct DirectParams {
-        shadow_map_size: u32 [64, 4096] = 1024, rebuild,
-            "shadow map resolution per view (texels per side)";
-        pcf_radius: i32 [0, 4] = 1, live,
-            "percentage-closer filter half-width in shadow texels (0: one tap)";
-        medium_steps: u32 [1, 256] = 16, rebuild,
-            "midpoint steps of the transmittance through noise/grid media (constant density is exact)";
-    }
-}
-
-/// Push constants of glsl/direct/lighting.comp.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct LightingPush {
-    light_count: u32,
-    pcf_radius: i32,
-    medium_steps: u32,
-}
-
 pub struct Direct {
-    pub shadows: ShadowMaps,
-    pub gbuffer: GBuffer,
-    pcf_radius: i32,
-    medium_steps: u32,
-    light_count: u32,
-    lighting: ComputePipeline,
-    set: DescriptorSet,
-    /// The radiance image the set's output binding points at: the frame
-    /// targets are not known at construction, so the binding is written on
-    /// the first `record` (and again if the targets change).
-    bound_radiance: vk::ImageView,
-    _layout: DescriptorSetLayout,
-    _sampler: Sampler,
-}
-
-impl Direct {
-    pub fn new(
-        ctx: &Arc<Context>,
-        params: &DirectParams,
-        scene: &Scene,
-        scene_gpu: &SceneGpu,
-        width: u32,
-        height: u32,
-    ) -> VkResult<Self> {
-        Self::with_contents(
-            ctx,
-            params,
-            scene,
-            scene_gpu,
-            width,
-            height,
-            GBufferContents::All,
-        )
-    }
-
-    /// The same passes over a G-buffer holding `contents` (`image_space`
-    /// lights the opaque scene behind its refractors).
-    pub fn with_contents(
-        ctx: &Arc<Context>,
-        params: &DirectParams,
-        scene: &Scene,
-        scene_gpu: &SceneGpu,
-        width: u32,
-        height: u32,
-        contents: GBufferContents,
-    ) -> VkResult<Self> {
-        let shadows = ShadowMaps::new(
-            ctx,
-            &scene_gpu.layout,
-            &scene.lights,
-            params.shadow_map_size,
-        )?;
-        let gbuffer = GBuffer::new(ctx, &scene_gpu.layout, width, height, contents)?;
-        let layout = DescriptorSetLayout::new(
-            ctx,
-            &[
-                (b::DIRECT_BINDING_POSITION, BindingKind::StorageImage),
-                (b::DIRECT_BINDING_NORMAL, BindingKind::StorageImage),
-                (b::DIRECT_BINDING_RADIANCE, BindingKind::StorageImage),
-                (b::DIRECT_BINDING_SHADOW_MAP, BindingKind::Sampled),
-                (b::DIRECT_BINDING_SHADOW_LIGHTS, BindingKind::Uniform),
-            ],
-        )?;
-        // Nearest: the shader fetches single texels and compares them itself.
-        let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
-        let set = DescriptorSet::new(ctx, &layout)?;
-        // The shadow maps are read in compute, where `Access::ComputeRead`
-        // puts them in GENERAL layout.
-        set.write_storage_image(b::DIRECT_BINDING_POSITION, &gbuffer.position)
-            .write_storage_image(b::DIRECT_BINDING_NORMAL, &gbuffer.normal)
-            .write_sampled_image(
-                b::DIRECT_BINDING_SHADOW_MAP,
-                &shadows.map,
-                &sampler,
-                vk::ImageLayout::GENERAL,
-            )
-            .write_buffer(b::DIRECT_BINDING_SHADOW_LIGHTS, &shadows.lights);
-        let lighting = ComputePipeline::new(
-            ctx,
-            "direct/lighting.comp",
-            &[&scene_gpu.layout, &layout],
-            std::mem::size_of::<LightingPush>() as u32,
-        )?;
-        Ok(Self {
-            light_count: scene.lights.len().min(b::MAX_LIGHTS as usize) as u32,
-            shadows,
-            gbuffer,
-            pcf_radius: params.pcf_radius,
-            medium_steps: params.medium_steps,
-            lighting,
-            set,
-            bound_radiance: vk::ImageView::null(),
-            _layout: layout,
-            _sampler: sampler,
-        })
-    }
+    pub light: DirectLight,
 }
 
 impl TechniqueBuild for Direct {
@@ -173,14 +31,9 @@ impl TechniqueBuild for Direct {
         width: u32,
         height: u32,
     ) -> anyhow::Result<Self> {
-        Ok(Self::new(ctx, params, scene, scene_gpu, width, height)?)
-    }
-}
-
-impl Direct {
-    /// Takes the live parameters of `params` (`pcf_radius`).
-    pub fn set_live(&mut self, params: &DirectParams) {
-        self.pcf_radius = params.pcf_radius;
+        Ok(Self {
+            light: DirectLight::new(ctx, params, scene, scene_gpu, width, height)?,
+        })
     }
 }
 
@@ -190,7 +43,7 @@ impl Technique for Direct {
     }
 
     fn update_live(&mut self, params: &Params) -> anyhow::Result<bool> {
-        self.set_live(&DirectParams::from_params(params)?);
+        self.light.set_live(&DirectParams::from_params(params)?);
         Ok(true)
     }
 
@@ -200,49 +53,10 @@ impl Technique for Direct {
         scene: &SceneGpu,
         targets: &FrameTargets,
     ) -> VkResult<()> {
-        if self.bound_radiance != targets.radiance.view {
-            // Updating a set is only legal while no pending command buffer
-            // uses it: the renderer waits for every frame before the next.
-            self.set
-                .write_storage_image(b::DIRECT_BINDING_RADIANCE, &targets.radiance);
-            self.bound_radiance = targets.radiance.view;
-        }
-        self.shadows.record(rec, scene)?;
-        self.gbuffer.record(rec, scene);
-        let ctx = rec.ctx().clone();
-        let push = LightingPush {
-            light_count: self.light_count,
-            pcf_radius: self.pcf_radius,
-            medium_steps: self.medium_steps,
-        };
-        rec.pass("direct lighting", |cmd| {
-            // The G-buffer's and shadow maps' attachment writes must be
-            // visible to the compute reads (and move to GENERAL); the
-            // radiance image is overwritten entirely, after waiting for last
-            // frame's readers (tonemap, readback).
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(&self.gbuffer.position, Access::ComputeRead),
-                    ImageAccess::new(&self.gbuffer.normal, Access::ComputeRead),
-                    ImageAccess::new(&self.shadows.map, Access::ComputeRead),
-                    ImageAccess::discard(&targets.radiance, Access::ComputeWrite),
-                ],
-                &[],
-            );
-            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
-            self.lighting.dispatch(
-                cmd,
-                &[&scene.set, &self.set],
-                bytemuck::bytes_of(&push),
-                groups,
-            );
-        });
-        Ok(())
+        self.light.record(rec, scene, targets)
     }
 
     fn set_lights(&mut self, lights: &[crate::scene::Light]) -> bool {
-        self.shadows.set_lights(lights)
+        self.light.set_lights(lights)
     }
 }

@@ -51,70 +51,26 @@
 //! any refractor, so two refractors one behind the other (with or without
 //! an opaque object between) share one back-face texture.
 
-mod refraction;
-
-pub use refraction::{CameraRefraction, RefractionPush};
-
-use super::direct::{Direct, DirectParams};
 use super::{Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::params::{ParamSet, Params};
-use crate::passes::caustic_map::{CausticMap, PhotonPaths};
-use crate::passes::gbuffer::GBufferContents;
+pub use crate::passes::caustic_map::ImageSpaceParams;
+use crate::passes::caustic_map::CausticMap;
+use crate::passes::light_views::LightViews;
+use crate::passes::surface_frame::SurfaceFrame;
 use crate::radiometry::Component;
 use crate::scene::Scene;
-use crate::shader_bindings as b;
-use crate::vk::{
-    barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
-    FrameRecorder, ImageAccess, Sampler, VkResult,
-};
-use ash::vk;
+use crate::vk::{Context, FrameRecorder, VkResult};
 use std::sync::Arc;
 
-crate::declare_params! {
-    /// `image_space`'s parameters: `Direct`'s, then the caustic map's and
-    /// the camera refraction's.
-    pub struct ImageSpaceParams {
-        @group direct: DirectParams;
-        photon_buffer_size: u32 [64, 1024] = 512, rebuild,
-            "photon buffer resolution (photons per side of the light view)";
-        caustic_map_size: u32 [64, 1024] = 512, rebuild,
-            "caustic map resolution per light view (texels per side)";
-        splat_size: u32 [1, 15] = 7, rebuild,
-            "photon splat width in caustic-map texels (odd; an even value is raised by 1)";
-        photon_mode: u32 [0, 2] = 0, rebuild,
-            "0: photon paths traced exactly through the BVH; 1: Wyman's two-sided image-space refraction from light-space front/back G-buffers (Eq. 6.3.1 distance); 2: the same G-buffers, the refracted ray marched against the back-face map (exact for convex objects)";
-        tir_remedy: u32 [0, 2] = 1, rebuild,
-            "total internal reflection at the approximated exit (Wyman 2006's ad hoc remedies; camera and photon_mode 1): 0 single refraction (T2 = T1), 1 clamp to the critical angle (T2 tangent to the back face), 2 reflect and ignore the refractor. Default 1, of the two Wyman recommends (the first 'behaves poorly in dynamic scenes'): a reflected ray heads back toward the camera or the light, where the image-space search has no data and photons fly up past the light, while the clamped ray goes on through, as the light does on average";
-        eq_6_3_2: u32 [0, 1] = 1, rebuild,
-            "1: where d~ overshoots and the back-face texel holds no normal, use Wyman's Eq. 6.3.2 (N2 = T1 - (V.T1) V, the exit through the side); 0: drop the transmitted light there";
-        search_steps: u32 [4, 256] = 32, live,
-            "linear steps of the image-space search of refracted and reflected camera rays against the opaque frame (then 10 bisections)";
-        caustics_on_change: bool [0, 1] = 0, live,
-            "1: recompute the caustic map only when a light moved or animated geometry changed, reusing the last one otherwise; 0: every frame (benchmarks)";
-    }
-}
-
 pub struct ImageSpace {
-    /// Direct light on the opaque scene (its G-buffer leaves the specular
-    /// surfaces out; they still cast shadows and caustics).
-    pub direct: Direct,
+    /// Shadows, G-buffers, direct light on the opaque scene (the specular
+    /// surfaces cast shadows and caustics but are left out of it), and the
+    /// camera refraction.
+    pub surface: SurfaceFrame,
+    /// Each light's view of the specular objects (photon texels).
+    pub light_views: LightViews,
     pub caustics: CausticMap,
-    /// The opaque frame: direct light + surface caustics without the
-    /// specular surfaces, what the refraction pass looks up.
-    pub opaque: FrameTargets,
-    pub refraction: CameraRefraction,
-    apply: ComputePipeline,
-    set: DescriptorSet,
-    /// `caustics_on_change`: reuse the caustic map while nothing it depends
-    /// on moved (Wyman 2006, "Putting it Together": "we only update the
-    /// caustic map after changes to the light or scene geometry").
-    caustics_on_change: bool,
-    /// Geometry time the caustic map was computed for; `None` when it must
-    /// be recomputed (never computed, or a light moved).
-    caustics_geometry_time: Option<f32>,
-    _layout: DescriptorSetLayout,
-    _sampler: Sampler,
 }
 
 impl ImageSpace {
@@ -126,83 +82,21 @@ impl ImageSpace {
         width: u32,
         height: u32,
     ) -> VkResult<Self> {
-        let direct = Direct::with_contents(
+        let surface = SurfaceFrame::new(
             ctx,
             &params.direct,
             scene,
             scene_gpu,
             width,
             height,
-            GBufferContents::Opaque,
+            params.refraction(),
         )?;
-        let opaque = FrameTargets::new(ctx, width, height)?;
-        let tir_remedy = params.tir_remedy;
-        let use_eq632 = params.eq_6_3_2;
-        let caustics = CausticMap::new(
-            ctx,
-            scene,
-            scene_gpu,
-            params.photon_buffer_size,
-            params.caustic_map_size,
-            params.splat_size,
-            PhotonPaths {
-                mode: params.photon_mode,
-                tir_remedy,
-                use_eq632: use_eq632 != 0,
-                medium_steps: params.direct.medium_steps,
-            },
-        )?;
-        let layout = DescriptorSetLayout::new(
-            ctx,
-            &[
-                (b::CAUSTIC_BINDING_VIEWS, BindingKind::Uniform),
-                (b::CAUSTIC_BINDING_MAP, BindingKind::Sampled),
-                (b::CAUSTIC_BINDING_POSITION, BindingKind::StorageImage),
-                (b::CAUSTIC_BINDING_NORMAL, BindingKind::StorageImage),
-                (b::CAUSTIC_BINDING_RADIANCE, BindingKind::StorageImage),
-            ],
-        )?;
-        let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
-        let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_buffer(b::CAUSTIC_BINDING_VIEWS, &caustics.views)
-            .write_sampled_image(
-                b::CAUSTIC_BINDING_MAP,
-                &caustics.map,
-                &sampler,
-                vk::ImageLayout::GENERAL,
-            )
-            .write_storage_image(b::CAUSTIC_BINDING_POSITION, &direct.gbuffer.position)
-            .write_storage_image(b::CAUSTIC_BINDING_NORMAL, &direct.gbuffer.normal)
-            .write_storage_image(b::CAUSTIC_BINDING_RADIANCE, &opaque.radiance);
-        let apply = ComputePipeline::new(
-            ctx,
-            "caustic_map/apply.comp",
-            &[&scene_gpu.layout, &layout],
-            size_of::<[u32; 2]>() as u32,
-        )?;
-        let refraction = CameraRefraction::new(
-            ctx,
-            scene_gpu,
-            &opaque.radiance,
-            &direct.gbuffer,
-            RefractionPush {
-                tir_remedy,
-                use_eq632,
-                search_steps: params.search_steps,
-                pad: 0,
-            },
-        )?;
+        let light_views = LightViews::new(ctx, scene, scene_gpu, params.photon_buffer_size)?;
+        let caustics = params.caustic_map(ctx, scene_gpu, &light_views, &surface)?;
         Ok(Self {
-            direct,
+            surface,
+            light_views,
             caustics,
-            opaque,
-            refraction,
-            apply,
-            set,
-            caustics_on_change: params.caustics_on_change,
-            caustics_geometry_time: None,
-            _layout: layout,
-            _sampler: sampler,
         })
     }
 }
@@ -228,12 +122,8 @@ impl TechniqueBuild for ImageSpace {
 impl ImageSpace {
     /// Takes the live parameters of `params`.
     pub fn set_live(&mut self, params: &ImageSpaceParams) {
-        self.direct.set_live(&params.direct);
-        self.refraction.set_search_steps(params.search_steps);
-        if params.caustics_on_change != self.caustics_on_change {
-            self.caustics_on_change = params.caustics_on_change;
-            self.caustics_geometry_time = None;
-        }
+        self.surface.set_live(&params.direct, params.search_steps);
+        self.caustics.set_on_change(params.caustics_on_change);
     }
 }
 
@@ -253,48 +143,20 @@ impl Technique for ImageSpace {
         scene: &SceneGpu,
         targets: &FrameTargets,
     ) -> VkResult<()> {
-        self.direct.record(rec, scene, &self.opaque)?;
-        if !self.caustics_on_change || self.caustics_geometry_time != Some(scene.geometry_time) {
-            self.caustics.record(rec, scene)?;
-            self.caustics_geometry_time = Some(scene.geometry_time);
+        self.surface.record_opaque(rec, scene)?;
+        if self.caustics.needs_update(scene) {
+            self.caustics.begin(rec, scene, &self.light_views)?;
+            self.light_views
+                .record(rec, scene, &mut [&mut self.caustics]);
         }
-        let ctx = rec.ctx().clone();
-        // apply.comp's push constants: light count, medium steps.
-        let push = [self.caustics.light_count(), self.caustics.medium_steps];
-        rec.pass("caustic apply", |cmd| {
-            // The splats' attachment writes and the direct pass's radiance
-            // writes must be visible to this read-modify-write.
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(&self.caustics.map, Access::ComputeRead),
-                    ImageAccess::new(&self.direct.gbuffer.position, Access::ComputeRead),
-                    ImageAccess::new(&self.direct.gbuffer.normal, Access::ComputeRead),
-                    ImageAccess::new(&self.opaque.radiance, Access::ComputeWrite),
-                ],
-                &[],
-            );
-            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
-            self.apply.dispatch(
-                cmd,
-                &[&scene.set, &self.set],
-                bytemuck::bytes_of(&push),
-                groups,
-            );
-        });
-        self.refraction.record(
-            rec,
-            scene,
-            &self.opaque.radiance,
-            &self.direct.gbuffer,
-            targets,
-        );
+        self.caustics
+            .apply(rec, scene, self.surface.gbuffer(), self.surface.opaque());
+        self.surface.record_refraction(rec, scene, targets);
         Ok(())
     }
 
     fn set_lights(&mut self, lights: &[crate::scene::Light]) -> bool {
-        self.caustics_geometry_time = None;
-        self.direct.set_lights(lights) && self.caustics.set_lights(lights)
+        self.caustics.invalidate();
+        self.surface.set_lights(lights) && self.light_views.set_lights(lights)
     }
 }

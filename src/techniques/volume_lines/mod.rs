@@ -1,16 +1,18 @@
 //! `volume_lines`: line-based volume caustics in single-scattering media
 //! (Hu, Dong, Ihrke, Grosch, Yuan, Seidel 2010, "Interactive Volume Caustics in
-//! Single-Scattering Media"), on top of `image_space`.
+//! Single-Scattering Media"), over image_space's surface frame.
 //!
 //! The frame is Hu's Fig. 2 sum: C (surface radiance with surface caustics
-//! and what the camera sees through glass) is `image_space::ImageSpace` as
-//! it is; B (light scattered once in the medium after one or more specular
+//! and what the camera sees through glass) is `image_space`'s frame as it
+//! is (the same building blocks: `passes::surface_frame`,
+//! `passes::caustic_map`); B (light scattered once in the medium after one or more specular
 //! events, the reference's L S+ V) is added by this module's passes, per
 //! light:
-//! 1. "volume light view": `passes::specular_gbuffer` from the light's
-//!    photon view (`caustic_map::photon_view`, the frustum fitted to the
-//!    specular objects; orthographic for directional light): front and
-//!    back faces of the specular objects (Sect. 5.1, step 1).
+//! 1. "light view" (`passes::light_views`): the light's view of the
+//!    specular objects (the frustum fitted to them; orthographic for
+//!    directional light), front and back faces (Sect. 5.1, step 1); drawn
+//!    once for the caustic map's photons and these rays when both have the
+//!    same resolution (`photon_buffer_size` = `volume_buffer_size`).
 //! 2. "volume segments" (glsl/volume_lines/segments.comp): per texel of that
 //!    view, one-bounce reflection (mirrors) or two-bounce refraction
 //!    (Wyman's two-sided refraction, shared with `image_space`) gives the
@@ -83,25 +85,21 @@
 //! `--component` writes each alone (direct and surface_caustics are C's
 //! two parts, airlight is A, volume_caustics is B).
 
-use super::image_space::{ImageSpace, ImageSpaceParams};
+mod lines;
+
+pub use lines::{GpuSegment, VolumeRays};
+
 use super::{Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::params::{ParamSet, Params};
 use crate::passes::airlight::{Airlight, AirlightParams};
-use crate::passes::caustic_map::{photon_view, photon_view_proj, specular_bounds, PhotonViewPush};
-use crate::passes::specular_gbuffer::{SpecularGBuffer, Viewpoint};
+use crate::passes::caustic_map::{CausticMap, ImageSpaceParams};
+use crate::passes::light_views::LightViews;
+use crate::passes::surface_frame::SurfaceFrame;
 use crate::radiometry::Component;
-use crate::scene::{Density, Light, Scene};
-use crate::shader_bindings as b;
-use crate::vk::{
-    barrier, begin_rendering, end_rendering, Access, BindingKind, Buffer, BufferAccess,
-    BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder,
-    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageAccess, ImageDesc,
-};
-use ash::vk;
-use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
-use std::mem::size_of;
+use crate::scene::{Light, Scene};
+use crate::vk::{Context, FrameRecorder};
+use lines::RaySettings;
 use std::sync::Arc;
 
 crate::declare_params! {
@@ -126,74 +124,20 @@ crate::declare_params! {
 /// Most regular step points a fragment visits (glsl/volume_lines/lines.frag).
 const MAX_RADIUS_IN_STEPS: f32 = 16.0;
 
-/// One entry of the volume caustic buffer, mirrored by `Segment` in
-/// glsl/volume_lines/volume_lines.glsl.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuSegment {
-    /// xyz exit point p1; w = 1 for a light ray, 0 for none.
-    pub p1: [f32; 4],
-    /// xyz end point p2.
-    pub p2: [f32; 4],
-    /// rgb flux (W) after the specular object; w: the texel's solid angle
-    /// (sr) or area (m^2).
-    pub flux: [f32; 4],
-}
-const _: () = assert!(size_of::<GpuSegment>() == 48);
-
-/// Push constants of segments.comp: the photon view and its parameters.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct SegmentPush {
-    origin: [f32; 4],
-    right: [f32; 4],
-    up: [f32; 4],
-    forward: [f32; 4],
-    /// x: TIR remedy; y: Eq. 6.3.2 on; z: transmittance steps; w: the
-    /// filter radius (f32 bits; the clipping margin).
-    params: [u32; 4],
-}
-
-/// Push constants of lines.frag.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct LinePush {
-    step: f32,
-    radius: f32,
-    line_raster: u32,
-    transmittance_steps: u32,
-}
-
 pub struct VolumeLines {
-    /// C: direct light, surface caustics, refraction seen by the camera.
-    pub image_space: ImageSpace,
+    /// C's frame: shadows, G-buffers, direct light, camera refraction.
+    pub surface: SurfaceFrame,
+    /// C's surface caustics, added to the surface frame's opaque frame.
+    pub caustics: CausticMap,
+    /// Each light's view of the specular objects at `volume_buffer_size`
+    /// (the caustic map's too when `photon_buffer_size` is the same).
+    pub light_views: LightViews,
+    /// The caustic map's light views when its resolution differs.
+    caustic_views: Option<LightViews>,
+    /// B: the light rays, their lines, the volume caustic image.
+    pub rays: VolumeRays,
     /// A: airlight with volumetric shadows from C's shadow maps.
     pub airlight: Airlight,
-    /// The volume caustic buffer of the last light recorded: N x N
-    /// transmitted (or mirror-reflected) light rays, then N x N rays
-    /// reflected off a dielectric's front face.
-    pub segments: Buffer,
-    /// B alone: radiance (rgb) and fragments per pixel (a).
-    pub volume: Image,
-    /// Light-space front/back G-buffer of the specular objects.
-    pub light_view: SpecularGBuffer,
-    pub buffer_size: u32,
-    /// Buffer entries drawn: the transmitted half, or both halves with
-    /// `front_reflection`.
-    draw_count: u32,
-    /// Distance to the first surface per pixel (floats).
-    visibility: Buffer,
-    lights: Vec<Light>,
-    specular: Option<(Vec3, f32)>,
-    segment_params: [u32; 4],
-    line_push: LinePush,
-    segment_pipeline: ComputePipeline,
-    visibility_pipeline: ComputePipeline,
-    line_pipeline: GraphicsPipeline,
-    composite_pipeline: ComputePipeline,
-    set: DescriptorSet,
-    bound_radiance: vk::ImageView,
-    _layout: DescriptorSetLayout,
 }
 
 impl VolumeLines {
@@ -213,183 +157,62 @@ impl VolumeLines {
                 MAX_RADIUS_IN_STEPS * step
             );
         }
-        let image_space =
-            ImageSpace::new(ctx, &params.image_space, scene, scene_gpu, width, height)?;
+        let c = &params.image_space;
+        let surface = SurfaceFrame::new(
+            ctx,
+            &c.direct,
+            scene,
+            scene_gpu,
+            width,
+            height,
+            c.refraction(),
+        )?;
+        let light_views = LightViews::new(ctx, scene, scene_gpu, params.volume_buffer_size)?;
+        let caustic_views = if c.photon_buffer_size == params.volume_buffer_size {
+            None
+        } else {
+            Some(LightViews::new(ctx, scene, scene_gpu, c.photon_buffer_size)?)
+        };
+        let caustics = c.caustic_map(
+            ctx,
+            scene_gpu,
+            caustic_views.as_ref().unwrap_or(&light_views),
+            &surface,
+        )?;
         let airlight = Airlight::new(
             ctx,
             &params.airlight,
-            params.image_space.direct.medium_steps,
+            c.direct.medium_steps,
             scene,
             scene_gpu,
-            &image_space.direct.shadows,
+            surface.shadows(),
         )?;
-        let n = params.volume_buffer_size;
-        let segments = Buffer::new(
+        let rays = VolumeRays::new(
             ctx,
-            "volume caustic buffer",
-            2 * (n as u64 * n as u64) * size_of::<GpuSegment>() as u64,
-            BufferUsage::Storage,
-        )?;
-        let visibility = Buffer::new(
-            ctx,
-            "volume visibility",
-            width as u64 * height as u64 * 4,
-            BufferUsage::Storage,
-        )?;
-        let volume = Image::new(
-            ctx,
-            "volume caustic radiance",
-            ImageDesc::new_2d(
-                width,
-                height,
-                vk::Format::R32G32B32A32_SFLOAT,
-                vk::ImageUsageFlags::COLOR_ATTACHMENT
-                    | vk::ImageUsageFlags::STORAGE
-                    | vk::ImageUsageFlags::TRANSFER_SRC,
-            ),
-        )?;
-        let light_view = SpecularGBuffer::new(ctx, &scene_gpu.layout, n, n)?;
-        let layout = DescriptorSetLayout::new(
-            ctx,
-            &[
-                (b::VOLUME_LINES_BINDING_SEGMENTS, BindingKind::Storage),
-                (
-                    b::VOLUME_LINES_BINDING_FRONT_POSITION,
-                    BindingKind::StorageImage,
-                ),
-                (
-                    b::VOLUME_LINES_BINDING_FRONT_NORMAL,
-                    BindingKind::StorageImage,
-                ),
-                (
-                    b::VOLUME_LINES_BINDING_BACK_POSITION,
-                    BindingKind::StorageImage,
-                ),
-                (
-                    b::VOLUME_LINES_BINDING_BACK_NORMAL,
-                    BindingKind::StorageImage,
-                ),
-                (b::VOLUME_LINES_BINDING_VISIBILITY, BindingKind::Storage),
-                (
-                    b::VOLUME_LINES_BINDING_OPAQUE_POSITION,
-                    BindingKind::StorageImage,
-                ),
-                (
-                    b::VOLUME_LINES_BINDING_SPECULAR_POSITION,
-                    BindingKind::StorageImage,
-                ),
-                (b::VOLUME_LINES_BINDING_VOLUME, BindingKind::StorageImage),
-                (b::VOLUME_LINES_BINDING_RADIANCE, BindingKind::StorageImage),
-            ],
-        )?;
-        let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_buffer(b::VOLUME_LINES_BINDING_SEGMENTS, &segments)
-            .write_storage_image(
-                b::VOLUME_LINES_BINDING_FRONT_POSITION,
-                &light_view.front_position,
-            )
-            .write_storage_image(
-                b::VOLUME_LINES_BINDING_FRONT_NORMAL,
-                &light_view.front_normal,
-            )
-            .write_storage_image(
-                b::VOLUME_LINES_BINDING_BACK_POSITION,
-                &light_view.back_position,
-            )
-            .write_storage_image(b::VOLUME_LINES_BINDING_BACK_NORMAL, &light_view.back_normal)
-            .write_buffer(b::VOLUME_LINES_BINDING_VISIBILITY, &visibility)
-            .write_storage_image(
-                b::VOLUME_LINES_BINDING_OPAQUE_POSITION,
-                &image_space.direct.gbuffer.position,
-            )
-            .write_storage_image(
-                b::VOLUME_LINES_BINDING_SPECULAR_POSITION,
-                &image_space.refraction.gbuffer.front_position,
-            )
-            .write_storage_image(b::VOLUME_LINES_BINDING_VOLUME, &volume);
-        let sets = [&scene_gpu.layout, &layout];
-        let segment_pipeline = ComputePipeline::new(
-            ctx,
-            "volume_lines/segments.comp",
-            &sets,
-            size_of::<SegmentPush>() as u32,
-        )?;
-        let visibility_pipeline =
-            ComputePipeline::new(ctx, "volume_lines/visibility.comp", &sets, 0)?;
-        let composite_pipeline =
-            ComputePipeline::new(ctx, "volume_lines/composite.comp", &sets, 0)?;
-        // A constant density (or none) gets fragments compiled without the
-        // density field's code.
-        let homogeneous = scene
-            .medium
-            .as_ref()
-            .is_none_or(|m| matches!(m.density, Density::Constant(_)));
-        let fragment = if homogeneous {
-            "volume_lines/lines.frag"
-        } else {
-            "volume_lines/lines_heterogeneous.frag"
-        };
-        let mut desc = GraphicsPipelineDesc::new("volume_lines/lines.vert", fragment);
-        desc.geometry = Some("volume_lines/lines.geom");
-        desc.color_formats = vec![vk::Format::R32G32B32A32_SFLOAT];
-        desc.additive = true;
-        desc.topology = vk::PrimitiveTopology::POINT_LIST;
-        desc.push_size = size_of::<LinePush>() as u32;
-        let line_pipeline = GraphicsPipeline::new(ctx, &desc, &sets)?;
-        let transmittance_steps = params.transmittance_steps;
-        Ok(Self {
-            image_space,
-            airlight,
-            segments,
-            volume,
-            light_view,
-            buffer_size: n,
-            draw_count: if params.front_reflection {
-                2 * n * n
-            } else {
-                n * n
-            },
-            visibility,
-            lights: scene
-                .lights
-                .iter()
-                .take(b::MAX_LIGHTS as usize)
-                .copied()
-                .collect(),
-            specular: specular_bounds(scene),
-            segment_params: [
-                params.image_space.tir_remedy,
-                params.image_space.eq_6_3_2,
-                transmittance_steps,
-                radius.to_bits(),
-            ],
-            line_push: LinePush {
+            &RaySettings {
+                buffer_size: params.volume_buffer_size,
                 step,
                 radius,
-                // Strict lines are 1-px rectangles about the line; otherwise
-                // implementations rasterise a parallelogram (one fragment per
-                // major-axis column, the Bresenham-like rule).
-                line_raster: if ctx.limits.strict_lines == vk::TRUE {
-                    b::LINE_RASTER_RECTANGULAR
-                } else {
-                    b::LINE_RASTER_PARALLELOGRAM
-                },
-                transmittance_steps,
+                transmittance_steps: params.transmittance_steps,
+                front_reflection: params.front_reflection,
+                tir_remedy: c.tir_remedy,
+                eq_6_3_2: c.eq_6_3_2,
             },
-            segment_pipeline,
-            visibility_pipeline,
-            line_pipeline,
-            composite_pipeline,
-            set,
-            bound_radiance: vk::ImageView::null(),
-            _layout: layout,
+            scene,
+            scene_gpu,
+            &light_views.gbuffer,
+            &surface,
+            width,
+            height,
+        )?;
+        Ok(Self {
+            surface,
+            caustics,
+            light_views,
+            caustic_views,
+            rays,
+            airlight,
         })
-    }
-
-    /// The photon view of light `l` (None: no specular objects, or a point
-    /// light inside their bounding sphere).
-    fn view(&self, l: usize) -> Option<PhotonViewPush> {
-        photon_view(&self.lights[l], l as u32, self.specular?, self.buffer_size)
     }
 }
 
@@ -423,7 +246,9 @@ impl Technique for VolumeLines {
 
     fn update_live(&mut self, params: &Params) -> anyhow::Result<bool> {
         let params = VolumeLinesParams::from_params(params)?;
-        self.image_space.set_live(&params.image_space);
+        let c = &params.image_space;
+        self.surface.set_live(&c.direct, c.search_steps);
+        self.caustics.set_on_change(c.caustics_on_change);
         self.airlight.set_live(&params.airlight);
         Ok(true)
     }
@@ -434,170 +259,44 @@ impl Technique for VolumeLines {
         scene: &SceneGpu,
         targets: &FrameTargets,
     ) -> crate::vk::VkResult<()> {
-        self.image_space.record(rec, scene, targets)?;
-        if self.bound_radiance != targets.radiance.view {
-            // Legal: the renderer waits for every frame before the next.
-            self.set
-                .write_storage_image(b::VOLUME_LINES_BINDING_RADIANCE, &targets.radiance);
-            self.bound_radiance = targets.radiance.view;
+        self.surface.record_opaque(rec, scene)?;
+        self.rays.begin(rec, scene, &self.surface, targets);
+        // One loop over the lights for the caustic map's photons and B's
+        // rays when they share a resolution (one light view each).
+        let caustics = self.caustics.needs_update(scene);
+        if caustics {
+            let views = self.caustic_views.as_ref().unwrap_or(&self.light_views);
+            self.caustics.begin(rec, scene, views)?;
         }
-        let ctx = rec.ctx().clone();
-        rec.pass("volume visibility", |cmd| {
-            // The camera G-buffers were written by rasterisation; the
-            // distances are overwritten after last frame's line fragments.
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(
-                        &self.image_space.direct.gbuffer.position,
-                        Access::ComputeRead,
-                    ),
-                    ImageAccess::new(
-                        &self.image_space.refraction.gbuffer.front_position,
-                        Access::ComputeRead,
-                    ),
-                ],
-                &[BufferAccess::new(&self.visibility, Access::ComputeWrite)],
-            );
-            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
-            self.visibility_pipeline
-                .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
-        });
-        rec.pass("volume clear", |cmd| {
-            barrier(
-                &ctx,
-                cmd,
-                &[ImageAccess::discard(&self.volume, Access::ColorAttachment)],
-                &[],
-            );
-            begin_rendering(
-                &ctx,
-                cmd,
-                self.volume.extent(),
-                &[(self.volume.view, Some([0.0; 4]))],
-                None,
-            );
-            end_rendering(&ctx, cmd);
-        });
-        for l in 0..self.lights.len() {
-            let Some(view) = self.view(l) else {
-                if self.specular.is_some() {
-                    log::warn!(
-                        "light {l} lies inside the specular objects' bounds: no volume caustic"
-                    );
-                }
-                continue;
-            };
-            let specular = self.specular.unwrap_or_default();
-            let viewpoint = Viewpoint::Light {
-                view_proj: photon_view_proj(&view, specular),
-                origin: Vec3::from_slice(&view.origin[..3]),
-                forward: Vec3::from_slice(&view.forward[..3]),
-                orthographic: view.forward[3].to_bits() == b::SHADOW_PLANAR,
-            };
-            rec.pass("volume light view", |cmd| {
-                // Overwritten entirely; its barriers wait for the previous
-                // light's segment pass.
-                self.light_view.draw(&ctx, cmd, scene, &viewpoint);
-            });
-            let push = SegmentPush {
-                origin: view.origin,
-                right: view.right,
-                up: view.up,
-                forward: view.forward,
-                params: self.segment_params,
-            };
-            rec.pass("volume segments", |cmd| {
-                // The light view's attachment writes become storage reads;
-                // the buffer is rewritten after the previous light's lines
-                // (or last frame's) pulled it.
-                barrier(
-                    &ctx,
-                    cmd,
-                    &self.light_view.compute_reads(),
-                    &[
-                        BufferAccess::new(&self.segments, Access::ComputeWrite),
-                        BufferAccess::new(&scene.triangles, Access::ComputeRead),
-                    ],
-                );
-                let groups = [
-                    self.buffer_size.div_ceil(8),
-                    self.buffer_size.div_ceil(8),
-                    1,
-                ];
-                self.segment_pipeline.dispatch(
-                    cmd,
-                    &[&scene.set, &self.set],
-                    bytemuck::bytes_of(&push),
-                    groups,
-                );
-            });
-            rec.pass("volume lines", |cmd| {
-                // Segments pulled by the geometry shader and read again by
-                // the fragments (so the next light's segment pass waits for
-                // both); the distances read by the fragments.
-                barrier(
-                    &ctx,
-                    cmd,
-                    &[ImageAccess::new(&self.volume, Access::ColorAttachment)],
-                    &[
-                        BufferAccess::new(&self.segments, Access::GraphicsRead),
-                        BufferAccess::new(&self.visibility, Access::FragmentRead),
-                    ],
-                );
-                let extent = self.volume.extent();
-                begin_rendering(&ctx, cmd, extent, &[(self.volume.view, None)], None);
-                self.line_pipeline.bind(
-                    cmd,
-                    &[&scene.set, &self.set],
-                    bytemuck::bytes_of(&self.line_push),
-                    extent,
-                );
-                unsafe { ctx.device.cmd_draw(cmd, self.draw_count, 1, 0, 0) };
-                end_rendering(&ctx, cmd);
-            });
+        match (&self.caustic_views, caustics) {
+            (None, true) => {
+                self.light_views
+                    .record(rec, scene, &mut [&mut self.caustics, &mut self.rays])
+            }
+            (Some(views), true) => {
+                views.record(rec, scene, &mut [&mut self.caustics]);
+                self.light_views.record(rec, scene, &mut [&mut self.rays]);
+            }
+            (_, false) => self.light_views.record(rec, scene, &mut [&mut self.rays]),
         }
-        rec.pass("volume composite", |cmd| {
-            // The lines' blended writes are read; the frame's radiance was
-            // written by image_space's refraction pass.
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(&self.volume, Access::ComputeRead),
-                    ImageAccess::new(&targets.radiance, Access::ComputeWrite),
-                ],
-                &[],
-            );
-            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
-            self.composite_pipeline
-                .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
-        });
+        self.caustics
+            .apply(rec, scene, self.surface.gbuffer(), self.surface.opaque());
+        self.surface.record_refraction(rec, scene, targets);
+        self.rays.composite(rec, scene, targets);
         // A: single scattering straight from the lights, shadowed by every
         // object (the shadow maps C recorded this frame).
-        self.airlight.record(
-            rec,
-            scene,
-            &self.image_space.direct.shadows,
-            &targets.radiance,
-        );
+        self.airlight
+            .record(rec, scene, self.surface.shadows(), &targets.radiance);
         Ok(())
     }
 
     fn set_lights(&mut self, lights: &[Light]) -> bool {
-        if lights.len() != self.lights.len()
-            || lights
-                .iter()
-                .zip(&self.lights)
-                .any(|(a, b)| a.kind != b.kind)
-        {
-            return false;
-        }
-        if !self.image_space.set_lights(lights) {
-            return false;
-        }
-        self.lights.copy_from_slice(lights);
-        true
+        self.caustics.invalidate();
+        self.surface.set_lights(lights)
+            && self.light_views.set_lights(lights)
+            && self
+                .caustic_views
+                .as_mut()
+                .is_none_or(|v| v.set_lights(lights))
     }
 }

@@ -31,9 +31,10 @@
 //!    Algorithm 4) or the fixed-radius one it improves on, `denoise_passes`
 //!    times, in place on the caustic buffer (`denoise` 0 skips it).
 //! 5. "caustic composite": L += albedo/π · E on the diffuse receivers of
-//!    the opaque frame (`direct` over a G-buffer without the water), then
-//!    image_space's `CameraRefraction` draws the specular surfaces by an
-//!    image-space search of that frame.
+//!    the opaque frame (`passes::surface_frame`: direct light over a
+//!    G-buffer without the water), then the surface frame's camera
+//!    refraction draws the specular surfaces by an image-space search of
+//!    that frame.
 //! 6. "water view" (`view`, glsl/water_photons/view.comp): the traced
 //!    water's own pixels (one interface) are redrawn, L = F1 L(x_R) +
 //!    (1 − F1)/n² e^(−σ_a t) L(x_T) with x_R, x_T the first hits of the
@@ -136,210 +137,44 @@
 //! (Over 600 lines: about 100 are this map of the paper onto the passes;
 //! the passes themselves live in ccm.rs, trace.rs, splat.rs, denoise.rs.)
 
+mod cascade_frame;
 mod ccm;
 pub mod denoise;
+mod params;
 mod splat;
 mod trace;
 mod view;
 
+pub use cascade_frame::{water_bounds, CascadeFrame};
+use cascade_frame::water_uniform;
 pub use ccm::Ccm;
 pub use denoise::{DenoiseParams, Denoiser};
 pub use splat::{Composite, Splat};
 pub use trace::{GpuWaterPhoton, PhotonCounts, Trace, GUARD_PHOTONS, GUARD_WORD};
+pub use params::{GpuWpParams, WaterPhotonsParams, WpParamsBuffer};
 pub use view::WaterView;
 
-use super::direct::{Direct, DirectParams};
-use super::image_space::{CameraRefraction, RefractionPush};
 use super::{Technique, TechniqueBuild};
-use crate::cascades::{inner_cascade_size, light_position, CascadeLayout, LightRange};
+use crate::cascades::{inner_cascade_size, CascadeLayout};
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::gpu::GpuFrame;
 use crate::params::{ParamSet, Params};
-use crate::passes::gbuffer::GBufferContents;
+use crate::passes::camera_refraction::RefractionPush;
+use crate::passes::surface_frame::SurfaceFrame;
 use crate::radiometry::Component;
 use crate::scene::{Light, LightKind, Scene, Water};
 use crate::shader_bindings as b;
 use crate::vk::{Buffer, BufferUsage, Context, FrameRecorder, VkResult};
 use anyhow::Context as _;
-use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use std::mem::size_of;
 use std::sync::Arc;
 
-crate::declare_params! {
-    /// `water_photons`' parameters: `Direct`'s, the denoiser's, then the
-    /// cascades', photons' and splats'.
-    pub struct WaterPhotonsParams {
-        @group direct: DirectParams;
-        @group denoise: DenoiseParams;
-        cascades: u32 [1, b::WP_MAX_CASCADES] = 2, rebuild,
-            "N, the number of cascaded caustic maps (Eqs. 4-5)";
-        cascade_scale: f32 [1.25, 8.0] = 2.0, rebuild,
-            "s, each cascade covers s times the extent of the previous one (Eq. 2)";
-        ccm_size: u32 [16, 2048] = 512, rebuild,
-            "ccm_0, texels per side of every cascade (Eq. 3 picks 256-2048 from range / precision)";
-        ccm_precision: f32 [0.0, 1000.0] = 0.0, rebuild,
-            "p of Eq. 3 in metres per texel: ccm_0 is then the smallest of 256, 512, 1024, 2048 covering the range; 0: ccm_size decides";
-        light_range: f32 [0.0, 100000.0] = 0.0, rebuild,
-            "width (= height) r of the innermost cascade in metres; 0: the outermost cascade just covers the water";
-        photon_capacity: u32 [0, 33554432] = 0, rebuild,
-            "photon buffer size; 0: twice the threads of Eq. 5 (a reflected and a refracted photon each, never overflows)";
-        splat_mode: u32 [0, 2] = 0, rebuild,
-            "0: the photon differential's footprint (exact flux density); 1: Eqs. 16-19's quad sized by σ; 2: fixed splats (Eqs. 16-19 with σ = s^c, no differentials)";
-        intensity_mode: u32 [0, 1] = 0, rebuild,
-            "0: physical (exact Fresnel, photon flux = E x texel area, absorption); 1: the paper's Eqs. 12-15 (attenuation, stylised Fresnel)";
-        quad_size: f32 [0.25, 16.0] = 1.0, rebuild,
-            "q_0 of Eq. 16 in texel pitches (splat modes 1, 2); 1 makes the box splats tile a flat surface";
-        fresnel_frac: f32 [0.0, 1.0] = 0.02, rebuild,
-            "F_frac of Eq. 14 (intensity_mode 1)";
-        fresnel_exp: f32 [0.1, 16.0] = 5.0, rebuild,
-            "F_exp of Eq. 14 (intensity_mode 1)";
-        attenuation_gamma: f32 [0.01, 0.99] = 0.95, rebuild,
-            "γ of Eq. 13, the focus bias (intensity_mode 1)";
-        attenuation_t_max: f32 [0.01, 100000.0] = 20.0, rebuild,
-            "t_max of Eq. 13 in metres (intensity_mode 1)";
-        depth_bias: f32 [0.0, 0.1] = 0.01, rebuild,
-            "splats move toward the camera by this fraction of their distance before the depth test (along the view ray: the image does not move); 0.001 lets ocean_large's far seabed reject its own splats";
-        search_steps: u32 [4, 256] = 32, live,
-            "linear steps of the camera refraction's image-space search (image_space)";
-    }
-}
-
-/// The uniform block `WpParams` of glsl/water_photons/common.glsl (std140).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuWpParams {
-    pub light_view: [[f32; 4]; 4],
-    pub light_dir: [f32; 4],
-    pub irradiance: [f32; 4],
-    pub range: [f32; 4],
-    pub size: [u32; 4],
-    pub modes: [u32; 4],
-    pub cascade: [f32; 4],
-    pub paper: [f32; 4],
-    pub water: [u32; 4],
-}
-const _: () = assert!(size_of::<GpuWpParams>() == 192);
-
-/// The uniform buffer holding `GpuWpParams`, shared by the passes.
-pub struct WpParamsBuffer(pub Buffer);
-
-/// Light view and cascades of one directional light over one water surface.
-#[derive(Clone, Copy, Debug)]
-pub struct CascadeFrame {
-    pub view: Mat4,
-    pub range: LightRange,
-    pub layout: CascadeLayout,
-}
-
-impl CascadeFrame {
-    /// Eq. 1's light view from `origin` (the camera position) along the
-    /// light `dir`, far enough back that the whole water lies ahead; depth
-    /// range over the water's bounds; cascade 0 `range` metres wide, or
-    /// (range 0) so wide that cascade N − 1 covers the water.
-    pub fn new(water: &Water, origin: Vec3, dir: Vec3, layout: CascadeLayout, range: f32) -> Self {
-        let dir = dir.normalize();
-        let (lo, hi) = water_bounds(water);
-        let corners: Vec<Vec3> = (0..8)
-            .map(|i| {
-                Vec3::new(
-                    if i & 1 == 0 { lo.x } else { hi.x },
-                    if i & 2 == 0 { lo.y } else { hi.y },
-                    if i & 4 == 0 { lo.z } else { hi.z },
-                )
-            })
-            .collect();
-        let behind = corners
-            .iter()
-            .map(|c| -(*c - origin).dot(dir))
-            .fold(0.0f32, f32::max);
-        let back = behind + 1.0;
-        // `cascades::light_view` keeps +y up, which turns the texel grid
-        // against the water's x/z grid under a high sun; up = +z (or +y for
-        // a low sun) lines the two up, so the water fills the map.
-        let up = if dir.y.abs() > 0.5 { Vec3::Z } else { Vec3::Y };
-        let view = Mat4::look_to_rh(light_position(origin, dir, 0.0, back), dir, up);
-        let local: Vec<Vec3> = corners.iter().map(|c| view.transform_point3(*c)).collect();
-        // View space looks down −z: depth = −z.
-        let near = local.iter().map(|p| -p.z).fold(f32::MAX, f32::min) - 0.5;
-        let far = local.iter().map(|p| -p.z).fold(f32::MIN, f32::max) + 0.5;
-        let half = local
-            .iter()
-            .map(|p| p.x.abs().max(p.y.abs()))
-            .fold(0.0f32, f32::max)
-            * 1.001;
-        let width = if range > 0.0 {
-            range
-        } else {
-            2.0 * half / layout.scale.powi(layout.levels as i32 - 1)
-        };
-        Self {
-            view,
-            range: LightRange {
-                width,
-                height: width,
-                near: near.max(1e-3),
-                far,
-            },
-            layout,
-        }
-    }
-
-    /// Cascade c's world → clip (Eq. 2 × Eq. 1).
-    pub fn view_proj(&self, c: u32) -> Mat4 {
-        self.layout.projection(&self.range, c) * self.view
-    }
-}
-
-/// `WpParams.water`: the material index, then (as f32 bits) the rest
-/// height h, a bound on the surface slope |∇η| and the summed amplitude
-/// Σ A, which size the water view's photon search (view.comp). For a sum
-/// of Gerstner waves |∇η| ≤ Σ k A / (1 − Σ Q k A), k = 2π/λ (the crest
-/// sharpened by the horizontal steepness Q; no folds while Σ Q k A < 1).
-fn water_uniform(water: &Water) -> [u32; 4] {
-    let k = |w: &crate::scene::Wave| std::f32::consts::TAU / w.wavelength;
-    let ka: f32 = water.waves.iter().map(|w| k(w) * w.amplitude).sum();
-    let qka: f32 = water
-        .waves
-        .iter()
-        .map(|w| w.steepness * k(w) * w.amplitude)
-        .sum();
-    let slope = ka / (1.0 - qka).max(0.1);
-    let amplitude: f32 = water.waves.iter().map(|w| w.amplitude).sum();
-    [
-        water.material,
-        water.base_height.to_bits(),
-        slope.to_bits(),
-        amplitude.to_bits(),
-    ]
-}
-
-/// Axis-aligned bounds of a water surface over all times: the rest
-/// rectangle grown by the waves' horizontal and vertical reach.
-pub fn water_bounds(water: &Water) -> (Vec3, Vec3) {
-    let vertical: f32 = water.waves.iter().map(|w| w.amplitude).sum();
-    let horizontal: f32 = water.waves.iter().map(|w| w.amplitude * w.steepness).sum();
-    let half = water.size * 0.5 + glam::Vec2::splat(horizontal);
-    (
-        Vec3::new(
-            water.center.x - half.x,
-            water.base_height - vertical,
-            water.center.y - half.y,
-        ),
-        Vec3::new(
-            water.center.x + half.x,
-            water.base_height + vertical,
-            water.center.y + half.y,
-        ),
-    )
-}
-
 pub struct WaterPhotons {
-    /// Direct light on the scene without the water (it still casts shadows).
-    pub direct: Direct,
-    /// Direct light + surface caustics without the water: what the camera
-    /// refraction looks up.
-    pub opaque: FrameTargets,
+    /// Shadows, G-buffers and direct light on the scene without the water
+    /// (it still casts shadows), whose opaque frame gets the caustics and
+    /// is what the camera refraction looks up.
+    pub surface: SurfaceFrame,
     pub ccm: Ccm,
     pub trace: Trace,
     pub splat: Splat,
@@ -350,7 +185,6 @@ pub struct WaterPhotons {
     /// The scene's bounding sphere, for `l_min` when lights change.
     scene_sphere: (Vec3, f32),
     composite: Composite,
-    refraction: CameraRefraction,
     view: WaterView,
     pub frame: CascadeFrame,
     params: WpParamsBuffer,
@@ -433,16 +267,20 @@ impl WaterPhotons {
             photon_bytes
         );
         let capacity = capacity as u32;
-        let direct = Direct::with_contents(
+        let surface = SurfaceFrame::new(
             ctx,
             &params.direct,
             scene,
             scene_gpu,
             width,
             height,
-            GBufferContents::Opaque,
+            RefractionPush {
+                tir_remedy: b::TIR_CLAMP_CRITICAL,
+                use_eq632: 1,
+                search_steps: params.search_steps,
+                pad: 0,
+            },
         )?;
-        let opaque = FrameTargets::new(ctx, width, height)?;
         let params_buffer = WpParamsBuffer(Buffer::new(
             ctx,
             "water_photons params",
@@ -464,7 +302,7 @@ impl WaterPhotons {
             scene_gpu,
             &params_buffer,
             &trace.photons,
-            &direct.gbuffer,
+            surface.gbuffer(),
             width,
             height,
         )?;
@@ -472,7 +310,7 @@ impl WaterPhotons {
             ctx,
             &params.denoise,
             &splat.caustics,
-            &direct.gbuffer.position,
+            &surface.gbuffer().position,
         )?;
         let scene_sphere = scene.bounding_sphere(0.0);
         // The composite reads the splat's caustic buffer (denoised in place).
@@ -480,20 +318,8 @@ impl WaterPhotons {
             ctx,
             scene_gpu,
             &splat.caustics,
-            &direct.gbuffer,
-            &opaque.radiance,
-        )?;
-        let refraction = CameraRefraction::new(
-            ctx,
-            scene_gpu,
-            &opaque.radiance,
-            &direct.gbuffer,
-            RefractionPush {
-                tir_remedy: b::TIR_CLAMP_CRITICAL,
-                use_eq632: 1,
-                search_steps: params.search_steps,
-                pad: 0,
-            },
+            surface.gbuffer(),
+            surface.opaque(),
         )?;
         let view = WaterView::new(
             ctx,
@@ -501,9 +327,9 @@ impl WaterPhotons {
             &params_buffer,
             &trace.photons,
             &trace.slots,
-            &opaque.radiance,
-            &direct.gbuffer,
-            &refraction.gbuffer,
+            surface.opaque(),
+            surface.gbuffer(),
+            surface.specular(),
         )?;
         let gpu_params = GpuWpParams {
             light_view: Mat4::IDENTITY.to_cols_array_2d(),
@@ -533,8 +359,7 @@ impl WaterPhotons {
             water: water_uniform(&water),
         };
         let mut technique = Self {
-            direct,
-            opaque,
+            surface,
             ccm,
             trace,
             splat,
@@ -542,7 +367,6 @@ impl WaterPhotons {
             l_min: denoise::lights_l_min(&scene.lights, scene_sphere.0, scene_sphere.1),
             scene_sphere,
             composite,
-            refraction,
             view,
             frame,
             params: params_buffer,
@@ -606,8 +430,7 @@ impl Technique for WaterPhotons {
 
     fn update_live(&mut self, params: &Params) -> anyhow::Result<bool> {
         let params = WaterPhotonsParams::from_params(params)?;
-        self.direct.set_live(&params.direct);
-        self.refraction.set_search_steps(params.search_steps);
+        self.surface.set_live(&params.direct, params.search_steps);
         Ok(true)
     }
 
@@ -631,7 +454,7 @@ impl Technique for WaterPhotons {
         }
         // Host write while recording: no earlier frame is still in flight.
         self.params.0.upload(bytemuck::bytes_of(&self.gpu_params))?;
-        self.direct.record(rec, scene, &self.opaque)?;
+        self.surface.record_opaque(rec, scene)?;
         let view_projs: Vec<Mat4> = (0..self.frame.layout.levels)
             .map(|c| self.frame.view_proj(c))
             .collect();
@@ -641,7 +464,7 @@ impl Technique for WaterPhotons {
         self.splat.record(
             rec,
             scene,
-            &self.direct.gbuffer,
+            self.surface.gbuffer(),
             &self.trace.photons,
             &self.trace.draw,
         );
@@ -649,7 +472,7 @@ impl Technique for WaterPhotons {
             denoiser.record(
                 rec,
                 &self.splat.caustics,
-                &self.direct.gbuffer.position,
+                &self.surface.gbuffer().position,
                 eye,
                 forward,
                 self.l_min,
@@ -659,24 +482,18 @@ impl Technique for WaterPhotons {
             rec,
             scene,
             &self.splat.caustics,
-            &self.direct.gbuffer,
-            &self.opaque.radiance,
+            self.surface.gbuffer(),
+            self.surface.opaque(),
         );
-        self.refraction.record(
-            rec,
-            scene,
-            &self.opaque.radiance,
-            &self.direct.gbuffer,
-            targets,
-        );
+        self.surface.record_refraction(rec, scene, targets);
         self.view.record(
             rec,
             scene,
             &self.trace.photons,
             &self.trace.slots,
-            &self.opaque.radiance,
-            &self.direct.gbuffer,
-            &self.refraction.gbuffer,
+            self.surface.opaque(),
+            self.surface.gbuffer(),
+            self.surface.specular(),
             targets,
         );
         Ok(())
@@ -718,6 +535,6 @@ impl Technique for WaterPhotons {
         };
         self.set_light(&light);
         self.l_min = denoise::lights_l_min(lights, self.scene_sphere.0, self.scene_sphere.1);
-        self.direct.set_lights(lights)
+        self.surface.set_lights(lights)
     }
 }

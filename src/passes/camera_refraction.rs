@@ -1,5 +1,6 @@
 //! What the camera sees in the specular objects: Wyman 2005-06 two-sided
-//! image-space refraction (and mirror reflection) over the opaque frame.
+//! image-space refraction (and mirror reflection) over the opaque frame
+//! (image_space's camera side; water_photons draws its water with it too).
 //! "refractor gbuffer": the camera's specular G-buffer
 //! (`passes::specular_gbuffer`: nearest front faces with d_N, farthest back
 //! faces); "refraction" (glsl/image_space/refraction.comp): per pixel,
@@ -113,7 +114,16 @@ impl CameraRefraction {
         })
     }
 
-    /// Records "refractor gbuffer" and "refraction": reads `opaque` (all of
+    /// Records "refractor gbuffer": the camera's specular G-buffer, which
+    /// `record` reads (and techniques may read before it).
+    pub fn draw_gbuffer(&self, rec: &mut FrameRecorder, scene: &SceneGpu) {
+        let ctx = rec.ctx().clone();
+        rec.pass("refractor gbuffer", |cmd| {
+            self.gbuffer.draw(&ctx, cmd, scene, &Viewpoint::Camera);
+        });
+    }
+
+    /// Records "refraction" (after `draw_gbuffer`): reads `opaque` (all of
     /// it written by earlier passes) and `opaque_gbuffer`, writes every
     /// pixel of `targets.radiance`.
     pub fn record(
@@ -131,9 +141,6 @@ impl CameraRefraction {
             self.bound_radiance = targets.radiance.view;
         }
         let ctx = rec.ctx().clone();
-        rec.pass("refractor gbuffer", |cmd| {
-            self.gbuffer.draw(&ctx, cmd, scene, &Viewpoint::Camera);
-        });
         rec.pass("refraction", |cmd| {
             // The specular G-buffer's attachment writes and the opaque
             // frame's compute writes (caustic apply) must be visible; the
