@@ -30,7 +30,6 @@ use caustics::radiometry::spot_falloff;
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use caustics::scene::{Density, LightKind, Medium, Scene};
 use caustics::passes::direct_light::{DirectLight, DirectParams};
-use caustics::techniques::Technique;
 use caustics::vk::{Context, Profiler};
 use common::*;
 use glam::{DVec3, Vec3};

@@ -57,15 +57,15 @@ fn render(ctx: &Arc<Context>, scene: &Scene, overrides: &[&str]) -> Frame {
 
 /// The opaque frame (the scene without its specular surfaces) of `f`.
 fn opaque(f: &Frame) -> Vec<f32> {
-    f.tech.opaque.radiance.download_rgba32f().unwrap()
+    f.tech.surface.opaque().download_rgba32f().unwrap()
 }
 
 /// Pixels the camera's specular G-buffer covers (front faces).
 fn covered(f: &Frame) -> Vec<bool> {
     let front = f
         .tech
-        .refraction
-        .gbuffer
+        .surface
+        .specular()
         .front_position
         .download_rgba32f()
         .unwrap();

@@ -50,7 +50,7 @@ mod common;
 use caustics::bvh::Bvh;
 use caustics::frame::{FrameTargets, SceneGpu};
 use caustics::params::ParamSet;
-use caustics::passes::caustic_map::{photon_view, specular_bounds};
+use caustics::passes::light_views::{photon_view, specular_bounds};
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use caustics::scene::{MaterialKind, Scene};
 use caustics::techniques::volume_lines::{GpuSegment, VolumeLines, VolumeLinesParams};
@@ -83,7 +83,7 @@ impl Frame {
     }
 
     fn segments(&self) -> Vec<GpuSegment> {
-        self.tech.segments.download_pod().unwrap()
+        self.tech.rays.segments.download_pod().unwrap()
     }
 }
 
@@ -425,7 +425,8 @@ fn one_line_per_texel_that_sees_the_lens() {
     let reflections = reflected.iter().filter(|s| s.p1[3] > 0.0).count();
     let covered = f
         .tech
-        .light_view
+        .light_views
+        .gbuffer
         .front_position
         .download_rgba32f()
         .unwrap()
@@ -496,7 +497,7 @@ fn coverage_statistics() {
                 size,
             );
             let lines = f.segments().iter().filter(|s| s.p1[3] > 0.0).count();
-            let volume = f.tech.volume.download_rgba32f().unwrap();
+            let volume = f.tech.rays.volume.download_rgba32f().unwrap();
             let covered = volume.chunks(4).filter(|p| p[3] > 0.0).count();
             let fragments: f64 = volume.chunks(4).map(|p| p[3] as f64).sum();
             println!("| {buffer}² | {size}x{size} | {lines} | {covered} | {fragments:.0} |");

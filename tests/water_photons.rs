@@ -245,8 +245,8 @@ fn flat_water_gives_a_uniform_caustic() {
         let caustics = run.technique.splat.caustics.download_rgba32f().unwrap();
         let position = run
             .technique
-            .direct
-            .gbuffer
+            .surface
+            .gbuffer()
             .position
             .download_rgba32f()
             .unwrap();
@@ -700,8 +700,8 @@ fn floor_irradiance(run: &Run, centre: Vec3, half: f32, expected: f64) -> (f64, 
     let caustics = run.technique.splat.caustics.download_rgba32f().unwrap();
     let position = run
         .technique
-        .direct
-        .gbuffer
+        .surface
+        .gbuffer()
         .position
         .download_rgba32f()
         .unwrap();
@@ -941,8 +941,8 @@ fn splats_conserve_the_flux_of_a_focusing_crest() {
         let e = run.technique.splat.caustics.download_rgba32f().unwrap();
         let pos = run
             .technique
-            .direct
-            .gbuffer
+            .surface
+            .gbuffer()
             .position
             .download_rgba32f()
             .unwrap();
@@ -1445,8 +1445,8 @@ fn a_thin_wall_lit_on_one_side_stays_dark_on_the_other() {
         let caustics = run.technique.splat.caustics.download_rgba32f().unwrap();
         let position = run
             .technique
-            .direct
-            .gbuffer
+            .surface
+            .gbuffer()
             .position
             .download_rgba32f()
             .unwrap();
