@@ -1,8 +1,11 @@
-//! Descriptor binding numbers and shared constants: the one source of truth
-//! for both Rust and GLSL. `build.rs` includes this file and writes every
+//! Descriptor binding numbers and shared constants (the scene's set 0, the
+//! shared passes, the ground truth): the one source of truth for both Rust
+//! and GLSL. `build.rs` reads this file and writes every
 //! `pub const NAME: u32` as `#define NAME value` into the generated header
-//! `bindings.glsl`, which shaders `#include`. Keep this file to plain
-//! `pub const X: u32 = N;` lines so the build script can read it.
+//! `bindings.glsl`, which shaders `#include`. A technique's own constants
+//! live in its folder (`src/techniques/<name>/bindings.rs`, generated into
+//! `<name>_bindings.glsl` the same way). Keep these files to plain
+//! `pub const X: u32 = N;` lines so the build script can read them.
 
 // Set 0: the scene, shared by every pass that reads geometry.
 pub const BINDING_FRAME: u32 = 0;
@@ -52,7 +55,7 @@ pub const SHADOW_LAYERS_PER_LIGHT: u32 = 6;
 pub const SHADOW_RADIAL: u32 = 0;
 pub const SHADOW_PLANAR: u32 = 1;
 
-// Direct technique, descriptor set 1 (src/techniques/direct.rs, glsl/direct/lighting.comp).
+// Direct light pass, descriptor set 1 (src/passes/direct_light.rs, glsl/direct/lighting.comp).
 pub const DIRECT_BINDING_POSITION: u32 = 0;
 pub const DIRECT_BINDING_NORMAL: u32 = 1;
 pub const DIRECT_BINDING_RADIANCE: u32 = 2;
@@ -98,8 +101,8 @@ pub const TIR_SINGLE_REFRACTION: u32 = 0;
 pub const TIR_CLAMP_CRITICAL: u32 = 1;
 pub const TIR_REFLECT: u32 = 2;
 
-// image_space camera refraction (src/techniques/image_space/refraction.rs,
-// glsl/image_space/refraction.comp), descriptor set 1.
+// Camera refraction (src/passes/camera_refraction.rs,
+// glsl/passes/camera_refraction.comp), descriptor set 1.
 pub const REFRACTION_BINDING_OPAQUE_RADIANCE: u32 = 0;
 pub const REFRACTION_BINDING_OPAQUE_POSITION: u32 = 1;
 pub const REFRACTION_BINDING_FRONT_POSITION: u32 = 2;
@@ -108,79 +111,12 @@ pub const REFRACTION_BINDING_BACK_POSITION: u32 = 4;
 pub const REFRACTION_BINDING_BACK_NORMAL: u32 = 5;
 pub const REFRACTION_BINDING_RADIANCE: u32 = 6;
 
-// volume_lines (src/techniques/volume_lines/, glsl/volume_lines/), descriptor set 1.
-pub const VOLUME_LINES_BINDING_SEGMENTS: u32 = 0;
-pub const VOLUME_LINES_BINDING_FRONT_POSITION: u32 = 1;
-pub const VOLUME_LINES_BINDING_FRONT_NORMAL: u32 = 2;
-pub const VOLUME_LINES_BINDING_BACK_POSITION: u32 = 3;
-pub const VOLUME_LINES_BINDING_BACK_NORMAL: u32 = 4;
-pub const VOLUME_LINES_BINDING_VISIBILITY: u32 = 5;
-pub const VOLUME_LINES_BINDING_OPAQUE_POSITION: u32 = 6;
-pub const VOLUME_LINES_BINDING_SPECULAR_POSITION: u32 = 7;
-pub const VOLUME_LINES_BINDING_VOLUME: u32 = 8;
-pub const VOLUME_LINES_BINDING_RADIANCE: u32 = 9;
-/// How the device rasterises 1-pixel lines (push constant of lines.frag):
-/// strict (a 1-px-wide rectangle about the line) or not (a parallelogram
-/// one pixel tall along the minor axis, i.e. one fragment per column).
-pub const LINE_RASTER_RECTANGULAR: u32 = 0;
-pub const LINE_RASTER_PARALLELOGRAM: u32 = 1;
-
 // Water surface pass (src/passes/water_surface.rs, glsl/passes/water_surface.comp), set 0.
 pub const WATER_SURFACE_BINDING_WAVES: u32 = 0;
 pub const WATER_SURFACE_BINDING_VERTICES: u32 = 1;
 /// Workgroup side of the water surface pass (8 x 8 grid vertices).
 pub const WATER_SURFACE_GROUP_SIZE: u32 = 8;
 
-// water_photons caustics denoiser (src/techniques/water_photons/denoise.rs,
-// glsl/water_photons/denoise.comp), descriptor set 0.
-pub const DENOISE_BINDING_INPUT: u32 = 0;
-pub const DENOISE_BINDING_OUTPUT: u32 = 1;
-pub const DENOISE_BINDING_POSITION: u32 = 2;
-/// Kernel radius choice (Kougianos 2021 Sect. 3.3): per pixel by Eqs. 26-28,
-/// or one constant radius (the filter of their refs [6, 10]).
-pub const DENOISE_KIND_ADAPTIVE: u32 = 1;
-pub const DENOISE_KIND_FIXED: u32 = 2;
-/// Sub-pass axis: neighbours along x (the paper's "column-wise" sub-pass,
-/// Algorithm 4 line 18), then along y.
-pub const DENOISE_AXIS_X: u32 = 0;
-pub const DENOISE_AXIS_Y: u32 = 1;
-/// Workgroup side of the denoise sub-passes (8 x 8 pixels).
-pub const DENOISE_GROUP_SIZE: u32 = 8;
-// water_photons (src/techniques/water_photons/, glsl/water_photons/),
-// descriptor set 1 of each pass.
-pub const WP_BINDING_PARAMS: u32 = 0;
-pub const WP_BINDING_WATER_VERTICES: u32 = 1;
-pub const WP_BINDING_CCM_POSITION: u32 = 2;
-pub const WP_BINDING_CCM_NORMAL: u32 = 3;
-pub const WP_BINDING_PHOTONS: u32 = 4;
-pub const WP_BINDING_DRAW: u32 = 5;
-pub const WP_BINDING_CAUSTICS: u32 = 6;
-pub const WP_BINDING_GBUFFER_POSITION: u32 = 7;
-pub const WP_BINDING_GBUFFER_NORMAL: u32 = 8;
-pub const WP_BINDING_RADIANCE: u32 = 9;
-// water_photons "water view": the photon slot per (texel, cascade, ray
-// type) written by the trace, and the camera's view of the water.
-pub const WP_BINDING_PHOTON_SLOTS: u32 = 10;
-pub const WP_BINDING_OPAQUE_RADIANCE: u32 = 11;
-pub const WP_BINDING_FRONT_POSITION: u32 = 12;
-pub const WP_BINDING_FRONT_NORMAL: u32 = 13;
-pub const WP_BINDING_BACK_POSITION: u32 = 14;
-/// Most cascades of a cascaded caustic map (Kougianos & Moustakas 2021 use 1-4).
-pub const WP_MAX_CASCADES: u32 = 4;
-/// Trace threads per workgroup, and workgroups per dispatch row.
-pub const WP_TRACE_GROUP_SIZE: u32 = 64;
-pub const WP_TRACE_GROUPS_PER_ROW: u32 = 1024;
-/// Intensity modes: exact Fresnel, flux per photon (physical); Eqs. 13-14 (paper).
-pub const WP_INTENSITY_PHYSICAL: u32 = 0;
-pub const WP_INTENSITY_PAPER: u32 = 1;
-/// Splat modes: the photon differential's footprint; Eqs. 16-19's quad with
-/// σ from the differentials; the same quad with σ = s^c (fixed splats).
-pub const WP_SPLAT_DIFFERENTIAL: u32 = 0;
-pub const WP_SPLAT_PAPER: u32 = 1;
-pub const WP_SPLAT_FIXED: u32 = 2;
-/// Ray types of a photon (Algorithm 3 line 37).
-pub const WP_RAY_REFLECTED: u32 = 0;
-pub const WP_RAY_REFRACTED: u32 = 1;
 // Airlight pass (src/passes/airlight.rs, glsl/passes/airlight.comp), descriptor set 1.
 pub const AIRLIGHT_BINDING_RADIANCE: u32 = 0;
 pub const AIRLIGHT_BINDING_SHADOW_MAP: u32 = 1;

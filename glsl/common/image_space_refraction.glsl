@@ -1,7 +1,7 @@
 // Two-sided image-space refraction (Wyman 2005; Wyman 2006, GPU Gems-style
 // chapter "Interactive Refractions and Caustics Using Image-Space
 // Techniques", Sect. "Approximate, Image-Space Refraction"), shared by the
-// camera (glsl/image_space/refraction.comp) and the light
+// camera (glsl/passes/camera_refraction.comp) and the light
 // (glsl/caustic_map/photons.comp, photon_mode 1): one code path, so the
 // caustics and what the camera sees through the glass agree.
 //

@@ -2,6 +2,7 @@
 // volume_lines: adds the volume caustic image (B, already weighted by its
 // component) to the frame (A + C), Fig. 2's sum.
 #include "scene.glsl"
+#include "volume_lines_bindings.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 

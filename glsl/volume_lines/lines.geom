@@ -4,6 +4,7 @@
 // primitive can be constructed": the segment p1 -> p2 projected by the
 // camera; texels with no segment emit nothing.
 #include "scene.glsl"
+#include "volume_lines_bindings.glsl"
 #include "segment.glsl"
 
 layout(points) in;

@@ -38,6 +38,7 @@
 // weights renormalised over those in front (a ray march stops at the
 // surface), or x_l itself takes the weight when none is.
 #include "scene.glsl"
+#include "volume_lines_bindings.glsl"
 #include "optics.glsl"
 #include "random.glsl"
 #include "medium.glsl"

@@ -32,6 +32,7 @@
 // photons do the same), passing through specular surfaces, and fall back
 // to the scene's bounding sphere (frame.scene_sphere) when it leaves.
 #include "scene.glsl"
+#include "volume_lines_bindings.glsl"
 #include "optics.glsl"
 #include "lights.glsl"
 #include "bvh.glsl"

@@ -4,6 +4,7 @@
 // G-buffer front faces: refractors hide the volume caustic behind them),
 // for lines.frag's culling. 1e30 where the ray meets nothing.
 #include "scene.glsl"
+#include "volume_lines_bindings.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 

@@ -4,7 +4,7 @@
 // GpuWaterVertex per grid vertex) pulled as the triangles of
 // `Water::mesh` (cell (i, j): a c b, a d c), projected by cascade c's
 // orthographic light view (Eq. 2 × Eq. 1).
-#include "bindings.glsl"
+#include "water_photons_bindings.glsl"
 
 struct WaterVertex {
     vec4 position;

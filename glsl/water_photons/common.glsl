@@ -3,7 +3,7 @@
 #ifndef WATER_PHOTONS_COMMON_GLSL
 #define WATER_PHOTONS_COMMON_GLSL
 
-#include "bindings.glsl"
+#include "water_photons_bindings.glsl"
 
 layout(set = 1, binding = WP_BINDING_PARAMS, std140) uniform WpParams {
     mat4 light_view;   // Eq. 1: shared by every cascade

@@ -3,6 +3,7 @@
 // the camera sees (as glsl/caustic_map/apply.comp): L += albedo / π · E,
 // weighted by the surface-caustics component (L S D paths).
 #include "scene.glsl"
+#include "water_photons_bindings.glsl"
 #include "optics.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;

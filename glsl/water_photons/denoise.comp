@@ -10,7 +10,7 @@
 // The paper's prototype ran in Unreal Engine 4, whose unit is the
 // centimetre: its epsilon = 1 (Algorithm 4 line 22) and delta = 15 / 2 / 1
 // (Eq. 28) are 0.01 m and 0.15 / 0.02 / 0.01 m here.
-#include "bindings.glsl"
+#include "water_photons_bindings.glsl"
 #include "optics.glsl"
 
 layout(local_size_x = DENOISE_GROUP_SIZE, local_size_y = DENOISE_GROUP_SIZE) in;

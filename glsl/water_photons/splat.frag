@@ -14,7 +14,7 @@
 // pixel only if both point to the same side: dot > 0. Where no surface
 // covers the pixel the G-buffer normal is 0 and nothing is deposited
 // (the composite ignores those pixels anyway).
-#include "bindings.glsl"
+#include "water_photons_bindings.glsl"
 // splat_weight only: kernel.glsl's other function needs the parameters.
 #define WATER_PHOTONS_KERNEL_WEIGHT_ONLY
 #include "kernel.glsl"

@@ -7,7 +7,7 @@
 // are recomputed:
 //   L = F1 L(x_R) + (1 − F1)/n² exp(−σ_a t) L(x_T)
 // (GUIDE §2: radiance leaving the water keeps L/n², times the Fresnel
-// transmittance; glsl/image_space/refraction.comp derives it), with x_R and
+// transmittance; glsl/passes/camera_refraction.comp derives it), with x_R and
 // x_T the first hits of the reflected and refracted camera rays in the BVH
 // (exact, where the image-space search of the opaque frame guesses).
 //

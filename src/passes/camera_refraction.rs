@@ -3,7 +3,7 @@
 //! (image_space's camera side; water_photons draws its water with it too).
 //! "refractor gbuffer": the camera's specular G-buffer
 //! (`passes::specular_gbuffer`: nearest front faces with d_N, farthest back
-//! faces); "refraction" (glsl/image_space/refraction.comp): per pixel,
+//! faces); "refraction" (glsl/passes/camera_refraction.comp): per pixel,
 //! Fresnel-weighted reflection plus the twice-refracted ray, each found in
 //! the opaque frame by an image-space search, into the frame's radiance.
 
@@ -19,7 +19,7 @@ use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
 
-/// Push constants of glsl/image_space/refraction.comp.
+/// Push constants of glsl/passes/camera_refraction.comp.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct RefractionPush {
@@ -100,7 +100,7 @@ impl CameraRefraction {
             .write_storage_image(b::REFRACTION_BINDING_BACK_NORMAL, &gbuffer.back_normal);
         let pipeline = ComputePipeline::new(
             ctx,
-            "image_space/refraction.comp",
+            "passes/camera_refraction.comp",
             &[&scene_gpu.layout, &layout],
             std::mem::size_of::<RefractionPush>() as u32,
         )?;

@@ -2,12 +2,10 @@
 //! frame, writing linear radiance (W m^-2 sr^-1) into the frame's radiance
 //! image. Each declares its parameters once, as a typed struct
 //! (`crate::declare_params!`), and its name, description and components once
-//! (`TechniqueBuild`); the registry `TECHNIQUES` lists one line per technique.
-
-pub mod direct;
-pub mod image_space;
-pub mod volume_lines;
-pub mod water_photons;
+//! (`TechniqueBuild`); the registry (`registry!` below) lists one line per
+//! technique: its module and type. A technique composes passes
+//! (`crate::passes`: surface frame, light views, caustic map, airlight) and
+//! never imports another technique.
 
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::params::{ParamSet, ParamSpec, Params};
@@ -126,14 +124,23 @@ impl TechniqueInfo {
     }
 }
 
-/// Every real-time technique, one line each (the demo's number keys follow
-/// this order).
-pub const TECHNIQUES: &[TechniqueInfo] = &[
-    TechniqueInfo::of::<direct::Direct>(),
-    TechniqueInfo::of::<image_space::ImageSpace>(),
-    TechniqueInfo::of::<volume_lines::VolumeLines>(),
-    TechniqueInfo::of::<water_photons::WaterPhotons>(),
-];
+/// Declares each technique's module (`src/techniques/<module>/`) and lists
+/// it in `TECHNIQUES`, so adding one is one line.
+macro_rules! registry {
+    ($($module:ident :: $ty:ident),* $(,)?) => {
+        $(pub mod $module;)*
+        /// Every real-time technique, one line each (the demo's number keys
+        /// follow this order).
+        pub const TECHNIQUES: &[TechniqueInfo] = &[$(TechniqueInfo::of::<$module::$ty>()),*];
+    };
+}
+
+registry! {
+    direct::Direct,
+    image_space::ImageSpace,
+    volume_lines::VolumeLines,
+    water_photons::WaterPhotons,
+}
 
 pub fn find(name: &str) -> anyhow::Result<&'static TechniqueInfo> {
     TECHNIQUES.iter().find(|t| t.name == name).ok_or_else(|| {

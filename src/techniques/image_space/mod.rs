@@ -25,7 +25,7 @@
 //! Passes: "shadow maps", "gbuffer", "direct lighting"; "caustic map
 //! clear", per light ("caustic light view" in photon modes 1 and 2)
 //! "caustic photons" and "caustic splat"; "caustic apply"; "refractor
-//! gbuffer"; "refraction" (glsl/image_space/refraction.comp).
+//! gbuffer"; "refraction" (glsl/passes/camera_refraction.comp).
 //! With `caustics_on_change` = 1 the caustic clear, photon and splat passes
 //! run only when a light moved (`set_lights`) or the geometry's animation
 //! time changed; other frames reuse the last caustic map.

@@ -3,7 +3,7 @@
 //! per-frame "volume visibility" and "volume clear" before and "volume
 //! composite" after (the module doc of `volume_lines` has the method).
 
-use crate::shader_bindings as b;
+use super::bindings;
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::passes::light_views::{LightView, LightViewConsumer};
 use crate::passes::specular_gbuffer::SpecularGBuffer;
@@ -137,61 +137,61 @@ impl VolumeRays {
         let layout = DescriptorSetLayout::new(
             ctx,
             &[
-                (b::VOLUME_LINES_BINDING_SEGMENTS, BindingKind::Storage),
+                (bindings::VOLUME_LINES_BINDING_SEGMENTS, BindingKind::Storage),
                 (
-                    b::VOLUME_LINES_BINDING_FRONT_POSITION,
+                    bindings::VOLUME_LINES_BINDING_FRONT_POSITION,
                     BindingKind::StorageImage,
                 ),
                 (
-                    b::VOLUME_LINES_BINDING_FRONT_NORMAL,
+                    bindings::VOLUME_LINES_BINDING_FRONT_NORMAL,
                     BindingKind::StorageImage,
                 ),
                 (
-                    b::VOLUME_LINES_BINDING_BACK_POSITION,
+                    bindings::VOLUME_LINES_BINDING_BACK_POSITION,
                     BindingKind::StorageImage,
                 ),
                 (
-                    b::VOLUME_LINES_BINDING_BACK_NORMAL,
+                    bindings::VOLUME_LINES_BINDING_BACK_NORMAL,
                     BindingKind::StorageImage,
                 ),
-                (b::VOLUME_LINES_BINDING_VISIBILITY, BindingKind::Storage),
+                (bindings::VOLUME_LINES_BINDING_VISIBILITY, BindingKind::Storage),
                 (
-                    b::VOLUME_LINES_BINDING_OPAQUE_POSITION,
+                    bindings::VOLUME_LINES_BINDING_OPAQUE_POSITION,
                     BindingKind::StorageImage,
                 ),
                 (
-                    b::VOLUME_LINES_BINDING_SPECULAR_POSITION,
+                    bindings::VOLUME_LINES_BINDING_SPECULAR_POSITION,
                     BindingKind::StorageImage,
                 ),
-                (b::VOLUME_LINES_BINDING_VOLUME, BindingKind::StorageImage),
-                (b::VOLUME_LINES_BINDING_RADIANCE, BindingKind::StorageImage),
+                (bindings::VOLUME_LINES_BINDING_VOLUME, BindingKind::StorageImage),
+                (bindings::VOLUME_LINES_BINDING_RADIANCE, BindingKind::StorageImage),
             ],
         )?;
         let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_buffer(b::VOLUME_LINES_BINDING_SEGMENTS, &segments)
+        set.write_buffer(bindings::VOLUME_LINES_BINDING_SEGMENTS, &segments)
             .write_storage_image(
-                b::VOLUME_LINES_BINDING_FRONT_POSITION,
+                bindings::VOLUME_LINES_BINDING_FRONT_POSITION,
                 &light_view.front_position,
             )
             .write_storage_image(
-                b::VOLUME_LINES_BINDING_FRONT_NORMAL,
+                bindings::VOLUME_LINES_BINDING_FRONT_NORMAL,
                 &light_view.front_normal,
             )
             .write_storage_image(
-                b::VOLUME_LINES_BINDING_BACK_POSITION,
+                bindings::VOLUME_LINES_BINDING_BACK_POSITION,
                 &light_view.back_position,
             )
-            .write_storage_image(b::VOLUME_LINES_BINDING_BACK_NORMAL, &light_view.back_normal)
-            .write_buffer(b::VOLUME_LINES_BINDING_VISIBILITY, &visibility)
+            .write_storage_image(bindings::VOLUME_LINES_BINDING_BACK_NORMAL, &light_view.back_normal)
+            .write_buffer(bindings::VOLUME_LINES_BINDING_VISIBILITY, &visibility)
             .write_storage_image(
-                b::VOLUME_LINES_BINDING_OPAQUE_POSITION,
+                bindings::VOLUME_LINES_BINDING_OPAQUE_POSITION,
                 &surface.gbuffer().position,
             )
             .write_storage_image(
-                b::VOLUME_LINES_BINDING_SPECULAR_POSITION,
+                bindings::VOLUME_LINES_BINDING_SPECULAR_POSITION,
                 &surface.specular().front_position,
             )
-            .write_storage_image(b::VOLUME_LINES_BINDING_VOLUME, &volume);
+            .write_storage_image(bindings::VOLUME_LINES_BINDING_VOLUME, &volume);
         let sets = [&scene_gpu.layout, &layout];
         let segment_pipeline = ComputePipeline::new(
             ctx,
@@ -245,9 +245,9 @@ impl VolumeRays {
                 // implementations rasterise a parallelogram (one fragment per
                 // major-axis column, the Bresenham-like rule).
                 line_raster: if ctx.limits.strict_lines == vk::TRUE {
-                    b::LINE_RASTER_RECTANGULAR
+                    bindings::LINE_RASTER_RECTANGULAR
                 } else {
-                    b::LINE_RASTER_PARALLELOGRAM
+                    bindings::LINE_RASTER_PARALLELOGRAM
                 },
                 transmittance_steps,
             },
@@ -273,7 +273,7 @@ impl VolumeRays {
         if self.bound_radiance != targets.radiance.view {
             // Legal: the renderer waits for every frame before the next.
             self.set
-                .write_storage_image(b::VOLUME_LINES_BINDING_RADIANCE, &targets.radiance);
+                .write_storage_image(bindings::VOLUME_LINES_BINDING_RADIANCE, &targets.radiance);
             self.bound_radiance = targets.radiance.view;
         }
         let ctx = rec.ctx().clone();

@@ -85,6 +85,7 @@
 //! `--component` writes each alone (direct and surface_caustics are C's
 //! two parts, airlight is A, volume_caustics is B).
 
+pub mod bindings;
 mod lines;
 
 pub use lines::{GpuSegment, VolumeRays};

@@ -7,7 +7,7 @@
 
 use crate::passes::water_surface::WaterSurface;
 use crate::scene::Water;
-use crate::shader_bindings as b;
+use super::bindings;
 use crate::vk::{
     barrier, begin_rendering, end_rendering, Access, BindingKind, BufferAccess, Context,
     DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc,
@@ -67,9 +67,9 @@ impl Ccm {
             desc(DEPTH_FORMAT, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT),
         )?;
         let layout =
-            DescriptorSetLayout::new(ctx, &[(b::WP_BINDING_WATER_VERTICES, BindingKind::Storage)])?;
+            DescriptorSetLayout::new(ctx, &[(bindings::WP_BINDING_WATER_VERTICES, BindingKind::Storage)])?;
         let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_buffer(b::WP_BINDING_WATER_VERTICES, &surface.vertices);
+        set.write_buffer(bindings::WP_BINDING_WATER_VERTICES, &surface.vertices);
         let mut desc =
             GraphicsPipelineDesc::new("water_photons/ccm.vert", "water_photons/ccm.frag");
         desc.color_formats = vec![CCM_FORMAT, CCM_FORMAT];

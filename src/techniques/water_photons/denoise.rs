@@ -46,7 +46,7 @@
 //! pixels and narrow at bright ones adds energy around isolated photons).
 
 use crate::scene::{Camera, Light, LightKind, Scene};
-use crate::shader_bindings as b;
+use super::bindings;
 use crate::vk::{
     barrier, copy_image, Access, BindingKind, ComputePipeline, Context, DescriptorSet,
     DescriptorSetLayout, FrameRecorder, Image, ImageAccess, ImageDesc, Profiler, TimingSource,
@@ -84,8 +84,8 @@ pub enum DenoiseKind {
 impl DenoiseKind {
     fn code(self) -> u32 {
         match self {
-            DenoiseKind::Adaptive => b::DENOISE_KIND_ADAPTIVE,
-            DenoiseKind::Fixed => b::DENOISE_KIND_FIXED,
+            DenoiseKind::Adaptive => bindings::DENOISE_KIND_ADAPTIVE,
+            DenoiseKind::Fixed => bindings::DENOISE_KIND_FIXED,
         }
     }
 
@@ -229,9 +229,9 @@ impl Denoiser {
         let layout = DescriptorSetLayout::new(
             ctx,
             &[
-                (b::DENOISE_BINDING_INPUT, BindingKind::StorageImage),
-                (b::DENOISE_BINDING_OUTPUT, BindingKind::StorageImage),
-                (b::DENOISE_BINDING_POSITION, BindingKind::StorageImage),
+                (bindings::DENOISE_BINDING_INPUT, BindingKind::StorageImage),
+                (bindings::DENOISE_BINDING_OUTPUT, BindingKind::StorageImage),
+                (bindings::DENOISE_BINDING_POSITION, BindingKind::StorageImage),
             ],
         )?;
         let pipeline = ComputePipeline::new(
@@ -252,14 +252,14 @@ impl Denoiser {
         )?;
         let set_x = DescriptorSet::new(ctx, &layout)?;
         set_x
-            .write_storage_image(b::DENOISE_BINDING_INPUT, caustics)
-            .write_storage_image(b::DENOISE_BINDING_OUTPUT, &scratch)
-            .write_storage_image(b::DENOISE_BINDING_POSITION, position);
+            .write_storage_image(bindings::DENOISE_BINDING_INPUT, caustics)
+            .write_storage_image(bindings::DENOISE_BINDING_OUTPUT, &scratch)
+            .write_storage_image(bindings::DENOISE_BINDING_POSITION, position);
         let set_y = DescriptorSet::new(ctx, &layout)?;
         set_y
-            .write_storage_image(b::DENOISE_BINDING_INPUT, &scratch)
-            .write_storage_image(b::DENOISE_BINDING_OUTPUT, caustics)
-            .write_storage_image(b::DENOISE_BINDING_POSITION, position);
+            .write_storage_image(bindings::DENOISE_BINDING_INPUT, &scratch)
+            .write_storage_image(bindings::DENOISE_BINDING_OUTPUT, caustics)
+            .write_storage_image(bindings::DENOISE_BINDING_POSITION, position);
         Ok(Self {
             config,
             pipeline,
@@ -308,8 +308,8 @@ impl Denoiser {
             mode: [axis, self.config.kind.code(), self.config.fixed_radius, 0],
         };
         let groups = [
-            caustics.desc.width.div_ceil(b::DENOISE_GROUP_SIZE),
-            caustics.desc.height.div_ceil(b::DENOISE_GROUP_SIZE),
+            caustics.desc.width.div_ceil(bindings::DENOISE_GROUP_SIZE),
+            caustics.desc.height.div_ceil(bindings::DENOISE_GROUP_SIZE),
             1,
         ];
         let kind = self.config.kind.name();
@@ -331,7 +331,7 @@ impl Denoiser {
                 self.pipeline.dispatch(
                     cmd,
                     &[&self.set_x],
-                    bytemuck::bytes_of(&push(b::DENOISE_AXIS_X)),
+                    bytemuck::bytes_of(&push(bindings::DENOISE_AXIS_X)),
                     groups,
                 );
             });
@@ -352,7 +352,7 @@ impl Denoiser {
                 self.pipeline.dispatch(
                     cmd,
                     &[&self.set_y],
-                    bytemuck::bytes_of(&push(b::DENOISE_AXIS_Y)),
+                    bytemuck::bytes_of(&push(bindings::DENOISE_AXIS_Y)),
                     groups,
                 );
             });

@@ -137,6 +137,7 @@
 //! (Over 600 lines: about 100 are this map of the paper onto the passes;
 //! the passes themselves live in ccm.rs, trace.rs, splat.rs, denoise.rs.)
 
+pub mod bindings;
 mod cascade_frame;
 mod ccm;
 pub mod denoise;

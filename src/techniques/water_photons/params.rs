@@ -2,7 +2,7 @@
 
 use super::denoise::DenoiseParams;
 use crate::passes::direct_light::DirectParams;
-use crate::shader_bindings as b;
+use super::bindings;
 use crate::vk::Buffer;
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
@@ -13,7 +13,7 @@ crate::declare_params! {
     pub struct WaterPhotonsParams {
         @group direct: DirectParams;
         @group denoise: DenoiseParams;
-        cascades: u32 [1, b::WP_MAX_CASCADES] = 2, rebuild,
+        cascades: u32 [1, bindings::WP_MAX_CASCADES] = 2, rebuild,
             "N, the number of cascaded caustic maps (Eqs. 4-5)";
         cascade_scale: f32 [1.25, 8.0] = 2.0, rebuild,
             "s, each cascade covers s times the extent of the previous one (Eq. 2)";

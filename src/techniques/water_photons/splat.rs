@@ -15,7 +15,7 @@
 use super::WpParamsBuffer;
 use crate::frame::SceneGpu;
 use crate::passes::gbuffer::{GBuffer, DEPTH_FORMAT};
-use crate::shader_bindings as b;
+use super::bindings;
 use crate::vk::{
     barrier, begin_rendering_with_depth, end_rendering, Access, BindingKind, Buffer, BufferAccess,
     ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
@@ -60,18 +60,18 @@ impl Splat {
         let layout = DescriptorSetLayout::new(
             ctx,
             &[
-                (b::WP_BINDING_PARAMS, BindingKind::Uniform),
-                (b::WP_BINDING_PHOTONS, BindingKind::Storage),
-                (b::WP_BINDING_GBUFFER_NORMAL, BindingKind::Sampled),
+                (bindings::WP_BINDING_PARAMS, BindingKind::Uniform),
+                (bindings::WP_BINDING_PHOTONS, BindingKind::Storage),
+                (bindings::WP_BINDING_GBUFFER_NORMAL, BindingKind::Sampled),
             ],
         )?;
         // Nearest: splat.frag fetches the G-buffer texel under the fragment.
         let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
         let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_buffer(b::WP_BINDING_PARAMS, &params.0)
-            .write_buffer(b::WP_BINDING_PHOTONS, photons)
+        set.write_buffer(bindings::WP_BINDING_PARAMS, &params.0)
+            .write_buffer(bindings::WP_BINDING_PHOTONS, photons)
             .write_sampled_image(
-                b::WP_BINDING_GBUFFER_NORMAL,
+                bindings::WP_BINDING_GBUFFER_NORMAL,
                 &gbuffer.normal,
                 &sampler,
                 vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
@@ -159,17 +159,17 @@ impl Composite {
         let layout = DescriptorSetLayout::new(
             ctx,
             &[
-                (b::WP_BINDING_CAUSTICS, BindingKind::StorageImage),
-                (b::WP_BINDING_GBUFFER_POSITION, BindingKind::StorageImage),
-                (b::WP_BINDING_GBUFFER_NORMAL, BindingKind::StorageImage),
-                (b::WP_BINDING_RADIANCE, BindingKind::StorageImage),
+                (bindings::WP_BINDING_CAUSTICS, BindingKind::StorageImage),
+                (bindings::WP_BINDING_GBUFFER_POSITION, BindingKind::StorageImage),
+                (bindings::WP_BINDING_GBUFFER_NORMAL, BindingKind::StorageImage),
+                (bindings::WP_BINDING_RADIANCE, BindingKind::StorageImage),
             ],
         )?;
         let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_storage_image(b::WP_BINDING_CAUSTICS, caustics)
-            .write_storage_image(b::WP_BINDING_GBUFFER_POSITION, &gbuffer.position)
-            .write_storage_image(b::WP_BINDING_GBUFFER_NORMAL, &gbuffer.normal)
-            .write_storage_image(b::WP_BINDING_RADIANCE, radiance);
+        set.write_storage_image(bindings::WP_BINDING_CAUSTICS, caustics)
+            .write_storage_image(bindings::WP_BINDING_GBUFFER_POSITION, &gbuffer.position)
+            .write_storage_image(bindings::WP_BINDING_GBUFFER_NORMAL, &gbuffer.normal)
+            .write_storage_image(bindings::WP_BINDING_RADIANCE, radiance);
         let pipeline = ComputePipeline::new(
             ctx,
             "water_photons/composite.comp",

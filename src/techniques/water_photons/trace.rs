@@ -12,7 +12,7 @@
 use super::WpParamsBuffer;
 use crate::cascades::CascadeLayout;
 use crate::frame::SceneGpu;
-use crate::shader_bindings as b;
+use super::bindings;
 use crate::vk::{
     barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline, Context,
     DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageAccess, ImageDesc, VkResult,
@@ -137,21 +137,21 @@ impl Trace {
         let layout = DescriptorSetLayout::new(
             ctx,
             &[
-                (b::WP_BINDING_PARAMS, BindingKind::Uniform),
-                (b::WP_BINDING_CCM_POSITION, BindingKind::StorageImage),
-                (b::WP_BINDING_CCM_NORMAL, BindingKind::StorageImage),
-                (b::WP_BINDING_PHOTONS, BindingKind::Storage),
-                (b::WP_BINDING_DRAW, BindingKind::Storage),
-                (b::WP_BINDING_PHOTON_SLOTS, BindingKind::StorageImage),
+                (bindings::WP_BINDING_PARAMS, BindingKind::Uniform),
+                (bindings::WP_BINDING_CCM_POSITION, BindingKind::StorageImage),
+                (bindings::WP_BINDING_CCM_NORMAL, BindingKind::StorageImage),
+                (bindings::WP_BINDING_PHOTONS, BindingKind::Storage),
+                (bindings::WP_BINDING_DRAW, BindingKind::Storage),
+                (bindings::WP_BINDING_PHOTON_SLOTS, BindingKind::StorageImage),
             ],
         )?;
         let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_buffer(b::WP_BINDING_PARAMS, &params.0)
-            .write_storage_image(b::WP_BINDING_CCM_POSITION, ccm_position)
-            .write_storage_image(b::WP_BINDING_CCM_NORMAL, ccm_normal)
-            .write_buffer(b::WP_BINDING_PHOTONS, &photons)
-            .write_buffer(b::WP_BINDING_DRAW, &draw)
-            .write_storage_image(b::WP_BINDING_PHOTON_SLOTS, &slots);
+        set.write_buffer(bindings::WP_BINDING_PARAMS, &params.0)
+            .write_storage_image(bindings::WP_BINDING_CCM_POSITION, ccm_position)
+            .write_storage_image(bindings::WP_BINDING_CCM_NORMAL, ccm_normal)
+            .write_buffer(bindings::WP_BINDING_PHOTONS, &photons)
+            .write_buffer(bindings::WP_BINDING_DRAW, &draw)
+            .write_storage_image(bindings::WP_BINDING_PHOTON_SLOTS, &slots);
         let pipeline = ComputePipeline::new(
             ctx,
             "water_photons/trace.comp",
@@ -248,16 +248,16 @@ impl Trace {
                     BufferAccess::new(&scene.triangles, Access::ComputeRead),
                 ],
             );
-            let per_row = (b::WP_TRACE_GROUP_SIZE * b::WP_TRACE_GROUPS_PER_ROW) as u64;
+            let per_row = (bindings::WP_TRACE_GROUP_SIZE * bindings::WP_TRACE_GROUPS_PER_ROW) as u64;
             let groups = if self.threads <= per_row {
                 [
-                    self.threads.div_ceil(b::WP_TRACE_GROUP_SIZE as u64) as u32,
+                    self.threads.div_ceil(bindings::WP_TRACE_GROUP_SIZE as u64) as u32,
                     1,
                     1,
                 ]
             } else {
                 [
-                    b::WP_TRACE_GROUPS_PER_ROW,
+                    bindings::WP_TRACE_GROUPS_PER_ROW,
                     self.threads.div_ceil(per_row) as u32,
                     1,
                 ]

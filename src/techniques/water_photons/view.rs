@@ -11,7 +11,7 @@ use super::WpParamsBuffer;
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::specular_gbuffer::SpecularGBuffer;
-use crate::shader_bindings as b;
+use super::bindings;
 use crate::vk::{
     barrier, Access, BindingKind, Buffer, BufferAccess, ComputePipeline, Context, DescriptorSet,
     DescriptorSetLayout, FrameRecorder, Image, ImageAccess, VkResult,
@@ -41,26 +41,26 @@ impl WaterView {
         let layout = DescriptorSetLayout::new(
             ctx,
             &[
-                (b::WP_BINDING_PARAMS, BindingKind::Uniform),
-                (b::WP_BINDING_PHOTONS, BindingKind::Storage),
-                (b::WP_BINDING_PHOTON_SLOTS, BindingKind::StorageImage),
-                (b::WP_BINDING_OPAQUE_RADIANCE, BindingKind::StorageImage),
-                (b::WP_BINDING_GBUFFER_POSITION, BindingKind::StorageImage),
-                (b::WP_BINDING_FRONT_POSITION, BindingKind::StorageImage),
-                (b::WP_BINDING_FRONT_NORMAL, BindingKind::StorageImage),
-                (b::WP_BINDING_BACK_POSITION, BindingKind::StorageImage),
-                (b::WP_BINDING_RADIANCE, BindingKind::StorageImage),
+                (bindings::WP_BINDING_PARAMS, BindingKind::Uniform),
+                (bindings::WP_BINDING_PHOTONS, BindingKind::Storage),
+                (bindings::WP_BINDING_PHOTON_SLOTS, BindingKind::StorageImage),
+                (bindings::WP_BINDING_OPAQUE_RADIANCE, BindingKind::StorageImage),
+                (bindings::WP_BINDING_GBUFFER_POSITION, BindingKind::StorageImage),
+                (bindings::WP_BINDING_FRONT_POSITION, BindingKind::StorageImage),
+                (bindings::WP_BINDING_FRONT_NORMAL, BindingKind::StorageImage),
+                (bindings::WP_BINDING_BACK_POSITION, BindingKind::StorageImage),
+                (bindings::WP_BINDING_RADIANCE, BindingKind::StorageImage),
             ],
         )?;
         let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_buffer(b::WP_BINDING_PARAMS, &params.0)
-            .write_buffer(b::WP_BINDING_PHOTONS, photons)
-            .write_storage_image(b::WP_BINDING_PHOTON_SLOTS, slots)
-            .write_storage_image(b::WP_BINDING_OPAQUE_RADIANCE, opaque)
-            .write_storage_image(b::WP_BINDING_GBUFFER_POSITION, &opaque_gbuffer.position)
-            .write_storage_image(b::WP_BINDING_FRONT_POSITION, &specular.front_position)
-            .write_storage_image(b::WP_BINDING_FRONT_NORMAL, &specular.front_normal)
-            .write_storage_image(b::WP_BINDING_BACK_POSITION, &specular.back_position);
+        set.write_buffer(bindings::WP_BINDING_PARAMS, &params.0)
+            .write_buffer(bindings::WP_BINDING_PHOTONS, photons)
+            .write_storage_image(bindings::WP_BINDING_PHOTON_SLOTS, slots)
+            .write_storage_image(bindings::WP_BINDING_OPAQUE_RADIANCE, opaque)
+            .write_storage_image(bindings::WP_BINDING_GBUFFER_POSITION, &opaque_gbuffer.position)
+            .write_storage_image(bindings::WP_BINDING_FRONT_POSITION, &specular.front_position)
+            .write_storage_image(bindings::WP_BINDING_FRONT_NORMAL, &specular.front_normal)
+            .write_storage_image(bindings::WP_BINDING_BACK_POSITION, &specular.back_position);
         let pipeline = ComputePipeline::new(
             ctx,
             "water_photons/view.comp",
@@ -93,7 +93,7 @@ impl WaterView {
         if self.bound_radiance != targets.radiance.view {
             // Legal: the renderer waits for every frame before the next.
             self.set
-                .write_storage_image(b::WP_BINDING_RADIANCE, &targets.radiance);
+                .write_storage_image(bindings::WP_BINDING_RADIANCE, &targets.radiance);
             self.bound_radiance = targets.radiance.view;
         }
         let ctx = rec.ctx().clone();
