@@ -392,7 +392,10 @@ fn rect_solid_angle(u0: f64, u1: f64, v0: f64, v1: f64) -> f64 {
 /// (floor point, irradiance there from the caustic map).
 fn caustic_peak(f: &Frame, floor_y: f32) -> (Vec3, f64) {
     let size = f.tech.caustics.map_size;
-    let view = f.tech.caustics.views(f.tech.light_views.lights(), f.scene_gpu.sphere)[0];
+    let view = f
+        .tech
+        .caustics
+        .views(f.tech.light_views.lights(), f.scene_gpu.sphere)[0];
     let layer = 3; // -y (CUBE_FACES order +x -x +y -y +z -z)
     let texels = f.tech.caustics.map.download_layer_rgba32f(layer).unwrap();
     let inv = glam::Mat4::from_cols_array_2d(&view.view_proj[layer as usize]).inverse();
@@ -1035,7 +1038,10 @@ fn mirror_ring_cardioid_cusp() {
     // The cusp: the brightest caustic-map texel (orthographic view, one
     // layer), taken to the floor along the light.
     let size = f.tech.caustics.map_size;
-    let view = f.tech.caustics.views(f.tech.light_views.lights(), f.scene_gpu.sphere)[0];
+    let view = f
+        .tech
+        .caustics
+        .views(f.tech.light_views.lights(), f.scene_gpu.sphere)[0];
     let inv = glam::Mat4::from_cols_array_2d(&view.view_proj[0]).inverse();
     let d = light_dir.normalize();
     let to_floor = |tx: f32, ty: f32| {

@@ -203,7 +203,10 @@ fn flat_water_gives_a_uniform_caustic() {
         let p = photons(&run);
         let refracted: Vec<_> = p
             .iter()
-            .filter(|p| p.axis_u[3] == caustics::techniques::water_photons::bindings::WP_RAY_REFRACTED as f32)
+            .filter(|p| {
+                p.axis_u[3]
+                    == caustics::techniques::water_photons::bindings::WP_RAY_REFRACTED as f32
+            })
             .collect();
         assert!(
             refracted.len() > 1000,
@@ -303,7 +306,9 @@ fn a_crest_focuses_as_a_lens() {
     let p = photons(&run);
     let refracted: Vec<_> = p
         .iter()
-        .filter(|p| p.axis_u[3] == caustics::techniques::water_photons::bindings::WP_RAY_REFRACTED as f32)
+        .filter(|p| {
+            p.axis_u[3] == caustics::techniques::water_photons::bindings::WP_RAY_REFRACTED as f32
+        })
         .collect();
     // Paraxial: under the crest (slope 0, curvature κ = A k²) a ray at
     // offset δ leaves tilted by (1 − 1/n) κ δ toward the axis, so after the

@@ -2,7 +2,8 @@
 //! photons shot from each light through the specular objects, splatted into
 //! a light-space map, projected onto the diffuse receivers.
 //!
-//! Per light, each frame:
+//! Each frame "caustic map clear" (`begin`), then per light (the light
+//! views' loop, `LightViewConsumer::record_light`):
 //! 1. "caustic photons" (glsl/caustic_map/photons.comp): one photon per texel
 //!    of an N x N light view fitted to the specular objects' bounding sphere
 //!    (perspective for point and spot lights, orthographic for directional
@@ -14,7 +15,7 @@
 //!    reference). `mode` picks how the
 //!    refracted path is found: traced through the BVH (exact, default), or
 //!    from light-space front/back G-buffers of the specular objects
-//!    ("caustic light view", `passes::specular_gbuffer` from the light:
+//!    ("light view", `passes::light_views` (this map is one of its consumers):
 //!    Wyman's two-sided refraction, shared with the camera) with the back
 //!    interface by Eq. 6.3.1 or by marching the back-face map; the exit ray
 //!    lands through the BVH. Buffer: `2 N^2` `GpuPhoton`s, refracted photons
@@ -25,7 +26,7 @@
 //!    (`passes::shadow::shadow_views`; a spot light gets a point light's
 //!    cube faces, since caustics land outside its cone) at M x M texels,
 //!    storing flux per texel (W) in rgb and the sum of weights in a.
-//! 3. `apply` (glsl/caustic_map/apply.comp, recorded by the technique):
+//! 3. "caustic apply" (glsl/caustic_map/apply.comp, `CausticMap::apply`):
 //!    E = Phi_texel / A_texel(x) on each diffuse receiver.
 //!
 //! In a participating medium (Hu et al. 2010 Sect. 5.3) the photons' flux
@@ -68,11 +69,11 @@
 use crate::frame::SceneGpu;
 use crate::passes::camera_refraction::RefractionPush;
 use crate::passes::direct_light::DirectParams;
-use crate::passes::surface_frame::SurfaceFrame;
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::light_views::{LightView, LightViewConsumer, LightViews};
 use crate::passes::shadow::{shadow_views, GpuShadowLight};
 use crate::passes::specular_gbuffer::SpecularGBuffer;
+use crate::passes::surface_frame::SurfaceFrame;
 use crate::scene::{Light, LightKind};
 use crate::shader_bindings as b;
 use crate::vk::{
@@ -506,7 +507,6 @@ impl CausticMap {
             );
         });
     }
-
 }
 
 impl LightViewConsumer for CausticMap {

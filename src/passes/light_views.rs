@@ -166,7 +166,12 @@ pub struct LightViews {
 
 impl LightViews {
     /// Views of `size`^2 texels of the scene's first `MAX_LIGHTS` lights.
-    pub fn new(ctx: &Arc<Context>, scene: &Scene, scene_gpu: &SceneGpu, size: u32) -> VkResult<Self> {
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        scene_gpu: &SceneGpu,
+        size: u32,
+    ) -> VkResult<Self> {
         Ok(Self {
             gbuffer: SpecularGBuffer::new(ctx, &scene_gpu.layout, size, size)?,
             size,

@@ -60,8 +60,13 @@ impl SurfaceFrame {
             GBufferContents::Opaque,
         )?;
         let opaque = FrameTargets::new(ctx, width, height)?;
-        let refraction =
-            CameraRefraction::new(ctx, scene_gpu, &opaque.radiance, &direct.gbuffer, refraction)?;
+        let refraction = CameraRefraction::new(
+            ctx,
+            scene_gpu,
+            &opaque.radiance,
+            &direct.gbuffer,
+            refraction,
+        )?;
         Ok(Self {
             direct,
             opaque,

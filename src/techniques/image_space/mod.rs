@@ -1,6 +1,6 @@
 //! `image_space`: Wyman 2005-06, image-space refraction and caustic maps.
 //!
-//! 1. The opaque frame (`opaque`): the `direct` passes over a G-buffer that
+//! 1. The opaque frame (`SurfaceFrame::opaque`): direct light over a G-buffer that
 //!    leaves the specular surfaces out (they still cast shadows: the shadow
 //!    maps hold every caster), plus, on diffuse receivers, L = albedo / pi *
 //!    E_caustic from the caustic map (`passes::caustic_map`): the light the
@@ -22,10 +22,13 @@
 //!    shared with the caustic photons of `photon_mode` 1 (Wyman: "render
 //!    the specular objects from the light ... with the same code").
 //!
-//! Passes: "shadow maps", "gbuffer", "direct lighting"; "caustic map
-//! clear", per light ("caustic light view" in photon modes 1 and 2)
-//! "caustic photons" and "caustic splat"; "caustic apply"; "refractor
-//! gbuffer"; "refraction" (glsl/passes/camera_refraction.comp).
+//! Composed of passes (it holds no other technique): the surface frame
+//! (`passes::surface_frame`), the light views (`passes::light_views`) and
+//! the caustic map (`passes::caustic_map`, a light-view consumer).
+//! Passes: "shadow maps", "gbuffer", "refractor gbuffer", "direct
+//! lighting"; "caustic map clear", per light ("light view" in photon modes
+//! 1 and 2) "caustic photons" and "caustic splat"; "caustic apply";
+//! "refraction" (glsl/passes/camera_refraction.comp).
 //! With `caustics_on_change` = 1 the caustic clear, photon and splat passes
 //! run only when a light moved (`set_lights`) or the geometry's animation
 //! time changed; other frames reuse the last caustic map.

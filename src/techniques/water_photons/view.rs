@@ -1,5 +1,5 @@
 //! "water view" (glsl/water_photons/view.comp): the camera's view of the
-//! water surface, recomputed after image_space's `CameraRefraction` on the
+//! water surface, recomputed after the surface frame's camera refraction on the
 //! pixels whose nearest specular surface is the traced water (one
 //! interface): the reflected and refracted camera rays traced through the
 //! BVH; a hit the camera sees directly takes the opaque frame's radiance
