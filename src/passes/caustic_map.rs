@@ -409,9 +409,8 @@ impl CausticMap {
     /// and the next light's photons wait for that splat.
     pub fn record(&self, rec: &mut FrameRecorder, scene: &SceneGpu) -> VkResult<()> {
         let views = self.views(scene.sphere);
-        // Host write while recording: the renderer waits for each frame
-        // before recording the next, so no earlier frame still reads it.
-        self.views.upload(bytemuck::cast_slice(&views))?;
+        // Through the frame's upload ring: earlier frames may still read the buffer.
+        rec.upload(&self.views, bytemuck::cast_slice(&views));
         let ctx = rec.ctx().clone();
         rec.pass("caustic map clear", |cmd| {
             barrier(

@@ -436,7 +436,8 @@ impl Technique for VolumeLines {
     ) -> crate::vk::VkResult<()> {
         self.image_space.record(rec, scene, targets)?;
         if self.bound_radiance != targets.radiance.view {
-            // Legal: the renderer waits for every frame before the next.
+            // A set may not be updated while a submitted frame can use it.
+            rec.wait_for_other_frames();
             self.set
                 .write_storage_image(b::VOLUME_LINES_BINDING_RADIANCE, &targets.radiance);
             self.bound_radiance = targets.radiance.view;
