@@ -271,6 +271,11 @@ impl Frames {
         self.slots.len()
     }
 
+    /// Frames submitted and not yet seen complete.
+    pub fn pending(&self) -> usize {
+        self.order.len()
+    }
+
     /// Starts the next frame: waits for the fence of the frame that last used
     /// its slot (N frames ago; the only host wait of the loop), then frees
     /// that frame's releases, resets its ring and command pool. Returns the
