@@ -59,6 +59,13 @@ fn run(technique: &str, scene: &str, size: u32, frames: u32, in_flight: usize) -
     }
 }
 
+fn max_difference(a: &[f32], b: &[f32]) -> f32 {
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f32::max)
+}
+
 /// `direct` writes each pixel once, from the frame's constants and geometry:
 /// the last image is bit-exact whatever the overlap.
 #[test]
@@ -67,14 +74,25 @@ fn direct_100_animated_frames_two_in_flight_match_one() {
     let one = run("direct", scene, 64, 100, 1);
     let two = run("direct", scene, 64, 100, 2);
     assert_eq!(one.most_pending, 1);
-    assert_eq!(two.most_pending, 2, "submit_frame must not wait for the frame");
+    assert_eq!(
+        two.most_pending, 2,
+        "submit_frame must not wait for the frame"
+    );
     assert!(
         one.first != one.last,
         "the spinning gem should change the image over 100 frames"
     );
     assert_eq!(one.first, two.first);
-    let differing = one.last.iter().zip(&two.last).filter(|(a, b)| a != b).count();
-    assert_eq!(differing, 0, "{differing} channels differ between 1 and 2 in flight");
+    let differing = one
+        .last
+        .iter()
+        .zip(&two.last)
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(
+        differing, 0,
+        "{differing} channels differ between 1 and 2 in flight"
+    );
 }
 
 /// `water_photons` appends photons with atomics, so their order in the
@@ -90,21 +108,17 @@ fn water_photons_10_animated_frames_two_in_flight_match_one() {
     let scene = "assets/scenes/water_pool.toml";
     let one = run("water_photons", scene, 32, 10, 1);
     let two = run("water_photons", scene, 32, 10, 2);
-    assert_eq!(two.most_pending, 2, "submit_frame must not wait for the frame");
+    assert_eq!(
+        two.most_pending, 2,
+        "submit_frame must not wait for the frame"
+    );
     assert!(one.first != one.last, "the waves should change the image");
     let peak = one.last.iter().fold(0f32, |m, v| m.max(v.abs()));
-    let worst = one
-        .last
-        .iter()
-        .zip(&two.last)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0f32, f32::max);
-    let moved = one
-        .first
-        .iter()
-        .zip(&one.last)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0f32, f32::max);
+    let worst = max_difference(&one.last, &two.last);
+    let moved = max_difference(&one.first, &one.last);
     println!("peak {peak}, worst |1 - 2 in flight| {worst}, worst |first - last| {moved}");
-    assert!(worst <= 1e-4 * peak, "worst difference {worst} of peak {peak}");
+    assert!(
+        worst <= 1e-4 * peak,
+        "worst difference {worst} of peak {peak}"
+    );
 }

@@ -95,16 +95,23 @@ pub enum Command {
     Info,
 }
 
+/// What `render` and `bench` run: a scene and a technique with its parameters.
+#[derive(Args)]
+pub struct TechniqueArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Technique name, or `list` (with `render`) to print them with their parameters.
+    #[arg(long, default_value = "direct")]
+    pub technique: String,
+    /// Technique parameter, NAME=VALUE (repeatable; `render --technique list` shows them).
+    #[arg(long = "param")]
+    pub params: Vec<String>,
+}
+
 #[derive(Args)]
 pub struct RenderArgs {
     #[command(flatten)]
-    pub scene: SceneArgs,
-    /// Technique name, or `list` to print them with their parameters.
-    #[arg(long, default_value = "direct")]
-    pub technique: String,
-    /// Technique parameter, NAME=VALUE (repeatable; `--technique list` shows them).
-    #[arg(long = "param")]
-    pub params: Vec<String>,
+    pub run: TechniqueArgs,
     /// Frames to render (time advances 1/60 s per frame); timings are averaged over them.
     #[arg(long, default_value_t = 1)]
     pub frames: u32,
@@ -163,11 +170,7 @@ pub struct ReferenceArgs {
 #[derive(Args)]
 pub struct BenchArgs {
     #[command(flatten)]
-    pub scene: SceneArgs,
-    #[arg(long, default_value = "direct")]
-    pub technique: String,
-    #[arg(long = "param")]
-    pub params: Vec<String>,
+    pub run: TechniqueArgs,
     #[arg(long, default_value_t = 20)]
     pub frames: u32,
     /// Frames rendered before timing starts (pipeline compilation, caches).
@@ -258,14 +261,10 @@ pub fn check_size(args: &SceneArgs) -> anyhow::Result<()> {
 
 /// What `render` and `bench` check before they touch the device: the
 /// technique and its parameters, the image size, the frame count, the scene.
-pub fn checked_technique_run(
-    scene: &SceneArgs,
-    technique: &str,
-    overrides: &[String],
-    frames: u32,
-) -> anyhow::Result<(Scene, Params)> {
+pub fn checked_technique_run(run: &TechniqueArgs, frames: u32) -> anyhow::Result<(Scene, Params)> {
+    let (scene, technique) = (&run.scene, run.technique.as_str());
     let info = techniques::find(technique)?;
-    let params = Params::resolve(technique, info.params(), overrides)?;
+    let params = Params::resolve(technique, info.params(), &run.params)?;
     check_size(scene)?;
     if frames == 0 {
         anyhow::bail!("--frames must be at least 1");

@@ -2,47 +2,40 @@
 //! N in flight (`--frames-in-flight`), waited for once at the end.
 
 use super::{
-    check_validation, checked_technique_run, context, write_outputs, BenchArgs, RenderArgs,
+    check_validation, checked_technique_run, context, write_outputs, BenchArgs, DeviceArgs,
+    RenderArgs, TechniqueArgs,
 };
 use anyhow::Context as _;
 use caustics::output;
+use caustics::params::Params;
 use caustics::renderer::Renderer;
+use caustics::scene::Scene;
 use caustics::techniques;
-use caustics::vk::{FrameTiming, PassTiming};
+use caustics::vk::{Context, FrameOptions, FrameTiming, PassTiming};
 use std::collections::BTreeMap;
+use std::sync::Arc;
 use std::time::Instant;
 
 pub fn render(args: RenderArgs) -> anyhow::Result<()> {
     let RenderArgs {
-        scene,
-        technique,
-        params,
+        run,
         frames,
         component,
         out,
         frame,
         device,
     } = args;
-    if technique == "list" {
+    if run.technique == "list" {
         super::info::list_techniques();
         return Ok(());
     }
     output::format_of(&out)?;
-    let (loaded, params) = checked_technique_run(&scene, &technique, &params, frames)?;
-    let components = techniques::find(&technique)?.component_mask(&component)?;
+    let (loaded, params) = checked_technique_run(&run, frames)?;
+    let components = techniques::find(&run.technique)?.component_mask(&component)?;
     let options = frame.options()?;
     let outputs = output::prepare(&out)?;
-    let ctx = context(&device)?;
-    let mut renderer = Renderer::new(
-        &ctx,
-        loaded,
-        &technique,
-        &params,
-        scene.width,
-        scene.height,
-        scene.time,
-    )?;
-    renderer.set_frame_options(options)?;
+    let (ctx, mut renderer) = start(&run, loaded, &params, options, &device)?;
+    let (scene, technique) = (&run.scene, &run.technique);
     renderer.scene_gpu.components = components;
     for i in 0..frames {
         renderer.submit_frame(scene.time + i as f32 / 60.0)?;
@@ -82,6 +75,29 @@ pub fn render(args: RenderArgs) -> anyhow::Result<()> {
     drop(renderer);
     check_validation(ctx)?;
     write_outputs(&outputs, scene.width, scene.height, &radiance, &display)
+}
+
+/// The device and a renderer for `run` with `options`' frames in flight.
+fn start(
+    run: &TechniqueArgs,
+    scene: Scene,
+    params: &Params,
+    options: FrameOptions,
+    device: &DeviceArgs,
+) -> anyhow::Result<(Arc<Context>, Renderer)> {
+    let ctx = context(device)?;
+    let s = &run.scene;
+    let mut renderer = Renderer::new(
+        &ctx,
+        scene,
+        &run.technique,
+        params,
+        s.width,
+        s.height,
+        s.time,
+    )?;
+    renderer.set_frame_options(options)?;
+    Ok((ctx, renderer))
 }
 
 /// Each pass's times over frames, in the order of the first frame (passes
@@ -124,28 +140,17 @@ struct PassStats {
 
 pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
     let BenchArgs {
-        scene,
-        technique,
-        params,
+        run,
         frames,
         warmup,
         json,
         frame,
         device,
     } = args;
-    let (loaded, params) = checked_technique_run(&scene, &technique, &params, frames)?;
+    let (loaded, params) = checked_technique_run(&run, frames)?;
     let options = frame.options()?;
-    let ctx = context(&device)?;
-    let mut renderer = Renderer::new(
-        &ctx,
-        loaded,
-        &technique,
-        &params,
-        scene.width,
-        scene.height,
-        scene.time,
-    )?;
-    renderer.set_frame_options(options)?;
+    let (ctx, mut renderer) = start(&run, loaded, &params, options, &device)?;
+    let (scene, technique) = (&run.scene, &run.technique);
     for i in 0..warmup {
         renderer.submit_frame(scene.time + i as f32 / 60.0)?;
     }

@@ -241,7 +241,7 @@ impl SceneGpu {
         time: f32,
         frame_index: u32,
     ) -> VkResult<()> {
-        let data = self.constants(scene, width, height, time, frame_index);
+        let data = self.constants(scene, (width, height), time, frame_index);
         self.frame.upload(bytemuck::bytes_of(&data))
     }
 
@@ -250,11 +250,11 @@ impl SceneGpu {
         &self,
         rec: &mut FrameRecorder,
         scene: &Scene,
-        (width, height): (u32, u32),
+        size: (u32, u32),
         time: f32,
         frame_index: u32,
     ) {
-        let data = self.constants(scene, width, height, time, frame_index);
+        let data = self.constants(scene, size, time, frame_index);
         rec.upload(&self.frame, bytemuck::bytes_of(&data));
     }
 
@@ -266,8 +266,7 @@ impl SceneGpu {
     fn constants(
         &self,
         scene: &Scene,
-        width: u32,
-        height: u32,
+        (width, height): (u32, u32),
         time: f32,
         frame_index: u32,
     ) -> GpuFrame {

@@ -17,10 +17,12 @@ use crate::vk::{
 use std::sync::Arc;
 
 pub struct Renderer {
+    /// First, so it drops first: `Frames::drop` waits for the frames in
+    /// flight before the scene, targets and technique they use go.
+    pub frames: Frames,
     pub ctx: Arc<Context>,
     pub scene: Scene,
     pub scene_gpu: SceneGpu,
-    pub frames: Frames,
     pub targets: FrameTargets,
     pub tonemap: Tonemap,
     technique: Box<dyn Technique>,

@@ -593,24 +593,8 @@ impl FrameRecorder<'_> {
         let index = self.slot;
         let slot = &mut self.frames.slots[index];
         unsafe { ctx.device.end_command_buffer(slot.cmd) }?;
-        let waits: Vec<_> = sync
-            .waits
-            .iter()
-            .map(|&(s, stage)| {
-                vk::SemaphoreSubmitInfo::default()
-                    .semaphore(s)
-                    .stage_mask(stage)
-            })
-            .collect();
-        let signals: Vec<_> = sync
-            .signals
-            .iter()
-            .map(|&(s, stage)| {
-                vk::SemaphoreSubmitInfo::default()
-                    .semaphore(s)
-                    .stage_mask(stage)
-            })
-            .collect();
+        let waits = semaphore_infos(&sync.waits);
+        let signals = semaphore_infos(&sync.signals);
         let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(slot.cmd)];
         let submit = vk::SubmitInfo2::default()
             .wait_semaphore_infos(&waits)
@@ -629,6 +613,18 @@ impl FrameRecorder<'_> {
             None => Ok(()),
         }
     }
+}
+
+fn semaphore_infos(
+    list: &[(vk::Semaphore, vk::PipelineStageFlags2)],
+) -> Vec<vk::SemaphoreSubmitInfo<'static>> {
+    list.iter()
+        .map(|&(s, stage)| {
+            vk::SemaphoreSubmitInfo::default()
+                .semaphore(s)
+                .stage_mask(stage)
+        })
+        .collect()
 }
 
 /// One frame at a time, waited for: tests, the reference, calibrations.
