@@ -27,7 +27,7 @@ $bin info | sed -n 1p  # sed reads everything: no broken pipe under pipefail
 
 if wants direct; then
   for size in 512 1024; do
-    $bin bench --scene assets/scenes/ball_lens.toml --technique direct --width $size --height $size \
+    $bin bench --pass-timing --scene assets/scenes/ball_lens.toml --technique direct --width $size --height $size \
       --frames ${FRAMES:-10} --warmup 2 --json out/bench/direct_ball_lens_$size.json
   done
 fi
@@ -41,7 +41,7 @@ fi
 
 if wants geometry; then
   for scene in assets/scenes/*.toml; do
-    $bin bench --scene "$scene" --technique direct --width 64 --height 64 --frames 1 --warmup 0 \
+    $bin bench --pass-timing --scene "$scene" --technique direct --width 64 --height 64 --frames 1 --warmup 0 \
       --json out/bench/geometry_$(basename "$scene" .toml).json > /dev/null
     python3 - "$scene" out/bench/geometry_$(basename "$scene" .toml).json <<'PY'
 import json, sys
@@ -59,7 +59,7 @@ if wants image_space; then
     for photons in 64 256 1024; do
       for map in 128 512; do
         json=out/bench/image_space_ball_lens_${size}_p${photons}_m${map}.json
-        $bin bench --scene assets/scenes/ball_lens.toml --technique image_space \
+        $bin bench --pass-timing --scene assets/scenes/ball_lens.toml --technique image_space \
           --param photon_buffer_size=$photons --param caustic_map_size=$map \
           --width $size --height $size --frames ${FRAMES:-10} --warmup 2 --json $json \
           > /dev/null 2> ${json%.json}.log || { cat ${json%.json}.log; exit 1; }
@@ -87,7 +87,7 @@ if wants volume_lines; then
   for buffer in 256 512 1024; do
     for size in 256 512 1024; do
       json=out/bench/volume_lines_volume_cone_b${buffer}_s${size}.json
-      $bin bench --scene assets/scenes/volume_cone.toml --technique volume_lines \
+      $bin bench --pass-timing --scene assets/scenes/volume_cone.toml --technique volume_lines \
         --param volume_buffer_size=$buffer --param photon_buffer_size=64 --param caustic_map_size=64 \
         --width $size --height $size --frames ${FRAMES:-10} --warmup 2 --json $json \
         > /dev/null 2> ${json%.json}.log || { cat ${json%.json}.log; exit 1; }
@@ -110,7 +110,7 @@ PY
   echo "| --- | ---: | ---: | ---: | ---: | ---: |"
   for scene in volume_cone smoke; do
     json=out/bench/volume_lines_stages_$scene.json
-    $bin bench --scene assets/scenes/$scene.toml --technique volume_lines \
+    $bin bench --pass-timing --scene assets/scenes/$scene.toml --technique volume_lines \
       --width 256 --height 256 --frames ${FRAMES:-10} --warmup 1 --json $json \
       > /dev/null 2> ${json%.json}.log || { cat ${json%.json}.log; exit 1; }
     python3 - $json $scene <<'PY'
@@ -136,7 +136,7 @@ if wants water_photons; then
     local scene=$1
     shift
     json=out/bench/water_photons_${scene}_c$1_n$2_s$3_d$4x$5.json
-    $bin bench --scene assets/scenes/$scene.toml --technique water_photons \
+    $bin bench --pass-timing --scene assets/scenes/$scene.toml --technique water_photons \
       --param ccm_size=$1 --param cascades=$2 --param splat_mode=$3 \
       --param denoise=$4 --param denoise_passes=$5 \
       --width 256 --height 256 --frames ${FRAMES:-10} --warmup 2 --json $json \

@@ -75,7 +75,6 @@ impl State {
         match Scene::load(&path) {
             Err(e) => eprintln!("reload: {e} (keeping the old scene)"),
             Ok(scene) => {
-                self.ctx().wait_idle();
                 let camera = OrbitCamera::from_camera(&scene.camera);
                 match self.renderer.set_scene(scene, self.time) {
                     Ok(()) => {
@@ -105,7 +104,6 @@ impl State {
             return Ok(());
         }
         let params = Params::resolve(info.name, info.params(), &[])?;
-        self.ctx().wait_idle();
         self.renderer.set_technique(info.name, &params)?;
         self.renderer.scene_gpu.components = Component::All.mask();
         println!("technique: {}", info.name);

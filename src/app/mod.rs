@@ -1,17 +1,19 @@
 //! The desktop demo (`caustics demo`): a winit window, a swapchain, and the
 //! existing `Renderer` behind it. docs/ARCHITECTURE.md ("The demo frame
-//! loop") describes the synchronisation; the short version:
+//! loop") describes the synchronisation; the short version, per frame:
 //!
-//! 1. wait for this frame slot's fence (its command buffer and acquire
-//!    semaphore are free again; at most `FRAMES_IN_FLIGHT` presentation
-//!    submissions are queued);
-//! 2. `Renderer::render_frame` renders technique + tonemap into
-//!    `tonemap.display` and waits for that work itself, so the host writes it
-//!    makes (frame uniform buffer, animated geometry) never race the GPU;
-//! 3. acquire a swapchain image, record the blit display -> swapchain image in
-//!    the slot's command buffer, submit it waiting on the acquire semaphore
-//!    and signalling the image's render-finished semaphore and the slot's fence;
-//! 4. present, waiting on that semaphore.
+//! 1. `Renderer::submit_frame_with` takes the next of the renderer's frame
+//!    slots (`vk::Frames`, `--frames-in-flight`, default 2) and waits for the
+//!    fence of the frame that last used it, the loop's only wait: its
+//!    command buffer, upload ring and acquire semaphore are free again;
+//! 2. it records technique + tonemap into the slot's command buffer (host
+//!    writes through the slot's upload ring), then the demo acquires a
+//!    swapchain image and records the blit display -> swapchain image (and
+//!    the overlay) into the same command buffer;
+//! 3. one submission waits on the acquire semaphore and signals the image's
+//!    render-finished semaphore and the slot's fence;
+//! 4. present, waiting on that semaphore. The host goes on to the next frame
+//!    while the GPU runs this one.
 
 mod camera;
 mod controls;
@@ -20,13 +22,13 @@ mod slots;
 mod state;
 
 pub use camera::OrbitCamera;
-use slots::{Frame, ImageSemaphores};
+use slots::ImageSemaphores;
 use state::{Input, State};
 
 use crate::params::Params;
 use crate::renderer::Renderer;
 use crate::scene::Scene;
-use crate::vk::{Context, ContextOptions, Surface, VkResult};
+use crate::vk::{Context, ContextOptions, FrameOptions, Surface};
 use anyhow::Context as _;
 use ash::vk;
 use std::collections::VecDeque;
@@ -41,9 +43,6 @@ use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::window::{Window, WindowId};
 
-/// Presentation submissions that may be queued at once.
-pub const FRAMES_IN_FLIGHT: usize = 2;
-
 #[derive(Clone, Debug)]
 pub struct DemoOptions {
     pub scene: PathBuf,
@@ -57,6 +56,8 @@ pub struct DemoOptions {
     pub exit: bool,
     pub resize_test: bool,
     pub validate: bool,
+    /// Frames the renderer keeps in flight (`vk::Frames`).
+    pub frames_in_flight: usize,
     /// Synchronization validation too (implies `validate`).
     pub validate_sync: bool,
     pub device: Option<String>,
@@ -157,19 +158,18 @@ impl App {
         let (w, h) = (size.width.max(1), size.height.max(1));
         let scene = self.scene.take().expect("scene");
         let camera = OrbitCamera::from_camera(&scene.camera);
-        let renderer = Renderer::new(&ctx, scene, &o.technique, &o.params, w, h, 0.0)?;
-        let frames = (0..FRAMES_IN_FLIGHT)
-            .map(|_| Frame::new(&ctx))
-            .collect::<VkResult<Vec<_>>>()?;
+        let mut renderer = Renderer::new(&ctx, scene, &o.technique, &o.params, w, h, 0.0)?;
+        renderer.set_frame_options(FrameOptions {
+            frames_in_flight: o.frames_in_flight,
+            ..FrameOptions::default()
+        })?;
         let now = Instant::now();
         let mut state = State {
-            frames,
             finished: ImageSemaphores::new(&ctx, 0)?,
             swapchain: None,
             renderer,
             surface,
             window,
-            current: 0,
             camera,
             input: Input::default(),
             time: 0.0,
@@ -186,6 +186,7 @@ impl App {
             overlay: None,
             report_at: now + Duration::from_secs(1),
             report_from: now,
+            waited_from: Duration::ZERO,
             screenshots: 0,
         };
         state.recreate(o.present_mode)?;

@@ -3,12 +3,11 @@
 
 use super::camera::OrbitCamera;
 use super::overlay::{Action, MediumValues, Overlay, UiData};
-use super::slots::{Frame, ImageSemaphores};
-use super::FRAMES_IN_FLIGHT;
+use super::slots::ImageSemaphores;
 use crate::renderer::Renderer;
 use crate::vk::{
-    barrier, begin_rendering, end_rendering, Access, Acquired, Context, ImageAccess, PassTiming,
-    Surface, Swapchain,
+    barrier, begin_rendering, end_rendering, Access, Acquired, Context, FrameSync, ImageAccess,
+    PassTiming, Surface, Swapchain,
 };
 use ash::vk;
 use std::collections::{HashSet, VecDeque};
@@ -26,10 +25,9 @@ pub(super) struct Input {
 }
 
 /// Everything that lives while the window is open. Fields drop in this
-/// order: frame slots and semaphores, swapchain, renderer, surface, window
-/// (the surface must go before the window it was made from).
+/// order: semaphores, swapchain, renderer (with its frame slots), surface,
+/// window (the surface must go before the window it was made from).
 pub(super) struct State {
-    pub(super) frames: Vec<Frame>,
     pub(super) finished: ImageSemaphores,
     /// Made with the first swapchain (it needs the swapchain's format).
     pub(super) overlay: Option<Overlay>,
@@ -37,7 +35,6 @@ pub(super) struct State {
     pub(super) renderer: Renderer,
     pub(super) surface: Surface,
     pub(super) window: Window,
-    pub(super) current: usize,
     pub(super) camera: OrbitCamera,
     pub(super) input: Input,
     pub(super) time: f32,
@@ -59,6 +56,8 @@ pub(super) struct State {
     pub(super) report_at: Instant,
     /// When the frames being averaged for the next report began.
     pub(super) report_from: Instant,
+    /// `Frames::host_wait` at `report_from`.
+    pub(super) waited_from: Duration,
     pub(super) screenshots: u32,
 }
 
@@ -148,34 +147,20 @@ impl State {
         self.apply_fly(dt);
         if self.lights_changed {
             self.lights_changed = false;
-            // The scene (lights) is re-uploaded: nothing may still read it.
-            self.ctx().wait_idle();
+            // Waits for the frames in flight, which read the lights.
             self.renderer.lights_changed(self.time)?;
         }
         if self.medium_changed {
             self.medium_changed = false;
-            self.ctx().wait_idle();
-            self.renderer
-                .scene_gpu
-                .update_medium(&self.renderer.scene)?;
+            self.renderer.medium_changed()?;
         }
         self.renderer.scene.camera = self.camera.camera();
 
         let ctx = self.ctx().clone();
-        let d = &ctx.device;
-        let frame = &self.frames[self.current];
-        // Wait until this slot's previous submission is done: its command
-        // buffer and acquire semaphore may then be reused. The renderer's
-        // host writes below (frame uniform buffer, animated geometry) do not
-        // need this wait: `render_frame` waits for its own GPU work before
-        // returning, and the presentation submissions only read the display
-        // image, never those buffers. Were `render_frame` made asynchronous,
-        // those buffers would have to become per frame slot.
-        unsafe { d.wait_for_fences(&[frame.fence], true, u64::MAX) }?;
-
         if self.overlay.is_none() {
             let format = self.swapchain.as_ref().expect("swapchain").format;
-            self.overlay = Some(Overlay::new(&ctx, &self.window, format, FRAMES_IN_FLIGHT)?);
+            let n = self.renderer.frames.frames_in_flight();
+            self.overlay = Some(Overlay::new(&ctx, &self.window, format, n)?);
         }
         let overlay = self.overlay.as_mut().expect("overlay");
         let history: Vec<f32> = self.history_ms.iter().copied().collect();
@@ -221,7 +206,8 @@ impl State {
                     }
                 }
                 Action::Params(params) => {
-                    ctx.wait_idle();
+                    // No wait: a rebuilt technique's predecessor is released
+                    // after the frames in flight that use it.
                     let start = Instant::now();
                     let how = match self.renderer.set_params(&params)? {
                         true => "rebuilt",
@@ -234,81 +220,75 @@ impl State {
                 }
             }
         }
-        let frame = &self.frames[self.current];
 
         let start = Instant::now();
-        let timings = self.renderer.render_frame(self.time)?;
-
         let swapchain = self.swapchain.as_ref().expect("swapchain");
-        let index = match swapchain.acquire(frame.acquired)? {
-            Acquired::Image { index, suboptimal } => {
-                self.stale |= suboptimal;
-                index
-            }
-            Acquired::OutOfDate => {
-                self.stale = true;
-                return Ok(false);
-            }
-        };
-        // Reset only once an image is acquired: an early return above leaves
-        // the fence signalled, so the next wait on it cannot deadlock.
-        unsafe {
-            d.reset_fences(&[frame.fence])?;
-            d.reset_command_pool(frame.pool, vk::CommandPoolResetFlags::empty())?;
-            d.begin_command_buffer(
-                frame.cmd,
-                &vk::CommandBufferBeginInfo::default()
-                    .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-            )?;
-        }
-        let display = &self.renderer.tonemap.display;
-        // The tonemap's compute writes -> transfer read. The next frame's
-        // tonemap pass (a later submission) orders its write after this read
-        // through the display image's tracked state (write-after-read).
-        barrier(
-            &ctx,
-            frame.cmd,
-            &[ImageAccess::new(display, Access::TransferRead)],
-            &[],
-        );
         let overlay = self.overlay.as_mut().expect("overlay");
-        let draw_overlay = overlay.visible();
-        swapchain.blit_to_image(
-            frame.cmd,
-            index,
-            display.raw,
-            display.extent(),
-            draw_overlay,
-        );
-        if draw_overlay {
-            let view = swapchain.views[index as usize];
-            begin_rendering(&ctx, frame.cmd, swapchain.extent, &[(view, None)], None);
-            let drawn = overlay.record(frame.cmd, swapchain.extent);
-            end_rendering(&ctx, frame.cmd);
-            swapchain.attachment_to_present(frame.cmd, index);
-            drawn?;
+        let finished = &self.finished;
+        let stale = &mut self.stale;
+        let mut presented = None;
+        // One command buffer per frame: technique, tonemap, then the blit
+        // (and overlay) to the acquired image. `submit_frame_with` first waits
+        // for the fence of the frame that last used this slot, which frees
+        // its command buffer, ring and acquire semaphore; it does not wait
+        // for this frame.
+        self.renderer.submit_frame_with(
+            self.time,
+            |rec, display| -> anyhow::Result<FrameSync> {
+                let acquired = rec.acquire_semaphore();
+                let index = match swapchain.acquire(acquired)? {
+                    Acquired::Image { index, suboptimal } => {
+                        *stale |= suboptimal;
+                        index
+                    }
+                    Acquired::OutOfDate => {
+                        // The frame is still submitted (its fence must
+                        // signal), with nothing to present.
+                        *stale = true;
+                        return Ok(FrameSync::default());
+                    }
+                };
+                let cmd = rec.cmd();
+                // The tonemap's compute writes -> transfer read. The next frame's
+                // tonemap pass orders its write after this read through the
+                // display image's tracked state (write-after-read).
+                barrier(
+                    &ctx,
+                    cmd,
+                    &[ImageAccess::new(display, Access::TransferRead)],
+                    &[],
+                );
+                let draw_overlay = overlay.visible();
+                swapchain.blit_to_image(cmd, index, display.raw, display.extent(), draw_overlay);
+                if draw_overlay {
+                    let view = swapchain.views[index as usize];
+                    begin_rendering(&ctx, cmd, swapchain.extent, &[(view, None)], None);
+                    let drawn = overlay.record(cmd, swapchain.extent);
+                    end_rendering(&ctx, cmd);
+                    swapchain.attachment_to_present(cmd, index);
+                    drawn?;
+                }
+                presented = Some(index);
+                Ok(FrameSync {
+                    waits: vec![(acquired, vk::PipelineStageFlags2::ALL_TRANSFER)],
+                    signals: vec![(
+                        finished.raw[index as usize],
+                        vk::PipelineStageFlags2::ALL_COMMANDS,
+                    )],
+                })
+            },
+        )?;
+        for done in self.renderer.take_timings() {
+            self.last_timings.clone_from(&done.passes);
+            self.timings.push(done.passes);
         }
-        unsafe { d.end_command_buffer(frame.cmd) }?;
-        let finished = self.finished.raw[index as usize];
-        let waits = [vk::SemaphoreSubmitInfo::default()
-            .semaphore(frame.acquired)
-            .stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)];
-        let signals = [vk::SemaphoreSubmitInfo::default()
-            .semaphore(finished)
-            .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
-        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(frame.cmd)];
-        let submit = vk::SubmitInfo2::default()
-            .wait_semaphore_infos(&waits)
-            .command_buffer_infos(&cmds)
-            .signal_semaphore_infos(&signals);
-        unsafe { d.queue_submit2(ctx.queue, &[submit], frame.fence) }?;
-        self.stale |= swapchain.present(index, finished)?;
-        self.current = (self.current + 1) % FRAMES_IN_FLIGHT;
+        let Some(index) = presented else {
+            return Ok(false);
+        };
+        let swapchain = self.swapchain.as_ref().expect("swapchain");
+        self.stale |= swapchain.present(index, self.finished.raw[index as usize])?;
         self.presented += 1;
-
         self.frame_ms.push(start.elapsed().as_secs_f64() * 1e3);
-        self.last_timings.clone_from(&timings);
-        self.timings.push(timings);
         if Instant::now() >= self.report_at {
             self.report();
         }
@@ -325,6 +305,10 @@ impl State {
         // Frame interval: everything, fence waits and event handling included.
         let interval_ms = (now - self.report_from).as_secs_f64() * 1e3 / n;
         self.report_from = now;
+        // Host time blocked on fences (frame slots and waits for edits).
+        let waited = self.renderer.frames.host_wait;
+        let wait_ms = (waited - self.waited_from).as_secs_f64() * 1e3 / n;
+        self.waited_from = waited;
         let mut passes: Vec<(String, f64, usize)> = Vec::new();
         for t in self.timings.iter().flatten() {
             match passes.iter_mut().find(|p| p.0 == t.name) {
@@ -337,14 +321,16 @@ impl State {
         }
         let r = &self.renderer;
         println!(
-            "{} {}x{}: {:.2} ms/frame render+present, {:.2} ms frame interval, over {} frame(s) ({})",
+            "{} {}x{}: {:.2} ms/frame render+present, {:.2} ms frame interval, {:.2} ms/frame host wait, over {} frame(s), {} in flight ({})",
             r.technique_name(),
             r.targets.width,
             r.targets.height,
             frame_ms,
             interval_ms,
+            wait_ms,
             self.frame_ms.len(),
-            r.profiler.source.describe()
+            r.frames.frames_in_flight(),
+            r.frames.source.describe()
         );
         for (name, sum, count) in &passes {
             println!("  {:<28} {:>9.3} ms", name, sum / *count as f64);

@@ -8,9 +8,11 @@ use crate::radiometry::Component;
 use crate::scene::{Camera, Density, MaterialKind, Scene, Triangle};
 use crate::shader_bindings as b;
 use crate::vk::{
-    BindingKind, Buffer, BufferUsage, Context, DescriptorSet, DescriptorSetLayout, VkResult,
+    BindingKind, Buffer, BufferUsage, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder,
+    VkResult,
 };
 use glam::{Mat4, Vec3};
+use std::cell::Cell;
 use std::sync::Arc;
 
 /// Statistics of the uploaded geometry (printed by `render`, recorded in BENCHMARKS.md).
@@ -30,7 +32,11 @@ pub struct SceneGpu {
     pub lights: Buffer,
     pub medium: Buffer,
     pub density_grid: Buffer,
+    /// The frame constants (device-local; written by a copy in each frame's
+    /// command buffer, so frames in flight never share host-written memory).
     pub frame: Buffer,
+    /// The host's copy of the constants last written (`upload_frame`).
+    frame_constants: Cell<GpuFrame>,
     pub layout: DescriptorSetLayout,
     pub set: DescriptorSet,
     pub stats: GeometryStats,
@@ -160,6 +166,7 @@ impl SceneGpu {
             medium: medium_buf,
             density_grid: grid_buf,
             frame: frame_buf,
+            frame_constants: Cell::new(bytemuck::Zeroable::zeroed()),
             layout,
             set,
             stats,
@@ -185,9 +192,11 @@ impl SceneGpu {
         &self.bvh
     }
 
-    /// Re-uploads moved triangles and refits the BVH (animated scenes). The
-    /// caller has waited for every frame that read the old geometry.
-    pub fn update_geometry(&mut self, scene: &Scene, time: f32) -> VkResult<()> {
+    /// Refits the BVH to the triangles at `time` (animated scenes) and
+    /// writes both through this frame's upload ring: earlier frames in
+    /// flight still read the old geometry, which the frame's copy replaces
+    /// only after their reads (queue order and the copy's barrier).
+    pub fn update_geometry(&mut self, rec: &mut FrameRecorder, scene: &Scene, time: f32) {
         let triangles = scene.triangles(time);
         self.bvh.refit(&triangles);
         // d_N is kept from the upload: the `animate` motions are rigid, which
@@ -197,13 +206,10 @@ impl SceneGpu {
         for (t, d) in gpu_triangles.iter_mut().zip(&self.normal_thickness) {
             (t.n0[3], t.n1[3], t.n2[3]) = (d[0], d[1], d[2]);
         }
-        self.triangles
-            .upload(bytemuck::cast_slice(&gpu_triangles))?;
-        self.bvh_nodes
-            .upload(bytemuck::cast_slice(&self.bvh.nodes))?;
+        rec.upload(&self.triangles, bytemuck::cast_slice(&gpu_triangles));
+        rec.upload(&self.bvh_nodes, bytemuck::cast_slice(&self.bvh.nodes));
         self.sphere = scene.bounding_sphere(time);
         self.geometry_time = time;
-        Ok(())
     }
 
     /// Re-uploads moved lights (same count). The caller has waited for every
@@ -225,7 +231,8 @@ impl SceneGpu {
         self.medium.upload(bytemuck::bytes_of(&medium))
     }
 
-    /// Writes the per-frame constants for an image of `width` x `height`.
+    /// Writes the per-frame constants for an image of `width` x `height`
+    /// now, waiting for the copy (tests and the reference, between frames).
     pub fn update_frame(
         &self,
         scene: &Scene,
@@ -234,6 +241,35 @@ impl SceneGpu {
         time: f32,
         frame_index: u32,
     ) -> VkResult<()> {
+        let data = self.constants(scene, (width, height), time, frame_index);
+        self.frame.upload(bytemuck::bytes_of(&data))
+    }
+
+    /// Writes this frame's constants through its upload ring.
+    pub fn upload_frame(
+        &self,
+        rec: &mut FrameRecorder,
+        scene: &Scene,
+        size: (u32, u32),
+        time: f32,
+        frame_index: u32,
+    ) {
+        let data = self.constants(scene, size, time, frame_index);
+        rec.upload(&self.frame, bytemuck::bytes_of(&data));
+    }
+
+    /// The constants last written, as the host computed them.
+    pub fn frame_constants(&self) -> GpuFrame {
+        self.frame_constants.get()
+    }
+
+    fn constants(
+        &self,
+        scene: &Scene,
+        (width, height): (u32, u32),
+        time: f32,
+        frame_index: u32,
+    ) -> GpuFrame {
         let aspect = width as f32 / height as f32;
         let (view, proj) = camera_matrices(&scene.camera, aspect);
         let view_proj = proj * view;
@@ -257,6 +293,7 @@ impl SceneGpu {
             ],
             components: [self.components, 0, 0, 0],
         };
-        self.frame.upload(bytemuck::bytes_of(&data))
+        self.frame_constants.set(data);
+        data
     }
 }

@@ -138,8 +138,8 @@ impl Airlight {
         out: &Image,
     ) {
         if self.bound_out != out.view {
-            // Updating a set is only legal while no pending command buffer
-            // uses it: the renderer waits for every frame before the next.
+            // A set may not be updated while a submitted frame can use it.
+            rec.wait_for_other_frames();
             self.set
                 .write_storage_image(b::AIRLIGHT_BINDING_RADIANCE, out);
             self.bound_out = out.view;

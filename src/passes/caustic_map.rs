@@ -449,9 +449,8 @@ impl CausticMap {
         light_views: &LightViews,
     ) -> VkResult<()> {
         let views = self.views(light_views.lights(), scene.sphere);
-        // Host write while recording: the renderer waits for each frame
-        // before recording the next, so no earlier frame still reads it.
-        self.views.upload(bytemuck::cast_slice(&views))?;
+        // Through the frame's upload ring: earlier frames may still read the buffer.
+        rec.upload(&self.views, bytemuck::cast_slice(&views));
         self.frame_views = views;
         self.geometry_time = Some(scene.geometry_time);
         let ctx = rec.ctx().clone();

@@ -168,8 +168,8 @@ impl DirectLight {
         targets: &FrameTargets,
     ) -> VkResult<()> {
         if self.bound_radiance != targets.radiance.view {
-            // Updating a set is only legal while no pending command buffer
-            // uses it: the renderer waits for every frame before the next.
+            // A set may not be updated while a submitted frame can use it.
+            rec.wait_for_other_frames();
             self.set
                 .write_storage_image(b::DIRECT_BINDING_RADIANCE, &targets.radiance);
             self.bound_radiance = targets.radiance.view;

@@ -273,11 +273,8 @@ impl ShadowMaps {
     /// Records the pass "shadow maps": every view of every light.
     pub fn record(&self, rec: &mut FrameRecorder, scene: &SceneGpu) -> VkResult<()> {
         let views = self.views(scene.sphere);
-        // Host write of the uniform buffer while recording: safe because the
-        // renderer waits for each frame's fence before recording the next, so
-        // no earlier frame still reads it; the queue submission makes host
-        // writes visible to the device.
-        self.lights.upload(bytemuck::cast_slice(&views))?;
+        // Through the frame's upload ring: earlier frames may still read the buffer.
+        rec.upload(&self.lights, bytemuck::cast_slice(&views));
         let ctx = rec.ctx().clone();
         rec.pass("shadow maps", |cmd| {
             // Every used layer is cleared and redrawn: discard the contents,

@@ -1,24 +1,35 @@
 //! Frame orchestration: technique selection, tonemapping, profiling and
-//! output, over the scene and targets of `crate::frame`. `render` and `bench` run frames through here.
+//! output, over the scene and targets of `crate::frame`. `render`, `bench`
+//! and the demo run frames through here, with `vk::Frames` keeping N frames
+//! in flight: `submit_frame` does not wait for the GPU, `finish` waits for
+//! every frame in flight, and whatever a replaced technique, scene or set
+//! of targets held is released after the fences of the frames that used it.
 
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::params::{Apply, Params};
 use crate::passes::tonemap::Tonemap;
 use crate::scene::Scene;
 use crate::techniques::{self, Technique};
-use crate::vk::{Context, PassTiming, Profiler, VkResult};
+use crate::vk::{
+    Context, FrameOptions, FrameRecorder, FrameSync, FrameTiming, Frames, Image, PassTiming,
+    VkError, VkResult,
+};
 use std::sync::Arc;
 
 pub struct Renderer {
+    /// First, so it drops first: `Frames::drop` waits for the frames in
+    /// flight before the scene, targets and technique they use go.
+    pub frames: Frames,
     pub ctx: Arc<Context>,
     pub scene: Scene,
     pub scene_gpu: SceneGpu,
-    pub profiler: Profiler,
     pub targets: FrameTargets,
     pub tonemap: Tonemap,
     technique: Box<dyn Technique>,
     params: Params,
     frame_index: u32,
+    /// Completed frames whose timings nobody has taken yet.
+    completed: Vec<FrameTiming>,
 }
 
 impl Renderer {
@@ -40,27 +51,36 @@ impl Renderer {
             ctx: ctx.clone(),
             scene,
             scene_gpu,
-            profiler: Profiler::new(ctx, 64)?,
+            frames: Frames::new(ctx, FrameOptions::default())?,
             targets,
             tonemap,
             technique,
             params: params.clone(),
             frame_index: 0,
+            completed: Vec::new(),
         })
     }
 
+    /// Frames in flight and timing mode (waits for the frames in flight first).
+    pub fn set_frame_options(&mut self, options: FrameOptions) -> VkResult<()> {
+        self.finish()?;
+        self.frames = Frames::new(&self.ctx, options)?;
+        Ok(())
+    }
+
     /// Rebuilds the frame targets, the tonemap and the technique at a new
-    /// size (the demo's window resize). The caller has waited for every frame
-    /// that used the old ones.
+    /// size (the demo's window resize). The old ones are released after the
+    /// frames in flight that use them.
     pub fn resize(&mut self, width: u32, height: u32) -> anyhow::Result<()> {
         let name = self.technique.name();
-        // Drop the old technique and targets before making the new ones, so
-        // peak memory holds one set.
-        self.technique = Box::new(NoTechnique);
+        let old = std::mem::replace(&mut self.technique, Box::new(NoTechnique));
+        self.frames.defer_release(old);
         let targets = FrameTargets::new(&self.ctx, width, height)?;
         let tonemap = Tonemap::new(&self.ctx, &targets.radiance)?;
-        self.tonemap = tonemap;
-        self.targets = targets;
+        let old_tonemap = std::mem::replace(&mut self.tonemap, tonemap);
+        self.frames.defer_release(old_tonemap);
+        let old_targets = std::mem::replace(&mut self.targets, targets);
+        self.frames.defer_release(old_targets);
         self.set_technique(name, &self.params.clone())
     }
 
@@ -75,7 +95,8 @@ impl Renderer {
             self.targets.width,
             self.targets.height,
         )?;
-        self.technique = technique;
+        let old = std::mem::replace(&mut self.technique, technique);
+        self.frames.defer_release(old);
         self.params = params.clone();
         Ok(())
     }
@@ -84,8 +105,9 @@ impl Renderer {
     /// parameter is live (`params::Apply::Live`) and the technique takes
     /// them in place (`Technique::update_live`), nothing is rebuilt;
     /// otherwise the technique is rebuilt (keeping the current one on
-    /// error). Returns whether it was rebuilt. The caller has waited for
-    /// every frame in flight.
+    /// error; the old one is released after the frames in flight). Returns
+    /// whether it was rebuilt. Live values are read at record time, so
+    /// frames in flight keep theirs.
     pub fn set_params(&mut self, params: &Params) -> anyhow::Result<bool> {
         let specs = self.technique_info().params();
         let live = self.params.changed(params).all(|name| {
@@ -103,8 +125,8 @@ impl Renderer {
 
     /// Replaces the scene (reload from disk, or a light moved): re-uploads it
     /// and rebuilds the technique, whose resources (shadow maps) depend on
-    /// the lights. On error the old scene stays. The caller has waited for
-    /// every frame that used the old scene.
+    /// the lights. On error the old scene stays; the old one is released
+    /// after the frames in flight.
     pub fn set_scene(&mut self, scene: Scene, time: f32) -> anyhow::Result<()> {
         let mut scene_gpu = SceneGpu::new(&self.ctx, &scene, time)?;
         scene_gpu.components = self.scene_gpu.components;
@@ -117,16 +139,20 @@ impl Renderer {
             self.targets.width,
             self.targets.height,
         )?;
-        self.technique = technique;
-        self.scene_gpu = scene_gpu;
+        let old = std::mem::replace(&mut self.technique, technique);
+        self.frames.defer_release(old);
+        let old = std::mem::replace(&mut self.scene_gpu, scene_gpu);
+        self.frames.defer_release(old);
         self.scene = scene;
         Ok(())
     }
 
     /// `scene.lights` were edited in place (the demo moves a light): updates
     /// the GPU copy and the technique, rebuilding the technique only if it
-    /// cannot take the change. The caller has waited for every frame in flight.
+    /// cannot take the change. Waits for the frames in flight (they read
+    /// the lights buffer this rewrites); a user's edit, not every frame.
     pub fn lights_changed(&mut self, time: f32) -> anyhow::Result<()> {
+        self.finish()?;
         if self.technique.set_lights(&self.scene.lights) {
             self.scene_gpu.update_lights(&self.scene)?;
             Ok(())
@@ -148,33 +174,79 @@ impl Renderer {
         techniques::find(self.technique.name()).expect("a built technique is listed")
     }
 
-    /// Renders one frame at animation time `time` and waits for it; returns
-    /// each pass's time.
-    pub fn render_frame(&mut self, time: f32) -> VkResult<Vec<PassTiming>> {
-        if self.scene.is_animated() {
-            self.scene_gpu.update_geometry(&self.scene, time)?;
+    /// `scene.medium` was edited in place (same density kind): re-uploads
+    /// it, after the frames in flight that read it.
+    pub fn medium_changed(&mut self) -> VkResult<()> {
+        self.finish()?;
+        self.scene_gpu.update_medium(&self.scene)
+    }
+
+    /// Records and submits one frame at animation time `time` without
+    /// waiting for it. `present` records what follows the tonemap into the
+    /// same command buffer (the demo's blit to the swapchain) and names the
+    /// semaphores the submission waits on and signals. Timings of frames
+    /// that completed meanwhile are kept for `take_timings`.
+    pub fn submit_frame_with<E: From<VkError>>(
+        &mut self,
+        time: f32,
+        present: impl FnOnce(&mut FrameRecorder, &Image) -> Result<FrameSync, E>,
+    ) -> Result<(), E> {
+        let (mut rec, done) = self.frames.begin_frame()?;
+        if let Some(done) = done {
+            // Its fence has signalled: its read-backs are current.
+            self.technique.after_frame(done.slot)?;
+            self.completed.push(done);
         }
-        self.scene_gpu.update_frame(
-            &self.scene,
-            self.targets.width,
-            self.targets.height,
-            time,
-            self.frame_index,
-        )?;
+        if self.scene.is_animated() {
+            self.scene_gpu.update_geometry(&mut rec, &self.scene, time);
+        }
+        let size = (self.targets.width, self.targets.height);
+        self.scene_gpu
+            .upload_frame(&mut rec, &self.scene, size, time, self.frame_index);
         self.frame_index = self.frame_index.wrapping_add(1);
-        let technique = &mut self.technique;
-        let scene_gpu = &self.scene_gpu;
-        let targets = &self.targets;
-        let tonemap = &self.tonemap;
-        let exposure = self.scene.output.exposure;
-        let timings = self.profiler.frame(|rec| {
-            technique.record(rec, scene_gpu, targets)?;
-            tonemap.record(rec, &targets.radiance, exposure);
-            Ok(())
-        })?;
-        // The frame has completed: the technique's read-backs are current.
-        self.technique.after_frame()?;
-        Ok(timings)
+        let recorded = self
+            .technique
+            .record(&mut rec, &self.scene_gpu, &self.targets)
+            .map(|()| {
+                self.tonemap
+                    .record(&mut rec, &self.targets.radiance, self.scene.output.exposure)
+            });
+        let sync = match recorded {
+            Ok(()) => present(&mut rec, &self.tonemap.display),
+            Err(e) => Err(E::from(e)),
+        };
+        // Submitted even after an error: the slot's fence must signal.
+        let none = FrameSync::default();
+        let submitted = rec.submit(sync.as_ref().unwrap_or(&none));
+        sync?;
+        Ok(submitted?)
+    }
+
+    /// `submit_frame_with` for headless frames.
+    pub fn submit_frame(&mut self, time: f32) -> VkResult<()> {
+        self.submit_frame_with(time, |_, _| Ok(FrameSync::default()))
+    }
+
+    /// Waits for every frame in flight; returns the timings of all frames
+    /// completed since the last `take_timings`, oldest first.
+    pub fn finish(&mut self) -> VkResult<Vec<FrameTiming>> {
+        for done in self.frames.wait_all()? {
+            self.technique.after_frame(done.slot)?;
+            self.completed.push(done);
+        }
+        Ok(self.take_timings())
+    }
+
+    /// Timings of the frames completed so far and not yet taken, oldest first.
+    pub fn take_timings(&mut self) -> Vec<FrameTiming> {
+        std::mem::take(&mut self.completed)
+    }
+
+    /// Renders one frame at animation time `time` and waits for it (and any
+    /// other frame in flight); returns each pass's time.
+    pub fn render_frame(&mut self, time: f32) -> VkResult<Vec<PassTiming>> {
+        self.submit_frame(time)?;
+        Ok(self.finish()?.pop().map(|t| t.passes).unwrap_or_default())
     }
 
     /// The technique's counts of the last frame (`Technique::counters`).
@@ -182,7 +254,8 @@ impl Renderer {
         self.technique.counters()
     }
 
-    /// The last frame's radiance, RGBA f32 per pixel, rows top to bottom.
+    /// The last frame's radiance, RGBA f32 per pixel, rows top to bottom
+    /// (the copy is queued after the frames in flight and ordered after them).
     pub fn radiance(&self) -> VkResult<Vec<f32>> {
         self.targets.radiance.download_rgba32f()
     }
@@ -202,7 +275,7 @@ impl Technique for NoTechnique {
     }
     fn record(
         &mut self,
-        _rec: &mut crate::vk::FrameRecorder,
+        _rec: &mut FrameRecorder,
         _scene: &SceneGpu,
         _targets: &FrameTargets,
     ) -> VkResult<()> {

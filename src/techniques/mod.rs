@@ -40,10 +40,11 @@ pub trait Technique {
         Ok(false)
     }
 
-    /// Called once the frame recorded by `record` has completed (after the
-    /// renderer's fence wait): host-visible results of that frame are
-    /// current, so this is where a technique reads them back and reports.
-    fn after_frame(&mut self) -> VkResult<()> {
+    /// Called once a frame recorded by `record` has completed (its fence
+    /// has signalled), with the slot it ran in (`FrameRecorder::slot`):
+    /// host-visible results written per slot are that frame's, so this is
+    /// where a technique reads them back and reports. Frames complete in order.
+    fn after_frame(&mut self, _slot: usize) -> VkResult<()> {
         Ok(())
     }
 

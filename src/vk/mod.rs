@@ -5,24 +5,28 @@
 //!
 //! Lifetime model: every object is owned by a Rust value and destroyed by its
 //! `Drop`. Values hold an `Arc` of the device, so the device outlives them.
-//! The renderer waits for the frame's fence before it drops anything that
-//! frame used, so `Drop` never frees what the GPU may still read.
+//! Whatever a frame in flight may still use is handed to
+//! `Frames::defer_release` and dropped after that frame's fence
+//! (`vk/frame.rs`), so `Drop` never frees what the GPU may still read.
 
 mod context;
 mod device;
+mod frame;
 mod pipeline;
-mod profiler;
 mod resources;
 mod swapchain;
 mod sync;
 
 pub use context::{Context, ContextOptions, ValidationCounts};
 pub use device::{DeviceInfo, RequiredFeature};
+pub use frame::{
+    FrameOptions, FrameRecorder, FrameSync, FrameTiming, Frames, PassTiming, Profiler,
+    TimingSource, MAX_FRAMES_IN_FLIGHT,
+};
 pub use pipeline::{
     begin_rendering, begin_rendering_with_depth, end_rendering, BindingKind, ComputePipeline,
     DescriptorSet, DescriptorSetLayout, GraphicsPipeline, GraphicsPipelineDesc, Sampler,
 };
-pub use profiler::{FrameRecorder, PassTiming, Profiler, TimingSource};
 pub use resources::{Buffer, BufferUsage, Image, ImageDesc};
 pub use swapchain::{Acquired, Surface, Swapchain};
 pub use sync::{barrier, copy_image, Access, BufferAccess, ImageAccess};

@@ -17,7 +17,8 @@ pub enum BufferUsage {
     Storage,
     /// Device-local storage buffer that is also read as indirect-draw arguments.
     StorageIndirect,
-    /// Host-visible uniform buffer, written by the CPU every frame.
+    /// Device-local uniform buffer, written per frame through
+    /// `FrameRecorder::upload` (the frame's ring and a copy).
     Uniform,
     /// Host-visible buffer the GPU copies into for the CPU to read.
     Readback,
@@ -50,8 +51,8 @@ impl Buffer {
                 MemoryLocation::GpuOnly,
             ),
             BufferUsage::Uniform => (
-                vk::BufferUsageFlags::UNIFORM_BUFFER,
-                MemoryLocation::CpuToGpu,
+                vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuOnly,
             ),
             BufferUsage::Readback => (vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu),
             BufferUsage::Upload => (vk::BufferUsageFlags::TRANSFER_SRC, MemoryLocation::CpuToGpu),
@@ -147,6 +148,17 @@ impl Buffer {
             );
         })?;
         Ok(())
+    }
+
+    /// Writes `bytes` at `offset` of a host-visible buffer (the upload ring;
+    /// the caller knows the GPU is not reading that range).
+    pub(super) fn write_at(&self, offset: u64, bytes: &[u8]) {
+        let dst = self.mapped().expect("a host-visible buffer");
+        assert!(offset + bytes.len() as u64 <= self.size);
+        // SAFETY: in bounds (asserted) and host-coherent (gpu-allocator CpuToGpu).
+        unsafe {
+            std::ptr::copy_nonoverlapping(bytes.as_ptr(), dst.add(offset as usize), bytes.len())
+        };
     }
 
     /// Reads the whole buffer back to the host (blocking).

@@ -271,7 +271,8 @@ impl VolumeRays {
         targets: &FrameTargets,
     ) {
         if self.bound_radiance != targets.radiance.view {
-            // Legal: the renderer waits for every frame before the next.
+            // A set may not be updated while a submitted frame can use it.
+            rec.wait_for_other_frames();
             self.set
                 .write_storage_image(bindings::VOLUME_LINES_BINDING_RADIANCE, &targets.radiance);
             self.bound_radiance = targets.radiance.view;

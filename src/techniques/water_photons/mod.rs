@@ -400,9 +400,10 @@ impl WaterPhotons {
         p.water = water_uniform(&self.water);
     }
 
-    /// Photons written and requested in the last frame.
+    /// Photons written and requested in the last frame recorded, once it
+    /// has completed.
     pub fn photon_counts(&self) -> VkResult<PhotonCounts> {
-        self.trace.counts()
+        self.trace.counts(self.trace.last_slot.get())
     }
 }
 
@@ -441,20 +442,19 @@ impl Technique for WaterPhotons {
         scene: &SceneGpu,
         targets: &FrameTargets,
     ) -> VkResult<()> {
-        // Eq. 1 follows the camera: the frame constants (host-visible,
-        // written before recording) hold this frame's eye.
-        let constants: Vec<GpuFrame> = scene.frame.download_pod()?;
-        let eye = Vec3::from_slice(&constants[0].eye[..3]);
+        // Eq. 1 follows the camera: this frame's constants hold its eye.
+        let constants: GpuFrame = scene.frame_constants();
+        let eye = Vec3::from_slice(&constants.eye[..3]);
         // View space looks down -z: the camera's forward is -(third row of the view).
-        let view = Mat4::from_cols_array_2d(&constants[0].view);
+        let view = Mat4::from_cols_array_2d(&constants.view);
         let forward = -view.row(2).truncate();
         if eye != self.camera_origin {
             self.camera_origin = eye;
             let light = self.light;
             self.set_light(&light);
         }
-        // Host write while recording: no earlier frame is still in flight.
-        self.params.0.upload(bytemuck::bytes_of(&self.gpu_params))?;
+        // Through the frame's upload ring: earlier frames may still read the buffer.
+        rec.upload(&self.params.0, bytemuck::bytes_of(&self.gpu_params));
         self.surface.record_opaque(rec, scene)?;
         let view_projs: Vec<Mat4> = (0..self.frame.layout.levels)
             .map(|c| self.frame.view_proj(c))
@@ -503,8 +503,8 @@ impl Technique for WaterPhotons {
     /// The frame's photon counts (copied to the host by "photon trace"),
     /// read once the frame has completed: overflow is reported for the
     /// frame that overflowed, the last one included.
-    fn after_frame(&mut self) -> VkResult<()> {
-        let counts = self.trace.counts()?;
+    fn after_frame(&mut self, slot: usize) -> VkResult<()> {
+        let counts = self.trace.counts(slot)?;
         if counts.overflow() > 0 {
             log::warn!(
                 "water_photons: {} of {} photons did not fit the buffer of {} (raise photon_capacity)",

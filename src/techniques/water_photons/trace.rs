@@ -16,6 +16,7 @@ use super::bindings;
 use crate::vk::{
     barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline, Context,
     DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageAccess, ImageDesc, VkResult,
+    MAX_FRAMES_IN_FLIGHT,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -84,8 +85,11 @@ pub struct Trace {
     pub slots: Image,
     /// `DrawCounters`: indirect arguments and counters.
     pub draw: Buffer,
-    /// Host-visible copy of `draw`, written at the end of each trace.
-    readback: Buffer,
+    /// Host-visible copies of `draw`, one per frame slot (`rec.slot()`), so
+    /// a frame's counts are not overwritten by the next frame in flight.
+    readbacks: Vec<Buffer>,
+    /// The slot of the last frame recorded.
+    pub last_slot: std::cell::Cell<usize>,
     pub capacity: u32,
     threads: u64,
     pipeline: ComputePipeline,
@@ -117,12 +121,16 @@ impl Trace {
             BufferUsage::StorageIndirect,
         )?;
         // Zero counts until the first trace lands.
-        let readback = Buffer::with_data(
-            ctx,
-            "water photon counts",
-            &[DrawCounters::zeroed()],
-            BufferUsage::Readback,
-        )?;
+        let readbacks = (0..MAX_FRAMES_IN_FLIGHT)
+            .map(|_| {
+                Buffer::with_data(
+                    ctx,
+                    "water photon counts",
+                    &[DrawCounters::zeroed()],
+                    BufferUsage::Readback,
+                )
+            })
+            .collect::<VkResult<Vec<_>>>()?;
         let slots = Image::new_array(
             ctx,
             "water photon slots",
@@ -162,7 +170,8 @@ impl Trace {
             photons,
             slots,
             draw,
-            readback,
+            readbacks,
+            last_slot: Default::default(),
             capacity,
             threads: layout_c.total_threads(),
             pipeline,
@@ -171,10 +180,9 @@ impl Trace {
         })
     }
 
-    /// The counts of the last completed frame (the renderer waits for each
-    /// frame, so the host-visible copy is current between frames).
-    pub fn counts(&self) -> VkResult<PhotonCounts> {
-        let c: Vec<DrawCounters> = self.readback.download_pod()?;
+    /// The counts of the frame that ran in `slot`, once its fence has signalled.
+    pub fn counts(&self, slot: usize) -> VkResult<PhotonCounts> {
+        let c: Vec<DrawCounters> = self.readbacks[slot].download_pod()?;
         Ok(PhotonCounts {
             written: c[0].instance_count,
             requested: c[0].requested,
@@ -193,6 +201,8 @@ impl Trace {
         ccm_normal: &Image,
     ) {
         let ctx = rec.ctx().clone();
+        self.last_slot.set(rec.slot());
+        let readback = &self.readbacks[rec.slot()];
         rec.pass("photon trace", |cmd| {
             // Reset by a transfer write, after last frame's indirect read
             // and copy (write-after-read).
@@ -271,19 +281,19 @@ impl Trace {
                 &[],
                 &[
                     BufferAccess::new(&self.draw, Access::TransferRead),
-                    BufferAccess::new(&self.readback, Access::TransferWrite),
+                    BufferAccess::new(readback, Access::TransferWrite),
                 ],
             );
             let region = vk::BufferCopy::default().size(self.draw.size);
             unsafe {
                 ctx.device
-                    .cmd_copy_buffer(cmd, self.draw.raw, self.readback.raw, &[region])
+                    .cmd_copy_buffer(cmd, self.draw.raw, readback.raw, &[region])
             };
             barrier(
                 &ctx,
                 cmd,
                 &[],
-                &[BufferAccess::new(&self.readback, Access::HostRead)],
+                &[BufferAccess::new(readback, Access::HostRead)],
             );
         });
     }

@@ -91,7 +91,8 @@ impl WaterView {
         targets: &FrameTargets,
     ) {
         if self.bound_radiance != targets.radiance.view {
-            // Legal: the renderer waits for every frame before the next.
+            // A set may not be updated while a submitted frame can use it.
+            rec.wait_for_other_frames();
             self.set
                 .write_storage_image(bindings::WP_BINDING_RADIANCE, &targets.radiance);
             self.bound_radiance = targets.radiance.view;

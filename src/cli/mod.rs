@@ -1,0 +1,297 @@
+//! The command line's arguments and what its commands share: device and
+//! validation, scene and size checks, image output. One file per command.
+
+pub mod info;
+pub mod reference;
+pub mod render;
+
+use caustics::output;
+use caustics::params::Params;
+use caustics::scene::{Scene, DEFAULT_SCENE};
+use caustics::techniques;
+use caustics::vk::{Context, ContextOptions, FrameOptions, MAX_FRAMES_IN_FLIGHT};
+use clap::{Args, Parser, Subcommand};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+#[derive(Parser)]
+#[command(
+    name = "caustics",
+    version,
+    about = "Real-time caustics techniques on Vulkan, side by side against a GPU ground truth"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Args, Clone)]
+pub struct DeviceArgs {
+    /// Vulkan device by index or name substring (`caustics info` lists them).
+    #[arg(long)]
+    pub device: Option<String>,
+    /// Turn on the Khronos validation layer (default in debug builds); any validation error makes the command fail.
+    #[arg(long)]
+    pub validate: bool,
+    /// Also turn on the validation layer's synchronization validation (hazards between commands are errors); implies --validate; default in debug builds.
+    #[arg(long)]
+    pub validate_sync: bool,
+}
+
+#[derive(Args, Clone)]
+pub struct SceneArgs {
+    /// Scene file (TOML, docs/SCENES.md).
+    #[arg(long, default_value = DEFAULT_SCENE)]
+    pub scene: PathBuf,
+    #[arg(long, default_value_t = 512)]
+    pub width: u32,
+    #[arg(long, default_value_t = 512)]
+    pub height: u32,
+    /// Animation time in seconds.
+    #[arg(long, default_value_t = 0.0)]
+    pub time: f32,
+}
+
+#[derive(Args, Clone)]
+pub struct FrameArgs {
+    /// Frames the GPU may still be running while the host records the next
+    /// (1 to 4); the host waits only for the frame that last used a slot.
+    #[arg(long, default_value_t = 2)]
+    pub frames_in_flight: usize,
+    /// Per-pass times on a CPU device (lavapipe), whose timestamps miss
+    /// compute: one submission per pass, each waited for, so frames cannot
+    /// overlap. Without it the frame is timed as a whole.
+    #[arg(long)]
+    pub pass_timing: bool,
+}
+
+impl FrameArgs {
+    pub fn options(&self) -> anyhow::Result<FrameOptions> {
+        if !(1..=MAX_FRAMES_IN_FLIGHT).contains(&self.frames_in_flight) {
+            anyhow::bail!(
+                "--frames-in-flight {}: must be between 1 and {MAX_FRAMES_IN_FLIGHT}",
+                self.frames_in_flight
+            );
+        }
+        Ok(FrameOptions {
+            frames_in_flight: self.frames_in_flight,
+            per_pass: self.pass_timing,
+            ..FrameOptions::default()
+        })
+    }
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Render a scene with a real-time technique and write PNG (tonemapped) or EXR (linear radiance).
+    Render(RenderArgs),
+    /// Render the ground truth with the GPU light tracer.
+    Reference(ReferenceArgs),
+    /// Per-pass GPU timings (min and median over frames) and the frame interval, after a warm-up.
+    Bench(BenchArgs),
+    /// Open a window and render interactively (keys and mouse: README.md).
+    Demo(DemoArgs),
+    /// List Vulkan devices and the features this renderer needs.
+    Info,
+}
+
+/// What `render` and `bench` run: a scene and a technique with its parameters.
+#[derive(Args)]
+pub struct TechniqueArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Technique name, or `list` (with `render`) to print them with their parameters.
+    #[arg(long, default_value = "direct")]
+    pub technique: String,
+    /// Technique parameter, NAME=VALUE (repeatable; `render --technique list` shows them).
+    #[arg(long = "param")]
+    pub params: Vec<String>,
+}
+
+#[derive(Args)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub run: TechniqueArgs,
+    /// Frames to render (time advances 1/60 s per frame); timings are averaged over them.
+    #[arg(long, default_value_t = 1)]
+    pub frames: u32,
+    /// Path-type component to draw: one the technique renders (`--technique list`) or all.
+    #[arg(long, default_value = "all")]
+    pub component: String,
+    /// Output image; .png or .exr (the other format is written beside it).
+    #[arg(long, default_value = "out/render.png")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub frame: FrameArgs,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+#[derive(Args)]
+pub struct ReferenceArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Photons to trace (rounded up to whole passes of 262,144).
+    #[arg(long, default_value_t = 20_000_000, conflicts_with = "seconds")]
+    pub photons: u64,
+    /// Trace for this many seconds instead of a photon count (whole passes).
+    #[arg(long)]
+    pub seconds: Option<f64>,
+    /// Seed of the random streams: different seeds give independent images.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
+    /// First pass's photon-mapping radius in metres (default: 1.5 pixel
+    /// footprints at the camera target's distance); it shrinks every pass.
+    #[arg(long)]
+    pub radius: Option<f32>,
+    /// The light tracer and the camera chains' direct light only: what is
+    /// seen through glass, water or mirrors lacks its caustics (for
+    /// measuring what photon mapping costs).
+    #[arg(long)]
+    pub no_photon_mapping: bool,
+    /// Share of the photons aimed at the mirrors and dielectrics (their
+    /// bounding sphere), in [0, 1); the rest follow the light's own
+    /// distribution. Unbiased for any share; more caustic photons.
+    #[arg(long, default_value_t = 0.5)]
+    pub aim_share: f32,
+    /// Path-type component to write: direct, surface_caustics, airlight, volume_caustics, other, all.
+    #[arg(long, default_value = "all")]
+    pub component: String,
+    /// Diffuse bounces photons continue through (0: direct light and caustics only).
+    #[arg(long, default_value_t = 0)]
+    pub diffuse_bounces: u32,
+    /// Output image; .png or .exr (the other format is written beside it).
+    #[arg(long, default_value = "out/reference.png")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+#[derive(Args)]
+pub struct BenchArgs {
+    #[command(flatten)]
+    pub run: TechniqueArgs,
+    #[arg(long, default_value_t = 20)]
+    pub frames: u32,
+    /// Frames rendered before timing starts (pipeline compilation, caches).
+    #[arg(long, default_value_t = 2)]
+    pub warmup: u32,
+    /// Also write the results as JSON.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    #[command(flatten)]
+    pub frame: FrameArgs,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+#[derive(Args)]
+pub struct DemoArgs {
+    /// Scene file (TOML, docs/SCENES.md); R reloads it.
+    #[arg(long, default_value = DEFAULT_SCENE)]
+    pub scene: PathBuf,
+    #[arg(long, default_value = "direct")]
+    pub technique: String,
+    #[arg(long = "param")]
+    pub params: Vec<String>,
+    /// Initial window width.
+    #[arg(long, default_value_t = 512)]
+    pub width: u32,
+    /// Initial window height.
+    #[arg(long, default_value_t = 512)]
+    pub height: u32,
+    /// fifo (default, vsync), mailbox or immediate; falls back to fifo when not offered.
+    #[arg(long, default_value = "fifo")]
+    pub present_mode: String,
+    /// With --exit: frames to present before exiting.
+    #[arg(long)]
+    pub frames: Option<u32>,
+    /// Exit after --frames N frames (tests, screenshots).
+    #[arg(long, requires = "frames")]
+    pub exit: bool,
+    /// Resize the window every few frames while running (tests).
+    #[arg(long)]
+    pub resize_test: bool,
+    /// Frames the GPU may still be running while the host records the next (1 to 4).
+    #[arg(long, default_value_t = 2)]
+    pub frames_in_flight: usize,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+pub fn context(args: &DeviceArgs) -> anyhow::Result<Arc<Context>> {
+    let options = ContextOptions {
+        validation: args.validate || args.validate_sync || cfg!(debug_assertions),
+        sync_validation: args.validate_sync || cfg!(debug_assertions),
+        device: args.device.clone(),
+    };
+    let ctx = Context::new(&options)?;
+    eprintln!("device: {} ({})", ctx.info.name, ctx.info.driver.trim());
+    Ok(ctx)
+}
+
+/// Fails the command if the validation layer reported errors, leaked objects
+/// included: everything that used the device must be dropped before this.
+pub fn check_validation(ctx: Arc<Context>) -> anyhow::Result<()> {
+    let counts = Context::shutdown(ctx)?;
+    if counts.errors > 0 {
+        anyhow::bail!(
+            "the Vulkan validation layer reported {} error(s) (see the log above)",
+            counts.errors
+        );
+    }
+    Ok(())
+}
+
+pub fn load_scene(path: &Path) -> anyhow::Result<Scene> {
+    Ok(Scene::load(path)?)
+}
+
+pub fn check_size(args: &SceneArgs) -> anyhow::Result<()> {
+    for (name, v) in [("--width", args.width), ("--height", args.height)] {
+        if !(1..=16384).contains(&v) {
+            anyhow::bail!("{name} {v}: must be between 1 and 16384");
+        }
+    }
+    if !args.time.is_finite() {
+        anyhow::bail!("--time must be a finite number of seconds");
+    }
+    Ok(())
+}
+
+/// What `render` and `bench` check before they touch the device: the
+/// technique and its parameters, the image size, the frame count, the scene.
+pub fn checked_technique_run(run: &TechniqueArgs, frames: u32) -> anyhow::Result<(Scene, Params)> {
+    let (scene, technique) = (&run.scene, run.technique.as_str());
+    let info = techniques::find(technique)?;
+    let params = Params::resolve(technique, info.params(), &run.params)?;
+    check_size(scene)?;
+    if frames == 0 {
+        anyhow::bail!("--frames must be at least 1");
+    }
+    Ok((load_scene(&scene.scene)?, params))
+}
+
+/// Writes both images, or neither: when the PNG fails the EXR just written is removed.
+pub fn write_outputs(
+    (exr, png): &(PathBuf, PathBuf),
+    width: u32,
+    height: u32,
+    radiance: &[f32],
+    display: &[u8],
+) -> anyhow::Result<()> {
+    if radiance.iter().any(|v| !v.is_finite()) {
+        anyhow::bail!("the rendered radiance contains NaN or Inf; no image written");
+    }
+    output::write_exr(exr, width, height, radiance)?;
+    if let Err(e) = output::write_png(png, width, height, display) {
+        let _ = std::fs::remove_file(exr);
+        return Err(e);
+    }
+    println!(
+        "wrote {} (linear radiance) and {} (tonemapped)",
+        exr.display(),
+        png.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,145 @@
+//! `caustics reference`: the ground truth with the GPU light tracer.
+
+use super::{check_size, check_validation, context, load_scene, write_outputs, ReferenceArgs};
+use anyhow::Context as _;
+use caustics::output;
+use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
+
+pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
+    let ReferenceArgs {
+        scene,
+        photons,
+        seconds,
+        seed,
+        radius,
+        no_photon_mapping,
+        aim_share,
+        component,
+        diffuse_bounces,
+        out,
+        device,
+    } = args;
+    check_size(&scene)?;
+    output::format_of(&out)?;
+    let component = Component::parse(&component)?;
+    if photons == 0 {
+        anyhow::bail!("--photons must be at least 1");
+    }
+    if let Some(seconds) = seconds {
+        if !(seconds.is_finite() && seconds > 0.0) {
+            anyhow::bail!("--seconds must be a positive number, got {seconds}");
+        }
+    }
+    if let Some(r) = radius {
+        if !(r.is_finite() && r > 0.0) {
+            anyhow::bail!("--radius must be a positive length in metres, got {r}");
+        }
+    }
+    let loaded = load_scene(&scene.scene)?;
+    let outputs = output::prepare(&out)?;
+    let ctx = context(&device)?;
+    let settings = ReferenceSettings {
+        diffuse_bounces,
+        seed,
+        radius,
+        photon_mapping: !no_photon_mapping,
+        aim_share,
+        ..Default::default()
+    };
+    let mut reference = ReferenceRenderer::new(
+        &ctx,
+        loaded,
+        scene.width,
+        scene.height,
+        scene.time,
+        settings,
+    )?;
+    trace_reference(&mut reference, photons, seconds)?;
+    let radiance = reference.resolve(component)?;
+    let display = reference.display()?;
+    drop(reference);
+    check_validation(ctx)?;
+    write_outputs(&outputs, scene.width, scene.height, &radiance, &display)
+}
+
+/// Runs reference passes until `photons` are traced or `seconds` have
+/// passed, with a progress bar that shows per pass the photons, the
+/// photon-mapping radius and the remaining noise; then prints the totals.
+fn trace_reference(
+    reference: &mut ReferenceRenderer,
+    photons: u64,
+    seconds: Option<f64>,
+) -> anyhow::Result<()> {
+    let bar = match seconds {
+        Some(s) => indicatif::ProgressBar::new((s * 1000.0) as u64).with_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {elapsed}/{msg}")
+                .context("progress style")?,
+        ),
+        None => indicatif::ProgressBar::new(photons).with_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:40} {percent:>3}% {human_pos}/{human_len} photons, eta {eta} {msg}",
+            )
+            .context("progress style")?,
+        ),
+    };
+    let start = std::time::Instant::now();
+    loop {
+        let elapsed = start.elapsed().as_secs_f64();
+        let done = match seconds {
+            Some(s) => elapsed >= s,
+            None => reference.reference.photons >= photons,
+        };
+        if done {
+            break;
+        }
+        let report = reference.pass()?;
+        let noise = reference.noise()?;
+        let noise = noise.map_or("-".to_string(), |n| format!("{:.2}%", n * 100.0));
+        let message = format!(
+            "pass {} at {:.1} s, r {:.4} m, noise {}",
+            reference.reference.passes,
+            start.elapsed().as_secs_f64(),
+            report.radius,
+            noise
+        );
+        match seconds {
+            Some(s) => {
+                bar.set_position((start.elapsed().as_secs_f64() * 1000.0).min(s * 1000.0) as u64);
+                bar.set_message(format!("{s:.0}s, {message}"));
+            }
+            None => {
+                bar.set_position(reference.reference.photons.min(photons));
+                bar.set_message(message.clone());
+            }
+        }
+        if bar.is_hidden() {
+            eprintln!("{} photons, {message}", reference.reference.photons);
+        }
+    }
+    bar.finish_and_clear();
+    let noise = reference.noise()?;
+    println!(
+        "traced {} photons in {} passes, {:.2} s: {:.3} M photons/s; last radius {:.4} m; remaining noise {}",
+        reference.reference.photons,
+        reference.reference.passes,
+        reference.trace_seconds,
+        reference.photons_per_second() / 1e6,
+        reference.reference.radius(),
+        noise.map_or("unknown (one pass)".to_string(), |n| format!("{:.2}%", n * 100.0)),
+    );
+    let passes = reference.reference.passes.max(1) as f64;
+    let stages: Vec<String> = reference
+        .pass_ms
+        .iter()
+        .map(|(name, ms)| format!("{name} {:.1} ms", ms / passes))
+        .collect();
+    println!("per pass: {}", stages.join(", "));
+    if reference.volume_overflow > 0 {
+        eprintln!(
+            "warning: {} medium collisions did not fit the volume photon map ({} per pass); the volume gather saw fewer photons than the light tracer",
+            reference.volume_overflow,
+            reference.reference.volume_capacity()
+        );
+    }
+    Ok(())
+}

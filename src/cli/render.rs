@@ -1,0 +1,240 @@
+//! `caustics render` and `caustics bench`: frames of a real-time technique,
+//! N in flight (`--frames-in-flight`), waited for once at the end.
+
+use super::{
+    check_validation, checked_technique_run, context, write_outputs, BenchArgs, DeviceArgs,
+    RenderArgs, TechniqueArgs,
+};
+use anyhow::Context as _;
+use caustics::output;
+use caustics::params::Params;
+use caustics::renderer::Renderer;
+use caustics::scene::Scene;
+use caustics::techniques;
+use caustics::vk::{Context, FrameOptions, FrameTiming, PassTiming};
+use std::collections::BTreeMap;
+use std::sync::Arc;
+use std::time::Instant;
+
+pub fn render(args: RenderArgs) -> anyhow::Result<()> {
+    let RenderArgs {
+        run,
+        frames,
+        component,
+        out,
+        frame,
+        device,
+    } = args;
+    if run.technique == "list" {
+        super::info::list_techniques();
+        return Ok(());
+    }
+    output::format_of(&out)?;
+    let (loaded, params) = checked_technique_run(&run, frames)?;
+    let components = techniques::find(&run.technique)?.component_mask(&component)?;
+    let options = frame.options()?;
+    let outputs = output::prepare(&out)?;
+    let (ctx, mut renderer) = start(&run, loaded, &params, options, &device)?;
+    let (scene, technique) = (&run.scene, &run.technique);
+    renderer.scene_gpu.components = components;
+    for i in 0..frames {
+        renderer.submit_frame(scene.time + i as f32 / 60.0)?;
+    }
+    // The one wait of the run: every frame in flight.
+    let done = renderer.finish()?;
+    let title = format!(
+        "{} at {}x{}, {} frame(s), {} in flight, mean per pass",
+        technique,
+        scene.width,
+        scene.height,
+        frames,
+        renderer.frames.frames_in_flight()
+    );
+    let passes = per_pass(&done);
+    let mean: Vec<PassTiming> = passes
+        .iter()
+        .map(|(name, ms)| PassTiming {
+            name: name.clone(),
+            ms: ms.iter().sum::<f64>() / ms.len() as f64,
+        })
+        .collect();
+    println!("{title} ({}):", renderer.frames.source.describe());
+    let mut total = 0.0;
+    for t in &mean {
+        println!("  {:<28} {:>9.3} ms", t.name, t.ms);
+        total += t.ms;
+    }
+    println!("  {:<28} {:>9.3} ms", "total", total);
+    let stats = renderer.scene_gpu.stats;
+    println!(
+        "geometry: {} triangles, BVH {} nodes ({} leaves, depth {}) built in {:.1} ms",
+        stats.triangles, stats.bvh_nodes, stats.bvh_leaves, stats.bvh_depth, stats.bvh_build_ms
+    );
+    let radiance = renderer.radiance()?;
+    let display = renderer.display()?;
+    drop(renderer);
+    check_validation(ctx)?;
+    write_outputs(&outputs, scene.width, scene.height, &radiance, &display)
+}
+
+/// The device and a renderer for `run` with `options`' frames in flight.
+fn start(
+    run: &TechniqueArgs,
+    scene: Scene,
+    params: &Params,
+    options: FrameOptions,
+    device: &DeviceArgs,
+) -> anyhow::Result<(Arc<Context>, Renderer)> {
+    let ctx = context(device)?;
+    let s = &run.scene;
+    let mut renderer = Renderer::new(
+        &ctx,
+        scene,
+        &run.technique,
+        params,
+        s.width,
+        s.height,
+        s.time,
+    )?;
+    renderer.set_frame_options(options)?;
+    Ok((ctx, renderer))
+}
+
+/// Each pass's times over frames, in the order of the first frame (passes
+/// matched by name; a repeated name collects all its occurrences).
+fn per_pass(frames: &[FrameTiming]) -> Vec<(String, Vec<f64>)> {
+    let mut out: Vec<(String, Vec<f64>)> = Vec::new();
+    for f in frames {
+        for (i, p) in f.passes.iter().enumerate() {
+            match out.iter_mut().find(|(n, _)| *n == p.name) {
+                Some((_, v)) if v.len() < frames.len() * (i + 1) => v.push(p.ms),
+                Some(_) => {}
+                None => out.push((p.name.clone(), vec![p.ms])),
+            }
+        }
+    }
+    out
+}
+
+fn median(values: &[f64]) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    match v.len() {
+        0 => 0.0,
+        n if n % 2 == 1 => v[n / 2],
+        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
+
+fn min(values: &[f64]) -> f64 {
+    values.iter().copied().fold(f64::INFINITY, f64::min)
+}
+
+#[derive(serde::Serialize)]
+struct PassStats {
+    name: String,
+    /// Median over frames.
+    ms: f64,
+    min_ms: f64,
+}
+
+pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
+    let BenchArgs {
+        run,
+        frames,
+        warmup,
+        json,
+        frame,
+        device,
+    } = args;
+    let (loaded, params) = checked_technique_run(&run, frames)?;
+    let options = frame.options()?;
+    let (ctx, mut renderer) = start(&run, loaded, &params, options, &device)?;
+    let (scene, technique) = (&run.scene, &run.technique);
+    for i in 0..warmup {
+        renderer.submit_frame(scene.time + i as f32 / 60.0)?;
+    }
+    renderer.finish()?;
+    let waited_before = renderer.frames.host_wait;
+    let start = Instant::now();
+    for i in 0..frames {
+        renderer.submit_frame(scene.time + (warmup + i) as f32 / 60.0)?;
+    }
+    let done = renderer.finish()?;
+    // Wall clock over the timed frames, the final wait included: what a
+    // frame costs when frames overlap.
+    let interval_ms = start.elapsed().as_secs_f64() * 1e3 / frames as f64;
+    let wait_ms = (renderer.frames.host_wait - waited_before).as_secs_f64() * 1e3 / frames as f64;
+    let (device_name, driver) = (ctx.info.name.clone(), ctx.info.driver.trim().to_string());
+    let (source, stats) = (renderer.frames.source, renderer.scene_gpu.stats);
+    let in_flight = renderer.frames.frames_in_flight();
+    let counters: BTreeMap<_, _> = renderer.technique_counters().into_iter().collect();
+    drop(renderer);
+    check_validation(ctx)?;
+    let passes: Vec<PassStats> = per_pass(&done)
+        .into_iter()
+        .map(|(name, ms)| PassStats {
+            name,
+            ms: median(&ms),
+            min_ms: min(&ms),
+        })
+        .collect();
+    let submit_to_done: Vec<f64> = done.iter().map(|f| f.submit_to_done_ms).collect();
+    println!(
+        "bench {} on {} at {}x{}, {} frames after {} warm-up, {} in flight ({}):",
+        technique,
+        scene.scene.display(),
+        scene.width,
+        scene.height,
+        frames,
+        warmup,
+        in_flight,
+        source.describe()
+    );
+    println!("  {:<28} {:>9} {:>9}", "pass", "min ms", "median ms");
+    for p in &passes {
+        println!("  {:<28} {:>9.3} {:>9.3}", p.name, p.min_ms, p.ms);
+    }
+    println!(
+        "  {:<28} {:>9.3} ms (host wall clock over the frames / frames)",
+        "frame interval", interval_ms
+    );
+    println!(
+        "  {:<28} {:>9.3} ms (median; with more than one in flight it includes queueing)",
+        "submit to done",
+        median(&submit_to_done)
+    );
+    println!(
+        "  {:<28} {:>9.3} ms per frame (host blocked on fences)",
+        "host wait", wait_ms
+    );
+    if let Some(path) = json {
+        let report = serde_json::json!({
+            "device": device_name,
+            "driver": driver,
+            "timing_source": source.describe(),
+            "scene": scene.scene.display().to_string(),
+            "technique": technique,
+            "params": params.iter().map(|(k, v)| (k.clone(), *v)).collect::<BTreeMap<_, _>>(),
+            "width": scene.width,
+            "height": scene.height,
+            "frames": frames,
+            "warmup": warmup,
+            "frames_in_flight": in_flight,
+            "passes_ms": passes,
+            "frame_ms": interval_ms,
+            "submit_to_done_ms": median(&submit_to_done),
+            "host_wait_ms": wait_ms,
+            "geometry": stats,
+            "counters": counters,
+        });
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create folder {}", dir.display()))?;
+        }
+        std::fs::write(&path, serde_json::to_string_pretty(&report)?)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,678 @@
+//! Frames in flight. `Frames` owns N per-frame contexts (default 2); each has
+//! its command pool and buffer, fence, acquire semaphore (for presentation),
+//! timestamp query pool, upload ring and deferred-release list.
+//! `begin_frame` waits only for the fence of the frame that last used the
+//! same slot, N frames ago; `FrameRecorder::submit` submits without waiting.
+//!
+//! What this makes safe, and what it relies on:
+//! - Everything the host writes for a frame (frame constants, light views,
+//!   animated geometry, technique uniforms) goes through `FrameRecorder::upload`:
+//!   the bytes land in this slot's ring, which the GPU reads only during this
+//!   frame, and a copy in the frame's command buffer moves them into the
+//!   device-local destination. The destination is shared by all frames but
+//!   written only by the GPU, in queue order, behind barriers, so frame k+1's
+//!   copy cannot overtake frame k's reads.
+//! - Every GPU-only image and buffer is likewise shared, ordered by the
+//!   barriers `vk/sync.rs` derives from its tracked state: recording order is
+//!   submission order, so the tracked state is right across frames.
+//! - Whatever a frame in flight may still use is dropped through
+//!   `Frames::defer_release`, after that frame's fence, never by an early `Drop`.
+//! - A descriptor set may not be rewritten while a frame in flight uses it:
+//!   a rewrite during recording first calls `FrameRecorder::wait_for_other_frames`.
+//!
+//! Timing (GUIDE §8): on a GPU, timestamp pairs around each pass in the
+//! frame's command buffer, read when its fence has signalled. On a CPU device
+//! whose timestamps miss compute, the frame is timed by the host clock
+//! (submit to observed completion), frames still overlap, and per-pass numbers
+//! come only on request (`per_pass`): one submission per pass, each waited for.
+
+use super::sync::ResourceState;
+use super::{Access, Buffer, BufferUsage, Context, VkError, VkResult};
+use ash::vk;
+use std::any::Any;
+use std::collections::VecDeque;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// The most frames a `Frames` may keep in flight (techniques size per-frame
+/// read-back buffers by it).
+pub const MAX_FRAMES_IN_FLIGHT: usize = 4;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum TimingSource {
+    /// vkCmdWriteTimestamp2 pairs, converted with timestampPeriod.
+    Timestamps,
+    /// One submission per pass, host wall clock from submit to fence (on
+    /// request: the host waits after every pass, so frames cannot overlap).
+    WallClock,
+    /// A CPU device: the whole frame in one command buffer, frames overlap;
+    /// the frame is timed by the host clock and the per-pass timestamps miss
+    /// compute dispatches.
+    FrameClock,
+}
+
+impl TimingSource {
+    pub fn describe(self) -> &'static str {
+        match self {
+            TimingSource::Timestamps => "GPU timestamp queries",
+            TimingSource::WallClock => {
+                "wall clock per pass submission (CPU device: its timestamps miss compute)"
+            }
+            TimingSource::FrameClock => {
+                "one command buffer per frame, host clock per frame; per-pass timestamps miss compute (CPU device)"
+            }
+        }
+    }
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct PassTiming {
+    pub name: String,
+    pub ms: f64,
+}
+
+/// How a `Frames` runs.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameOptions {
+    /// 1 to `MAX_FRAMES_IN_FLIGHT`.
+    pub frames_in_flight: usize,
+    /// On a CPU device: one submission per pass, timed by the host clock.
+    pub per_pass: bool,
+    /// Timestamp pairs per frame.
+    pub max_passes: u32,
+}
+
+impl Default for FrameOptions {
+    fn default() -> Self {
+        FrameOptions {
+            frames_in_flight: 2,
+            per_pass: false,
+            max_passes: 64,
+        }
+    }
+}
+
+/// A completed frame's timings.
+#[derive(Clone, Debug)]
+pub struct FrameTiming {
+    /// Which slot it ran in (per-frame read-back buffers are indexed by it).
+    pub slot: usize,
+    pub passes: Vec<PassTiming>,
+    /// Host clock from submission to the host seeing its fence signalled:
+    /// the frame's GPU time when one frame is in flight; with more it also
+    /// holds the time queued behind the frame before.
+    pub submit_to_done_ms: f64,
+}
+
+/// Host-visible chunks the host writes a frame's data into; reset once the
+/// frame's fence has signalled. Grows by adding a chunk; the chunks are
+/// merged into one at the next reset (the GPU is done with them then).
+struct Ring {
+    chunks: Vec<Buffer>,
+    used: u64,
+}
+
+const RING_ALIGN: u64 = 256;
+const RING_MIN: u64 = 64 * 1024;
+
+impl Ring {
+    fn alloc(&mut self, ctx: &Arc<Context>, bytes: &[u8]) -> VkResult<(vk::Buffer, u64)> {
+        let size = bytes.len() as u64;
+        let offset = self.used.next_multiple_of(RING_ALIGN);
+        let fits = self.chunks.last().is_some_and(|c| offset + size <= c.size);
+        let offset = if fits {
+            offset
+        } else {
+            let last = self.chunks.last().map_or(0, |c| c.size);
+            let capacity = size.max(2 * last).max(RING_MIN);
+            self.chunks.push(Buffer::new(
+                ctx,
+                "upload ring",
+                capacity,
+                BufferUsage::Upload,
+            )?);
+            0
+        };
+        let chunk = self.chunks.last().expect("a chunk");
+        chunk.write_at(offset, bytes);
+        self.used = offset + size;
+        Ok((chunk.raw, offset))
+    }
+
+    fn reset(&mut self, ctx: &Arc<Context>) -> VkResult<()> {
+        if self.chunks.len() > 1 {
+            let total: u64 = self.chunks.iter().map(|c| c.size).sum();
+            self.chunks.clear();
+            self.chunks
+                .push(Buffer::new(ctx, "upload ring", total, BufferUsage::Upload)?);
+        }
+        self.used = 0;
+        Ok(())
+    }
+}
+
+struct Pending {
+    names: Vec<String>,
+    wall_ms: Vec<f64>,
+    submitted: Instant,
+}
+
+struct Slot {
+    pool: vk::CommandPool,
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+    acquired: vk::Semaphore,
+    queries: vk::QueryPool,
+    ring: Ring,
+    release: Vec<Box<dyn Any>>,
+    pending: Option<Pending>,
+}
+
+pub struct Frames {
+    ctx: Arc<Context>,
+    slots: Vec<Slot>,
+    /// The slot the next frame uses.
+    next: usize,
+    /// Slots with a submitted frame, oldest first.
+    order: VecDeque<usize>,
+    max_passes: u32,
+    pub source: TimingSource,
+    /// Host time spent in `begin_frame` waiting for a slot's fence, and in
+    /// `wait_all`, since creation.
+    pub host_wait: Duration,
+}
+
+impl Frames {
+    pub fn new(ctx: &Arc<Context>, options: FrameOptions) -> VkResult<Frames> {
+        let n = options.frames_in_flight.clamp(1, MAX_FRAMES_IN_FLIGHT);
+        let source = match (ctx.is_cpu(), options.per_pass) {
+            (false, _) => TimingSource::Timestamps,
+            (true, true) => TimingSource::WallClock,
+            (true, false) => TimingSource::FrameClock,
+        };
+        let mut frames = Frames {
+            ctx: ctx.clone(),
+            slots: Vec::new(),
+            next: 0,
+            order: VecDeque::new(),
+            max_passes: options.max_passes,
+            source,
+            host_wait: Duration::ZERO,
+        };
+        for _ in 0..n {
+            let slot = frames.new_slot()?;
+            frames.slots.push(slot);
+        }
+        Ok(frames)
+    }
+
+    /// Makes one slot; what is made before an error is pushed into a slot
+    /// with null handles, which `Drop` skips (destroying null is a no-op).
+    fn new_slot(&self) -> VkResult<Slot> {
+        let d = &self.ctx.device;
+        let mut slot = Slot {
+            pool: vk::CommandPool::null(),
+            cmd: vk::CommandBuffer::null(),
+            fence: vk::Fence::null(),
+            acquired: vk::Semaphore::null(),
+            queries: vk::QueryPool::null(),
+            ring: Ring {
+                chunks: Vec::new(),
+                used: 0,
+            },
+            release: Vec::new(),
+            pending: None,
+        };
+        let result = (|| unsafe {
+            slot.pool = d.create_command_pool(
+                &vk::CommandPoolCreateInfo::default()
+                    .queue_family_index(self.ctx.queue_family)
+                    .flags(vk::CommandPoolCreateFlags::TRANSIENT),
+                None,
+            )?;
+            slot.cmd = d.allocate_command_buffers(
+                &vk::CommandBufferAllocateInfo::default()
+                    .command_pool(slot.pool)
+                    .level(vk::CommandBufferLevel::PRIMARY)
+                    .command_buffer_count(1),
+            )?[0];
+            slot.fence = d.create_fence(&vk::FenceCreateInfo::default(), None)?;
+            slot.acquired = d.create_semaphore(&vk::SemaphoreCreateInfo::default(), None)?;
+            slot.queries = d.create_query_pool(
+                &vk::QueryPoolCreateInfo::default()
+                    .query_type(vk::QueryType::TIMESTAMP)
+                    .query_count(self.max_passes * 2),
+                None,
+            )?;
+            Ok::<(), VkError>(())
+        })();
+        match result {
+            Ok(()) => Ok(slot),
+            Err(e) => {
+                self.destroy_slot(&mut slot);
+                Err(e)
+            }
+        }
+    }
+
+    fn destroy_slot(&self, slot: &mut Slot) {
+        let d = &self.ctx.device;
+        slot.release.clear();
+        slot.ring.chunks.clear();
+        unsafe {
+            d.destroy_query_pool(slot.queries, None);
+            d.destroy_semaphore(slot.acquired, None);
+            d.destroy_fence(slot.fence, None);
+            d.destroy_command_pool(slot.pool, None);
+        }
+    }
+
+    pub fn frames_in_flight(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// Frames submitted and not yet seen complete.
+    pub fn pending(&self) -> usize {
+        self.order.len()
+    }
+
+    /// Starts the next frame: waits for the fence of the frame that last used
+    /// its slot (N frames ago; the only host wait of the loop), then frees
+    /// that frame's releases, resets its ring and command pool. Returns the
+    /// recorder and that older frame's timings, if it had one.
+    pub fn begin_frame(&mut self) -> VkResult<(FrameRecorder<'_>, Option<FrameTiming>)> {
+        let index = self.next;
+        let done = if self.slots[index].pending.is_some() {
+            self.order.retain(|&s| s != index);
+            Some(self.complete(index)?)
+        } else {
+            None
+        };
+        let ctx = self.ctx.clone();
+        let slot = &mut self.slots[index];
+        slot.ring.reset(&ctx)?;
+        unsafe {
+            ctx.device
+                .reset_command_pool(slot.pool, vk::CommandPoolResetFlags::empty())?;
+            ctx.device.begin_command_buffer(
+                slot.cmd,
+                &vk::CommandBufferBeginInfo::default()
+                    .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+            )?;
+            if self.source != TimingSource::WallClock {
+                ctx.device
+                    .cmd_reset_query_pool(slot.cmd, slot.queries, 0, self.max_passes * 2);
+            }
+        }
+        let recorder = FrameRecorder {
+            frames: self,
+            slot: index,
+            names: Vec::new(),
+            wall_ms: Vec::new(),
+            error: None,
+        };
+        Ok((recorder, done))
+    }
+
+    /// Waits for slot `index`'s frame, releases what it held and reads its timings.
+    fn complete(&mut self, index: usize) -> VkResult<FrameTiming> {
+        let ctx = self.ctx.clone();
+        let slot = &mut self.slots[index];
+        let start = Instant::now();
+        unsafe {
+            ctx.device.wait_for_fences(&[slot.fence], true, u64::MAX)?;
+            ctx.device.reset_fences(&[slot.fence])?;
+        }
+        let waited = start.elapsed();
+        self.host_wait += waited;
+        let done = Instant::now();
+        // The frame has completed: nothing it used is read any more.
+        slot.release.clear();
+        let pending = slot.pending.take().expect("a submitted frame");
+        let passes = match self.source {
+            TimingSource::WallClock => pending
+                .names
+                .into_iter()
+                .zip(pending.wall_ms)
+                .map(|(name, ms)| PassTiming { name, ms })
+                .collect(),
+            TimingSource::Timestamps | TimingSource::FrameClock => {
+                read_timestamps(&ctx, slot.queries, pending.names)?
+            }
+        };
+        Ok(FrameTiming {
+            slot: index,
+            passes,
+            submit_to_done_ms: (done - pending.submitted).as_secs_f64() * 1e3,
+        })
+    }
+
+    /// Waits for every frame in flight (oldest first) and returns their
+    /// timings: headless `render` and `bench` call it once at the end.
+    pub fn wait_all(&mut self) -> VkResult<Vec<FrameTiming>> {
+        let mut out = Vec::new();
+        while let Some(index) = self.order.pop_front() {
+            out.push(self.complete(index)?);
+        }
+        Ok(out)
+    }
+
+    /// Drops `value` once no frame submitted so far can use it: after the
+    /// fence of the newest frame in flight (frames complete in order), or
+    /// now when none is in flight.
+    pub fn defer_release(&mut self, value: impl Any) {
+        if let Some(&newest) = self.order.back() {
+            self.slots[newest].release.push(Box::new(value));
+        }
+    }
+}
+
+fn read_timestamps(
+    ctx: &Context,
+    pool: vk::QueryPool,
+    names: Vec<String>,
+) -> VkResult<Vec<PassTiming>> {
+    if names.is_empty() {
+        return Ok(Vec::new());
+    }
+    let mut ticks = vec![0u64; names.len() * 2];
+    unsafe {
+        ctx.device.get_query_pool_results(
+            pool,
+            0,
+            &mut ticks,
+            vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+        )
+    }?;
+    let mask = if ctx.timestamp_valid_bits >= 64 {
+        u64::MAX
+    } else {
+        (1u64 << ctx.timestamp_valid_bits) - 1
+    };
+    Ok(names
+        .into_iter()
+        .enumerate()
+        .map(|(i, name)| {
+            // Wrapping subtraction within the valid bits: the counter may wrap mid-frame.
+            let delta = ticks[2 * i + 1].wrapping_sub(ticks[2 * i]) & mask;
+            PassTiming {
+                name,
+                ms: delta as f64 * ctx.timestamp_period * 1e-6,
+            }
+        })
+        .collect())
+}
+
+impl Drop for Frames {
+    fn drop(&mut self) {
+        // Nothing a slot owns may go while its frame runs.
+        let _ = self.wait_all();
+        let mut slots = std::mem::take(&mut self.slots);
+        for slot in &mut slots {
+            self.destroy_slot(slot);
+        }
+    }
+}
+
+/// Semaphores a frame's submission waits on and signals (the demo's
+/// acquire and render-finished semaphores).
+#[derive(Default)]
+pub struct FrameSync {
+    pub waits: Vec<(vk::Semaphore, vk::PipelineStageFlags2)>,
+    pub signals: Vec<(vk::Semaphore, vk::PipelineStageFlags2)>,
+}
+
+/// Records one frame: every pass goes through `pass`, every host write
+/// through `upload`; `submit` ends it.
+pub struct FrameRecorder<'a> {
+    frames: &'a mut Frames,
+    slot: usize,
+    names: Vec<String>,
+    wall_ms: Vec<f64>,
+    error: Option<VkError>,
+}
+
+impl FrameRecorder<'_> {
+    pub fn ctx(&self) -> &Arc<Context> {
+        &self.frames.ctx
+    }
+
+    /// This frame's slot, 0 to `frames_in_flight() - 1`.
+    pub fn slot(&self) -> usize {
+        self.slot
+    }
+
+    /// The frame's command buffer, for commands outside the timed passes
+    /// (the demo's blit to the swapchain).
+    pub fn cmd(&self) -> vk::CommandBuffer {
+        self.frames.slots[self.slot].cmd
+    }
+
+    /// Signalled by vkAcquireNextImageKHR for this frame (the demo).
+    pub fn acquire_semaphore(&self) -> vk::Semaphore {
+        self.frames.slots[self.slot].acquired
+    }
+
+    fn per_pass(&self) -> bool {
+        self.frames.source == TimingSource::WallClock
+    }
+
+    /// Records one named pass. Every pass of every technique goes through here.
+    pub fn pass(&mut self, name: &str, record: impl FnOnce(vk::CommandBuffer)) {
+        if self.error.is_some() {
+            return;
+        }
+        let ctx = self.frames.ctx.clone();
+        if self.per_pass() {
+            let start = Instant::now();
+            let result = ctx.submit_and_wait(|cmd| {
+                ctx.begin_label(cmd, name);
+                record(cmd);
+                ctx.end_label(cmd);
+            });
+            if let Err(e) = result {
+                self.error = Some(e);
+                return;
+            }
+            self.wall_ms.push(start.elapsed().as_secs_f64() * 1e3);
+        } else {
+            let slot = &self.frames.slots[self.slot];
+            let (cmd, pool) = (slot.cmd, slot.queries);
+            let index = self.names.len() as u32;
+            if index >= self.frames.max_passes {
+                panic!(
+                    "frame recorder: more than {} passes",
+                    self.frames.max_passes
+                );
+            }
+            ctx.begin_label(cmd, name);
+            unsafe {
+                ctx.device.cmd_write_timestamp2(
+                    cmd,
+                    vk::PipelineStageFlags2::TOP_OF_PIPE,
+                    pool,
+                    index * 2,
+                )
+            };
+            record(cmd);
+            unsafe {
+                ctx.device.cmd_write_timestamp2(
+                    cmd,
+                    vk::PipelineStageFlags2::BOTTOM_OF_PIPE,
+                    pool,
+                    index * 2 + 1,
+                )
+            };
+            ctx.end_label(cmd);
+        }
+        self.names.push(name.to_string());
+    }
+
+    /// Writes `bytes` to the start of `dst` for this frame: into the frame's
+    /// ring, then a copy in the frame's command buffer. The copy waits for
+    /// every earlier use of `dst` (all stages: reads by shaders that bind it
+    /// through a set and declare no barrier, such as set 0's frame constants,
+    /// are not tracked), and every later command sees the new contents.
+    pub fn upload(&mut self, dst: &Buffer, bytes: &[u8]) {
+        if bytes.is_empty() || self.error.is_some() {
+            return;
+        }
+        assert!(
+            bytes.len() as u64 <= dst.size,
+            "upload larger than its buffer"
+        );
+        let ctx = self.frames.ctx.clone();
+        let (src, offset) = match self.frames.slots[self.slot].ring.alloc(&ctx, bytes) {
+            Ok(a) => a,
+            Err(e) => {
+                self.error = Some(e);
+                return;
+            }
+        };
+        let copy = |cmd: vk::CommandBuffer| unsafe {
+            let before = vk::MemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                .src_access_mask(vk::AccessFlags2::MEMORY_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::COPY)
+                .dst_access_mask(vk::AccessFlags2::TRANSFER_WRITE);
+            ctx.device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().memory_barriers(&[before]),
+            );
+            let region = vk::BufferCopy::default()
+                .src_offset(offset)
+                .size(bytes.len() as u64);
+            ctx.device.cmd_copy_buffer(cmd, src, dst.raw, &[region]);
+            let after = vk::MemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::COPY)
+                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                .dst_access_mask(vk::AccessFlags2::MEMORY_READ);
+            ctx.device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().memory_barriers(&[after]),
+            );
+        };
+        if self.per_pass() {
+            // Passes are separate submissions here: the copy must run before
+            // the next one, so it is a submission of its own.
+            if let Err(e) = ctx.submit_and_wait(copy) {
+                self.error = Some(e);
+                return;
+            }
+        } else {
+            copy(self.cmd());
+        }
+        // The copy's write is visible to all later reads (the barrier above);
+        // a pass that declares an access to `dst` still gets its own barrier.
+        dst.state.set(ResourceState {
+            layout: vk::ImageLayout::UNDEFINED,
+            last_write: Access::TransferWrite,
+            current: Access::TransferWrite,
+        });
+    }
+
+    /// Waits for every other frame in flight. For the rare descriptor-set
+    /// rewrite during recording (a technique binding new frame targets):
+    /// a set may not be updated while a submitted frame can still use it.
+    /// Their timings are dropped; an error is returned by `submit`.
+    pub fn wait_for_other_frames(&mut self) {
+        let others: Vec<usize> = self.frames.order.drain(..).collect();
+        for index in others {
+            if let Err(e) = self.frames.complete(index) {
+                self.error.get_or_insert(e);
+            }
+        }
+    }
+
+    /// Ends and submits the frame without waiting for it. Returns the
+    /// recording's first error, if any (the frame is still submitted, so its
+    /// slot's fence signals).
+    pub fn submit(mut self, sync: &FrameSync) -> VkResult<()> {
+        let ctx = self.frames.ctx.clone();
+        let index = self.slot;
+        let slot = &mut self.frames.slots[index];
+        unsafe { ctx.device.end_command_buffer(slot.cmd) }?;
+        let waits = semaphore_infos(&sync.waits);
+        let signals = semaphore_infos(&sync.signals);
+        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(slot.cmd)];
+        let submit = vk::SubmitInfo2::default()
+            .wait_semaphore_infos(&waits)
+            .command_buffer_infos(&cmds)
+            .signal_semaphore_infos(&signals);
+        unsafe { ctx.device.queue_submit2(ctx.queue, &[submit], slot.fence) }?;
+        slot.pending = Some(Pending {
+            names: std::mem::take(&mut self.names),
+            wall_ms: std::mem::take(&mut self.wall_ms),
+            submitted: Instant::now(),
+        });
+        self.frames.order.push_back(index);
+        self.frames.next = (index + 1) % self.frames.slots.len();
+        match self.error.take() {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+}
+
+fn semaphore_infos(
+    list: &[(vk::Semaphore, vk::PipelineStageFlags2)],
+) -> Vec<vk::SemaphoreSubmitInfo<'static>> {
+    list.iter()
+        .map(|&(s, stage)| {
+            vk::SemaphoreSubmitInfo::default()
+                .semaphore(s)
+                .stage_mask(stage)
+        })
+        .collect()
+}
+
+/// One frame at a time, waited for: tests, the reference, calibrations.
+pub struct Profiler {
+    frames: std::cell::RefCell<Frames>,
+    pub source: TimingSource,
+}
+
+impl Profiler {
+    /// Timestamps in one command buffer on a GPU; one command buffer per
+    /// frame timed by the host clock on a CPU device.
+    pub fn new(ctx: &Arc<Context>, max_passes: u32) -> VkResult<Self> {
+        Self::with(ctx, max_passes, false)
+    }
+
+    /// For measurements that need each pass's time: per-pass host clock on
+    /// a CPU device, timestamps on a GPU.
+    pub fn for_timing(ctx: &Arc<Context>, max_passes: u32) -> VkResult<Self> {
+        Self::with(ctx, max_passes, true)
+    }
+
+    fn with(ctx: &Arc<Context>, max_passes: u32, per_pass: bool) -> VkResult<Self> {
+        let frames = Frames::new(
+            ctx,
+            FrameOptions {
+                frames_in_flight: 1,
+                per_pass,
+                max_passes,
+            },
+        )?;
+        Ok(Profiler {
+            source: frames.source,
+            frames: std::cell::RefCell::new(frames),
+        })
+    }
+
+    /// Records, submits and waits for one frame; returns each pass's time.
+    pub fn frame(
+        &self,
+        record: impl FnOnce(&mut FrameRecorder) -> VkResult<()>,
+    ) -> VkResult<Vec<PassTiming>> {
+        let mut frames = self.frames.borrow_mut();
+        let (mut rec, _) = frames.begin_frame()?;
+        let recorded = record(&mut rec);
+        let submitted = rec.submit(&FrameSync::default());
+        let mut done = frames.wait_all()?;
+        recorded?;
+        submitted?;
+        Ok(done.pop().map(|t| t.passes).unwrap_or_default())
+    }
+}
