@@ -11,6 +11,7 @@
 mod context;
 mod device;
 mod pipeline;
+mod pipeline_store;
 mod profiler;
 mod resources;
 mod swapchain;
@@ -22,6 +23,7 @@ pub use pipeline::{
     begin_rendering, begin_rendering_with_depth, end_rendering, BindingKind, ComputePipeline,
     DescriptorSet, DescriptorSetLayout, GraphicsPipeline, GraphicsPipelineDesc, Sampler,
 };
+pub use pipeline_store::{CacheLoad, PipelineCounts, PipelineStore, Specialization};
 pub use profiler::{FrameRecorder, PassTiming, Profiler, TimingSource};
 pub use resources::{Buffer, BufferUsage, Image, ImageDesc};
 pub use swapchain::{Acquired, Surface, Swapchain};
