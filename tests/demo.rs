@@ -83,6 +83,8 @@ fn start_xvfb() -> Xvfb {
 #[test]
 fn demo_resizes_and_exits_cleanly_under_validation() {
     let x = start_xvfb();
+    // The demo saves its pipeline cache here, not in the user's home.
+    let cache_home = std::env::temp_dir().join(format!("caustics-demo-{}", std::process::id()));
     let start = Instant::now();
     let mut child = Command::new(env!("CARGO_BIN_EXE_caustics"))
         .args([
@@ -105,6 +107,7 @@ fn demo_resizes_and_exits_cleanly_under_validation() {
             std::env::var_os("VK_DRIVER_FILES").unwrap_or_else(|| LAVAPIPE_ICD.into()),
         )
         .env("RUST_LOG", "warn")
+        .env("XDG_CACHE_HOME", &cache_home)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -144,5 +147,15 @@ fn demo_resizes_and_exits_cleanly_under_validation() {
     );
     // Per-pass timings use the same scope names as `caustics render`.
     assert!(stdout.contains("tonemap"), "no per-pass timings: {report}");
+    // The pipeline cache was saved for the next start (at least its
+    // 32-byte header: lavapipe's cache holds no pipelines).
+    let cache = cache_home.join("caustics/pipelines.bin");
+    let saved = std::fs::metadata(&cache).map(|m| m.len()).unwrap_or(0);
+    assert!(
+        saved >= 32,
+        "no pipeline cache at {}: {report}",
+        cache.display()
+    );
+    let _ = std::fs::remove_dir_all(&cache_home);
     eprintln!("{report}");
 }

@@ -72,6 +72,17 @@ pub fn parse_present_mode(s: &str) -> anyhow::Result<vk::PresentModeKHR> {
     })
 }
 
+/// Where the demo keeps the driver's pipeline cache between runs:
+/// `$XDG_CACHE_HOME/caustics/pipelines.bin`, else `~/.cache/caustics/...`;
+/// none when neither variable is set.
+fn pipeline_cache_file() -> Option<PathBuf> {
+    let base = std::env::var_os("XDG_CACHE_HOME")
+        .filter(|v| !v.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))?;
+    Some(base.join("caustics").join("pipelines.bin"))
+}
+
 /// Runs the demo until the window closes (or `--frames N --exit`). Fails on
 /// any error, on validation errors and on leaked Vulkan objects.
 pub fn run(options: DemoOptions) -> anyhow::Result<()> {
@@ -91,6 +102,15 @@ pub fn run(options: DemoOptions) -> anyhow::Result<()> {
         extensions,
     )?;
     eprintln!("device: {} ({})", ctx.info.name, ctx.info.driver.trim());
+    let cache_file = pipeline_cache_file();
+    if let Some(path) = &cache_file {
+        // A bad or foreign file is ignored with a warning (vk::CacheLoad).
+        log::info!(
+            "pipeline cache {}: {:?}",
+            path.display(),
+            ctx.pipelines().load(path)
+        );
+    }
     let mut app = App {
         ctx: Some(ctx),
         options,
@@ -103,6 +123,13 @@ pub fn run(options: DemoOptions) -> anyhow::Result<()> {
     // before the context is shut down and checked for leaks.
     app.state = None;
     let ctx = app.ctx.take().expect("context");
+    if let Some(path) = &cache_file {
+        // The next start compiles nothing this run compiled (real GPUs;
+        // lavapipe's cache stays empty). Failing to save costs only time.
+        if let Err(e) = ctx.pipelines().save(path) {
+            log::warn!("cannot save the pipeline cache {}: {e}", path.display());
+        }
+    }
     let counts = Context::shutdown(ctx)?;
     if let Some(e) = app.error {
         return Err(e);

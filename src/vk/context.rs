@@ -3,6 +3,7 @@
 //! `Arc<Context>` so the device is destroyed last.
 
 use super::device::{enumerate_devices, pick_device, query_device, DeviceInfo};
+use super::pipeline_store::PipelineStore;
 use super::{VkError, VkResult};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
@@ -64,6 +65,8 @@ pub struct Context {
     messenger: vk::DebugUtilsMessengerEXT,
     counters: Box<Counters>,
     command_pool: vk::CommandPool,
+    /// Pipelines shared across rebuilds, and the driver's pipeline cache.
+    pipelines: PipelineStore,
     destroyed: bool,
 }
 
@@ -373,6 +376,7 @@ impl Context {
             info.kind,
             info.driver
         );
+        let pipelines = PipelineStore::new(&device, &props);
         Ok(Arc::new(Context {
             entry,
             instance,
@@ -391,6 +395,7 @@ impl Context {
             messenger,
             counters,
             command_pool,
+            pipelines,
             destroyed: false,
         }))
     }
@@ -495,6 +500,11 @@ impl Context {
         result
     }
 
+    /// The pipeline store: reuse across rebuilds, counts, the disk cache.
+    pub fn pipelines(&self) -> &PipelineStore {
+        &self.pipelines
+    }
+
     pub fn wait_idle(&self) {
         let _ = unsafe { self.device.device_wait_idle() };
     }
@@ -521,6 +531,8 @@ impl Context {
         unsafe {
             let _ = self.device.device_wait_idle();
             self.device.destroy_command_pool(self.command_pool, None);
+            // The kept pipelines and the cache are made on the device.
+            self.pipelines.destroy();
             // The allocator frees its memory blocks; it must go before the device.
             ManuallyDrop::drop(&mut self.allocator);
             self.device.destroy_device(None);

@@ -13,6 +13,7 @@ mod context;
 mod device;
 mod frame;
 mod pipeline;
+mod pipeline_store;
 mod resources;
 mod swapchain;
 mod sync;
@@ -27,6 +28,7 @@ pub use pipeline::{
     begin_rendering, begin_rendering_with_depth, end_rendering, BindingKind, ComputePipeline,
     DescriptorSet, DescriptorSetLayout, GraphicsPipeline, GraphicsPipelineDesc, Sampler,
 };
+pub use pipeline_store::{CacheLoad, PipelineCounts, PipelineStore, Specialization};
 pub use resources::{Buffer, BufferUsage, Image, ImageDesc};
 pub use swapchain::{Acquired, Surface, Swapchain};
 pub use sync::{barrier, copy_image, Access, BufferAccess, ImageAccess};

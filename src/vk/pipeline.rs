@@ -2,9 +2,11 @@
 //! graphics pipelines. Bindings are declared by number (constants shared with
 //! GLSL through `shader_bindings.rs`), never by call order.
 
+use super::pipeline_store::{FixedState, PipelineKey, SharedPipeline, Specialization};
 use super::{Buffer, Context, Image, VkResult};
 use crate::shaders;
 use ash::vk;
+use std::ffi::CStr;
 use std::sync::Arc;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -220,6 +222,92 @@ fn pipeline_layout(
     Ok(unsafe { ctx.device.create_pipeline_layout(&info, None) }?)
 }
 
+/// The store's key for a pipeline of `stages` over `sets` (see
+/// `pipeline_store`): the set layouts by description, not by handle.
+fn pipeline_key(
+    stages: &[(vk::ShaderStageFlags, &str)],
+    specialization: &Specialization,
+    sets: &[&DescriptorSetLayout],
+    push_size: u32,
+    fixed: Option<FixedState>,
+) -> PipelineKey {
+    PipelineKey {
+        stages: stages
+            .iter()
+            .map(|&(stage, name)| (stage, name.to_string(), ENTRY_POINT))
+            .collect(),
+        specialization: specialization.clone(),
+        sets: sets
+            .iter()
+            .map(|s| {
+                s.bindings
+                    .iter()
+                    .map(|&(b, k)| (b, k.descriptor_type()))
+                    .collect()
+            })
+            .collect(),
+        push_size,
+        fixed,
+    }
+}
+
+/// Every shader's entry point.
+const ENTRY_POINT: &CStr = c"main";
+
+/// Makes the shader modules of `stages`, calls `create` with their stage
+/// infos (specialised by `specialization`) and a new pipeline layout, and
+/// destroys the modules; on failure the layout too.
+fn create_with_stages(
+    ctx: &Context,
+    stages: &[(vk::ShaderStageFlags, &str)],
+    specialization: &Specialization,
+    sets: &[&DescriptorSetLayout],
+    push_size: u32,
+    create: impl FnOnce(
+        &[vk::PipelineShaderStageCreateInfo],
+        vk::PipelineLayout,
+    ) -> Result<Vec<vk::Pipeline>, (Vec<vk::Pipeline>, vk::Result)>,
+) -> VkResult<(vk::Pipeline, vk::PipelineLayout)> {
+    let mut modules = Vec::with_capacity(stages.len());
+    for &(stage, name) in stages {
+        match shader_module(ctx, name) {
+            Ok(m) => modules.push((stage, m)),
+            Err(e) => {
+                for (_, m) in modules {
+                    unsafe { ctx.device.destroy_shader_module(m, None) };
+                }
+                return Err(e);
+            }
+        }
+    }
+    let (map, data) = specialization.raw();
+    let spec_info = vk::SpecializationInfo::default()
+        .map_entries(&map)
+        .data(&data);
+    let infos: Vec<_> = modules
+        .iter()
+        .map(|&(stage, module)| {
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(stage)
+                .module(module)
+                .name(ENTRY_POINT)
+                .specialization_info(&spec_info)
+        })
+        .collect();
+    let result =
+        pipeline_layout(ctx, sets, push_size).and_then(|layout| match create(&infos, layout) {
+            Ok(p) => Ok((p[0], layout)),
+            Err((_, e)) => {
+                unsafe { ctx.device.destroy_pipeline_layout(layout, None) };
+                Err(e.into())
+            }
+        });
+    for (_, m) in modules {
+        unsafe { ctx.device.destroy_shader_module(m, None) };
+    }
+    result
+}
+
 fn bind_sets(
     ctx: &Context,
     cmd: vk::CommandBuffer,
@@ -243,7 +331,12 @@ fn push(ctx: &Context, cmd: vk::CommandBuffer, layout: vk::PipelineLayout, data:
     }
 }
 
+/// A compute pipeline; equal ones are shared through the context's
+/// `PipelineStore`.
 pub struct ComputePipeline {
+    // Declared before `ctx`: fields drop in order, and the shared pipeline
+    // must go while the device it was made on is still held.
+    _shared: Arc<SharedPipeline>,
     ctx: Arc<Context>,
     pub raw: vk::Pipeline,
     pub layout: vk::PipelineLayout,
@@ -258,32 +351,41 @@ impl ComputePipeline {
         sets: &[&DescriptorSetLayout],
         push_size: u32,
     ) -> VkResult<Self> {
-        let module = shader_module(ctx, shader)?;
-        let layout = pipeline_layout(ctx, sets, push_size)?;
-        let stage = vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::COMPUTE)
-            .module(module)
-            .name(c"main");
-        let info = vk::ComputePipelineCreateInfo::default()
-            .stage(stage)
-            .layout(layout);
-        let result = unsafe {
-            ctx.device
-                .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
-        };
-        unsafe { ctx.device.destroy_shader_module(module, None) };
-        let raw = match result {
-            Ok(p) => p[0],
-            Err((_, e)) => {
-                unsafe { ctx.device.destroy_pipeline_layout(layout, None) };
-                return Err(e.into());
-            }
-        };
-        ctx.set_name(raw, shader);
+        Self::specialized(ctx, shader, &Specialization::new(), sets, push_size)
+    }
+
+    /// As `new`, with specialisation constants.
+    pub fn specialized(
+        ctx: &Arc<Context>,
+        shader: &str,
+        specialization: &Specialization,
+        sets: &[&DescriptorSetLayout],
+        push_size: u32,
+    ) -> VkResult<Self> {
+        let stages = [(vk::ShaderStageFlags::COMPUTE, shader)];
+        let key = pipeline_key(&stages, specialization, sets, push_size, None);
+        let shared = ctx.pipelines().get_or_create(key, |cache| {
+            let (raw, layout) = create_with_stages(
+                ctx,
+                &stages,
+                specialization,
+                sets,
+                push_size,
+                |infos, layout| {
+                    let info = vk::ComputePipelineCreateInfo::default()
+                        .stage(infos[0])
+                        .layout(layout);
+                    unsafe { ctx.device.create_compute_pipelines(cache, &[info], None) }
+                },
+            )?;
+            ctx.set_name(raw, shader);
+            Ok((raw, layout))
+        })?;
         Ok(Self {
+            raw: shared.raw,
+            layout: shared.layout,
+            _shared: shared,
             ctx: ctx.clone(),
-            raw,
-            layout,
             name: shader.to_string(),
         })
     }
@@ -310,15 +412,6 @@ impl ComputePipeline {
     }
 }
 
-impl Drop for ComputePipeline {
-    fn drop(&mut self) {
-        unsafe {
-            self.ctx.device.destroy_pipeline(self.raw, None);
-            self.ctx.device.destroy_pipeline_layout(self.layout, None);
-        }
-    }
-}
-
 /// How a graphics pipeline is built. Geometry comes from storage buffers
 /// (vertex pulling), so there is no vertex input state.
 #[derive(Clone, Debug)]
@@ -335,6 +428,8 @@ pub struct GraphicsPipelineDesc<'a> {
     pub cull: vk::CullModeFlags,
     pub topology: vk::PrimitiveTopology,
     pub push_size: u32,
+    /// Specialisation constants, the same for every stage.
+    pub specialization: Specialization,
 }
 
 impl<'a> GraphicsPipelineDesc<'a> {
@@ -351,11 +446,16 @@ impl<'a> GraphicsPipelineDesc<'a> {
             cull: vk::CullModeFlags::NONE,
             topology: vk::PrimitiveTopology::TRIANGLE_LIST,
             push_size: 0,
+            specialization: Specialization::new(),
         }
     }
 }
 
+/// A graphics pipeline; equal ones are shared through the context's
+/// `PipelineStore`.
 pub struct GraphicsPipeline {
+    // Before `ctx`, as in `ComputePipeline`.
+    _shared: Arc<SharedPipeline>,
     ctx: Arc<Context>,
     pub raw: vk::Pipeline,
     pub layout: vk::PipelineLayout,
@@ -367,95 +467,44 @@ impl GraphicsPipeline {
         desc: &GraphicsPipelineDesc,
         sets: &[&DescriptorSetLayout],
     ) -> VkResult<Self> {
-        let mut modules = vec![(
-            vk::ShaderStageFlags::VERTEX,
-            shader_module(ctx, desc.vertex)?,
-        )];
+        let mut stages = vec![(vk::ShaderStageFlags::VERTEX, desc.vertex)];
         if let Some(g) = desc.geometry {
-            modules.push((vk::ShaderStageFlags::GEOMETRY, shader_module(ctx, g)?));
+            stages.push((vk::ShaderStageFlags::GEOMETRY, g));
         }
-        modules.push((
-            vk::ShaderStageFlags::FRAGMENT,
-            shader_module(ctx, desc.fragment)?,
-        ));
-        let stages: Vec<_> = modules
-            .iter()
-            .map(|&(stage, module)| {
-                vk::PipelineShaderStageCreateInfo::default()
-                    .stage(stage)
-                    .module(module)
-                    .name(c"main")
-            })
-            .collect();
-        let layout = pipeline_layout(ctx, sets, desc.push_size)?;
-        let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
-        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(desc.topology);
-        let viewport = vk::PipelineViewportStateCreateInfo::default()
-            .viewport_count(1)
-            .scissor_count(1);
-        let raster = vk::PipelineRasterizationStateCreateInfo::default()
-            .polygon_mode(vk::PolygonMode::FILL)
-            .cull_mode(desc.cull)
-            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
-            .line_width(1.0);
-        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
-        let depth = vk::PipelineDepthStencilStateCreateInfo::default()
-            .depth_test_enable(desc.depth_test)
-            .depth_write_enable(desc.depth_write)
-            .depth_compare_op(vk::CompareOp::LESS_OR_EQUAL);
-        let attachment = if desc.additive {
-            vk::PipelineColorBlendAttachmentState::default()
-                .blend_enable(true)
-                .src_color_blend_factor(vk::BlendFactor::ONE)
-                .dst_color_blend_factor(vk::BlendFactor::ONE)
-                .color_blend_op(vk::BlendOp::ADD)
-                .src_alpha_blend_factor(vk::BlendFactor::ONE)
-                .dst_alpha_blend_factor(vk::BlendFactor::ONE)
-                .alpha_blend_op(vk::BlendOp::ADD)
-                .color_write_mask(vk::ColorComponentFlags::RGBA)
-        } else {
-            vk::PipelineColorBlendAttachmentState::default()
-                .color_write_mask(vk::ColorComponentFlags::RGBA)
+        stages.push((vk::ShaderStageFlags::FRAGMENT, desc.fragment));
+        let fixed = FixedState {
+            color_formats: desc.color_formats.clone(),
+            depth_format: desc.depth_format,
+            depth_test: desc.depth_test,
+            depth_write: desc.depth_write,
+            additive: desc.additive,
+            cull: desc.cull,
+            topology: desc.topology,
         };
-        let attachments = vec![attachment; desc.color_formats.len()];
-        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
-        let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
-        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
-        let mut rendering = vk::PipelineRenderingCreateInfo::default()
-            .color_attachment_formats(&desc.color_formats)
-            .depth_attachment_format(desc.depth_format.unwrap_or(vk::Format::UNDEFINED));
-        let info = vk::GraphicsPipelineCreateInfo::default()
-            .stages(&stages)
-            .vertex_input_state(&vertex_input)
-            .input_assembly_state(&assembly)
-            .viewport_state(&viewport)
-            .rasterization_state(&raster)
-            .multisample_state(&multisample)
-            .depth_stencil_state(&depth)
-            .color_blend_state(&blend)
-            .dynamic_state(&dynamic)
-            .layout(layout)
-            .push_next(&mut rendering);
-        let result = unsafe {
-            ctx.device
-                .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
-        };
-        for (_, m) in modules {
-            unsafe { ctx.device.destroy_shader_module(m, None) };
-        }
-        let raw = match result {
-            Ok(p) => p[0],
-            Err((_, e)) => {
-                unsafe { ctx.device.destroy_pipeline_layout(layout, None) };
-                return Err(e.into());
-            }
-        };
-        ctx.set_name(raw, desc.fragment);
+        let key = pipeline_key(
+            &stages,
+            &desc.specialization,
+            sets,
+            desc.push_size,
+            Some(fixed),
+        );
+        let shared = ctx.pipelines().get_or_create(key, |cache| {
+            let (raw, layout) = create_with_stages(
+                ctx,
+                &stages,
+                &desc.specialization,
+                sets,
+                desc.push_size,
+                |infos, layout| create_graphics(ctx, desc, infos, layout, cache),
+            )?;
+            ctx.set_name(raw, desc.fragment);
+            Ok((raw, layout))
+        })?;
         Ok(Self {
+            raw: shared.raw,
+            layout: shared.layout,
+            _shared: shared,
             ctx: ctx.clone(),
-            raw,
-            layout,
         })
     }
 
@@ -494,13 +543,66 @@ impl GraphicsPipeline {
     }
 }
 
-impl Drop for GraphicsPipeline {
-    fn drop(&mut self) {
-        unsafe {
-            self.ctx.device.destroy_pipeline(self.raw, None);
-            self.ctx.device.destroy_pipeline_layout(self.layout, None);
-        }
-    }
+/// Creates a graphics pipeline of `stages` with `desc`'s fixed-function
+/// state; dynamic rendering into `desc`'s formats, viewport and scissor
+/// dynamic.
+fn create_graphics(
+    ctx: &Context,
+    desc: &GraphicsPipelineDesc,
+    stages: &[vk::PipelineShaderStageCreateInfo],
+    layout: vk::PipelineLayout,
+    cache: vk::PipelineCache,
+) -> Result<Vec<vk::Pipeline>, (Vec<vk::Pipeline>, vk::Result)> {
+    let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
+    let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(desc.topology);
+    let viewport = vk::PipelineViewportStateCreateInfo::default()
+        .viewport_count(1)
+        .scissor_count(1);
+    let raster = vk::PipelineRasterizationStateCreateInfo::default()
+        .polygon_mode(vk::PolygonMode::FILL)
+        .cull_mode(desc.cull)
+        .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+        .line_width(1.0);
+    let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+        .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+        .depth_test_enable(desc.depth_test)
+        .depth_write_enable(desc.depth_write)
+        .depth_compare_op(vk::CompareOp::LESS_OR_EQUAL);
+    let attachment = if desc.additive {
+        vk::PipelineColorBlendAttachmentState::default()
+            .blend_enable(true)
+            .src_color_blend_factor(vk::BlendFactor::ONE)
+            .dst_color_blend_factor(vk::BlendFactor::ONE)
+            .color_blend_op(vk::BlendOp::ADD)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+            .alpha_blend_op(vk::BlendOp::ADD)
+            .color_write_mask(vk::ColorComponentFlags::RGBA)
+    } else {
+        vk::PipelineColorBlendAttachmentState::default()
+            .color_write_mask(vk::ColorComponentFlags::RGBA)
+    };
+    let attachments = vec![attachment; desc.color_formats.len()];
+    let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
+    let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+    let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+    let mut rendering = vk::PipelineRenderingCreateInfo::default()
+        .color_attachment_formats(&desc.color_formats)
+        .depth_attachment_format(desc.depth_format.unwrap_or(vk::Format::UNDEFINED));
+    let info = vk::GraphicsPipelineCreateInfo::default()
+        .stages(stages)
+        .vertex_input_state(&vertex_input)
+        .input_assembly_state(&assembly)
+        .viewport_state(&viewport)
+        .rasterization_state(&raster)
+        .multisample_state(&multisample)
+        .depth_stencil_state(&depth)
+        .color_blend_state(&blend)
+        .dynamic_state(&dynamic)
+        .layout(layout)
+        .push_next(&mut rendering);
+    unsafe { ctx.device.create_graphics_pipelines(cache, &[info], None) }
 }
 
 /// Begins dynamic rendering into `colors` (cleared to `clear` when given) and an optional depth image (cleared to 1).
