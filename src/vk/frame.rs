@@ -21,7 +21,8 @@
 //!   a rewrite during recording first calls `FrameRecorder::wait_for_other_frames`.
 //!
 //! Timing (GUIDE §8): on a GPU, timestamp pairs around each pass in the
-//! frame's command buffer, read when its fence has signalled. On a CPU device
+//! frame's command buffer, copied into its ring by that command buffer and
+//! read when its fence has signalled. On a CPU device
 //! whose timestamps miss compute, the frame is timed by the host clock
 //! (submit to observed completion), frames still overlap, and per-pass numbers
 //! come only on request (`per_pass`): one submission per pass, each waited for.
