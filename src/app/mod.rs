@@ -214,6 +214,7 @@ impl App {
             report_at: now + Duration::from_secs(1),
             report_from: now,
             waited_from: Duration::ZERO,
+            swapchain_wait: Duration::ZERO,
             screenshots: 0,
         };
         state.recreate(o.present_mode)?;

@@ -58,6 +58,10 @@ pub(super) struct State {
     pub(super) report_from: Instant,
     /// `Frames::host_wait` at `report_from`.
     pub(super) waited_from: Duration,
+    /// Host time in vkAcquireNextImageKHR and vkQueuePresentKHR since
+    /// `report_from` (a software presentation engine may wait there for
+    /// the frame's rendering).
+    pub(super) swapchain_wait: Duration,
     pub(super) screenshots: u32,
 }
 
@@ -227,6 +231,7 @@ impl State {
         let finished = &self.finished;
         let stale = &mut self.stale;
         let mut presented = None;
+        let mut in_swapchain = Duration::ZERO;
         // One command buffer per frame: technique, tonemap, then the blit
         // (and overlay) to the acquired image. `submit_frame_with` first waits
         // for the fence of the frame that last used this slot, which frees
@@ -236,7 +241,10 @@ impl State {
             self.time,
             |rec, display| -> anyhow::Result<FrameSync> {
                 let acquired = rec.acquire_semaphore();
-                let index = match swapchain.acquire(acquired)? {
+                let acquiring = Instant::now();
+                let result = swapchain.acquire(acquired)?;
+                in_swapchain += acquiring.elapsed();
+                let index = match result {
                     Acquired::Image { index, suboptimal } => {
                         *stale |= suboptimal;
                         index
@@ -286,7 +294,9 @@ impl State {
             return Ok(false);
         };
         let swapchain = self.swapchain.as_ref().expect("swapchain");
+        let presenting = Instant::now();
         self.stale |= swapchain.present(index, self.finished.raw[index as usize])?;
+        self.swapchain_wait += in_swapchain + presenting.elapsed();
         self.presented += 1;
         self.frame_ms.push(start.elapsed().as_secs_f64() * 1e3);
         if Instant::now() >= self.report_at {
@@ -309,6 +319,8 @@ impl State {
         let waited = self.renderer.frames.host_wait;
         let wait_ms = (waited - self.waited_from).as_secs_f64() * 1e3 / n;
         self.waited_from = waited;
+        let swapchain_ms = self.swapchain_wait.as_secs_f64() * 1e3 / n;
+        self.swapchain_wait = Duration::ZERO;
         let mut passes: Vec<(String, f64, usize)> = Vec::new();
         for t in self.timings.iter().flatten() {
             match passes.iter_mut().find(|p| p.0 == t.name) {
@@ -321,13 +333,14 @@ impl State {
         }
         let r = &self.renderer;
         println!(
-            "{} {}x{}: {:.2} ms/frame render+present, {:.2} ms frame interval, {:.2} ms/frame host wait, over {} frame(s), {} in flight ({})",
+            "{} {}x{}: {:.2} ms/frame render+present, {:.2} ms frame interval, {:.2} ms/frame host wait on fences, {:.2} ms/frame in acquire+present, over {} frame(s), {} in flight ({})",
             r.technique_name(),
             r.targets.width,
             r.targets.height,
             frame_ms,
             interval_ms,
             wait_ms,
+            swapchain_ms,
             self.frame_ms.len(),
             r.frames.frames_in_flight(),
             r.frames.source.describe()

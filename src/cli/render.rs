@@ -156,6 +156,7 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
     }
     renderer.finish()?;
     let waited_before = renderer.frames.host_wait;
+    let submit_before = renderer.frames.host_submit;
     let start = Instant::now();
     for i in 0..frames {
         renderer.submit_frame(scene.time + (warmup + i) as f32 / 60.0)?;
@@ -165,6 +166,8 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
     // frame costs when frames overlap.
     let interval_ms = start.elapsed().as_secs_f64() * 1e3 / frames as f64;
     let wait_ms = (renderer.frames.host_wait - waited_before).as_secs_f64() * 1e3 / frames as f64;
+    let submit_ms =
+        (renderer.frames.host_submit - submit_before).as_secs_f64() * 1e3 / frames as f64;
     let (device_name, driver) = (ctx.info.name.clone(), ctx.info.driver.trim().to_string());
     let (source, stats) = (renderer.frames.source, renderer.scene_gpu.stats);
     let in_flight = renderer.frames.frames_in_flight();
@@ -208,6 +211,10 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
         "  {:<28} {:>9.3} ms per frame (host blocked on fences)",
         "host wait", wait_ms
     );
+    println!(
+        "  {:<28} {:>9.3} ms per frame (host inside vkQueueSubmit2)",
+        "host submit", submit_ms
+    );
     if let Some(path) = json {
         let report = serde_json::json!({
             "device": device_name,
@@ -225,6 +232,7 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
             "frame_ms": interval_ms,
             "submit_to_done_ms": median(&submit_to_done),
             "host_wait_ms": wait_ms,
+            "host_submit_ms": submit_ms,
             "geometry": stats,
             "counters": counters,
         });

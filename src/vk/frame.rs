@@ -21,7 +21,8 @@
 //!   a rewrite during recording first calls `FrameRecorder::wait_for_other_frames`.
 //!
 //! Timing (GUIDE §8): on a GPU, timestamp pairs around each pass in the
-//! frame's command buffer, read when its fence has signalled. On a CPU device
+//! frame's command buffer, copied into its ring by that command buffer and
+//! read when its fence has signalled. On a CPU device
 //! whose timestamps miss compute, the frame is timed by the host clock
 //! (submit to observed completion), frames still overlap, and per-pass numbers
 //! come only on request (`per_pass`): one submission per pass, each waited for.
@@ -116,7 +117,8 @@ const RING_ALIGN: u64 = 256;
 const RING_MIN: u64 = 64 * 1024;
 
 impl Ring {
-    fn alloc(&mut self, ctx: &Arc<Context>, bytes: &[u8]) -> VkResult<(vk::Buffer, u64)> {
+    /// Copies `bytes` into the ring; returns the chunk's index, its buffer and the offset.
+    fn alloc(&mut self, ctx: &Arc<Context>, bytes: &[u8]) -> VkResult<(usize, vk::Buffer, u64)> {
         let size = bytes.len() as u64;
         let offset = self.used.next_multiple_of(RING_ALIGN);
         let fits = self.chunks.last().is_some_and(|c| offset + size <= c.size);
@@ -136,7 +138,7 @@ impl Ring {
         let chunk = self.chunks.last().expect("a chunk");
         chunk.write_at(offset, bytes);
         self.used = offset + size;
-        Ok((chunk.raw, offset))
+        Ok((self.chunks.len() - 1, chunk.raw, offset))
     }
 
     fn reset(&mut self, ctx: &Arc<Context>) -> VkResult<()> {
@@ -153,6 +155,9 @@ impl Ring {
 
 struct Pending {
     names: Vec<String>,
+    /// Where in the ring the frame's command buffer copied its timestamps
+    /// (chunk, offset).
+    ticks: Option<(usize, u64)>,
     wall_ms: Vec<f64>,
     submitted: Instant,
 }
@@ -180,6 +185,10 @@ pub struct Frames {
     /// Host time spent in `begin_frame` waiting for a slot's fence, and in
     /// `wait_all`, since creation.
     pub host_wait: Duration,
+    /// Host time spent inside vkQueueSubmit2 since creation (a CPU driver
+    /// may block there: lavapipe runs the submission's work before
+    /// returning when its queue is busy).
+    pub host_submit: Duration,
 }
 
 impl Frames {
@@ -198,6 +207,7 @@ impl Frames {
             max_passes: options.max_passes,
             source,
             host_wait: Duration::ZERO,
+            host_submit: Duration::ZERO,
         };
         for _ in 0..n {
             let slot = frames.new_slot()?;
@@ -336,9 +346,14 @@ impl Frames {
                 .zip(pending.wall_ms)
                 .map(|(name, ms)| PassTiming { name, ms })
                 .collect(),
-            TimingSource::Timestamps | TimingSource::FrameClock => {
-                read_timestamps(&ctx, slot.queries, pending.names)?
-            }
+            TimingSource::Timestamps | TimingSource::FrameClock => match pending.ticks {
+                Some((chunk, offset)) => {
+                    let bytes = slot.ring.chunks[chunk].read_at(offset, pending.names.len() * 16);
+                    let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&bytes);
+                    timings(&ctx, pending.names, &ticks)
+                }
+                None => Vec::new(),
+            },
         };
         Ok(FrameTiming {
             slot: index,
@@ -367,29 +382,14 @@ impl Frames {
     }
 }
 
-fn read_timestamps(
-    ctx: &Context,
-    pool: vk::QueryPool,
-    names: Vec<String>,
-) -> VkResult<Vec<PassTiming>> {
-    if names.is_empty() {
-        return Ok(Vec::new());
-    }
-    let mut ticks = vec![0u64; names.len() * 2];
-    unsafe {
-        ctx.device.get_query_pool_results(
-            pool,
-            0,
-            &mut ticks,
-            vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
-        )
-    }?;
+/// Pass times from each pass's pair of raw timestamps.
+fn timings(ctx: &Context, names: Vec<String>, ticks: &[u64]) -> Vec<PassTiming> {
     let mask = if ctx.timestamp_valid_bits >= 64 {
         u64::MAX
     } else {
         (1u64 << ctx.timestamp_valid_bits) - 1
     };
-    Ok(names
+    names
         .into_iter()
         .enumerate()
         .map(|(i, name)| {
@@ -400,7 +400,7 @@ fn read_timestamps(
                 ms: delta as f64 * ctx.timestamp_period * 1e-6,
             }
         })
-        .collect())
+        .collect()
 }
 
 impl Drop for Frames {
@@ -522,7 +522,7 @@ impl FrameRecorder<'_> {
             "upload larger than its buffer"
         );
         let ctx = self.frames.ctx.clone();
-        let (src, offset) = match self.frames.slots[self.slot].ring.alloc(&ctx, bytes) {
+        let (_, src, offset) = match self.frames.slots[self.slot].ring.alloc(&ctx, bytes) {
             Ok(a) => a,
             Err(e) => {
                 self.error = Some(e);
@@ -585,12 +585,51 @@ impl FrameRecorder<'_> {
         }
     }
 
+    /// Records the copy of the frame's timestamps into its ring, read by the
+    /// host after the fence. Not vkGetQueryPoolResults: lavapipe's waits for
+    /// everything submitted, which made the host wait for the next frame in
+    /// flight too (measured 110-130 ms per frame at 256x256 with 2 in flight).
+    fn copy_timestamps(&mut self) -> VkResult<Option<(usize, u64)>> {
+        let count = self.names.len() as u32 * 2;
+        if self.per_pass() || count == 0 {
+            return Ok(None);
+        }
+        let ctx = self.frames.ctx.clone();
+        let slot = &mut self.frames.slots[self.slot];
+        let zeros = vec![0u8; count as usize * 8];
+        let (chunk, buffer, offset) = slot.ring.alloc(&ctx, &zeros)?;
+        unsafe {
+            // WAIT: the copy waits for the timestamps to be written.
+            ctx.device.cmd_copy_query_pool_results(
+                slot.cmd,
+                slot.queries,
+                0,
+                count,
+                buffer,
+                offset,
+                8,
+                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+            );
+            let to_host = vk::MemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::COPY)
+                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+                .dst_access_mask(vk::AccessFlags2::HOST_READ);
+            ctx.device.cmd_pipeline_barrier2(
+                slot.cmd,
+                &vk::DependencyInfo::default().memory_barriers(&[to_host]),
+            );
+        }
+        Ok(Some((chunk, offset)))
+    }
+
     /// Ends and submits the frame without waiting for it. Returns the
     /// recording's first error, if any (the frame is still submitted, so its
     /// slot's fence signals).
     pub fn submit(mut self, sync: &FrameSync) -> VkResult<()> {
         let ctx = self.frames.ctx.clone();
         let index = self.slot;
+        let ticks = self.copy_timestamps()?;
         let slot = &mut self.frames.slots[index];
         unsafe { ctx.device.end_command_buffer(slot.cmd) }?;
         let waits = semaphore_infos(&sync.waits);
@@ -600,8 +639,11 @@ impl FrameRecorder<'_> {
             .wait_semaphore_infos(&waits)
             .command_buffer_infos(&cmds)
             .signal_semaphore_infos(&signals);
+        let start = Instant::now();
         unsafe { ctx.device.queue_submit2(ctx.queue, &[submit], slot.fence) }?;
+        self.frames.host_submit += start.elapsed();
         slot.pending = Some(Pending {
+            ticks,
             names: std::mem::take(&mut self.names),
             wall_ms: std::mem::take(&mut self.wall_ms),
             submitted: Instant::now(),

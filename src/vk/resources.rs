@@ -22,7 +22,8 @@ pub enum BufferUsage {
     Uniform,
     /// Host-visible buffer the GPU copies into for the CPU to read.
     Readback,
-    /// Host-visible staging buffer the CPU writes for the GPU to copy from.
+    /// Host-visible staging buffer the CPU writes for the GPU to copy from
+    /// (and the upload ring, which the GPU also copies timestamps into).
     Upload,
 }
 
@@ -55,7 +56,8 @@ impl Buffer {
                 MemoryLocation::GpuOnly,
             ),
             BufferUsage::Readback => (vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu),
-            BufferUsage::Upload => (vk::BufferUsageFlags::TRANSFER_SRC, MemoryLocation::CpuToGpu),
+            // Also a copy destination: frames copy their timestamps into the ring.
+            BufferUsage::Upload => (transfer, MemoryLocation::CpuToGpu),
         };
         let info = vk::BufferCreateInfo::default()
             .size(size)
@@ -159,6 +161,17 @@ impl Buffer {
         unsafe {
             std::ptr::copy_nonoverlapping(bytes.as_ptr(), dst.add(offset as usize), bytes.len())
         };
+    }
+
+    /// Reads `len` bytes at `offset` of a host-visible buffer (the upload
+    /// ring; the caller has waited for the GPU's writes there).
+    pub(super) fn read_at(&self, offset: u64, len: usize) -> Vec<u8> {
+        let src = self.mapped().expect("a host-visible buffer");
+        assert!(offset + len as u64 <= self.size);
+        let mut out = vec![0u8; len];
+        // SAFETY: in bounds (asserted); host-coherent memory.
+        unsafe { std::ptr::copy_nonoverlapping(src.add(offset as usize), out.as_mut_ptr(), len) };
+        out
     }
 
     /// Reads the whole buffer back to the host (blocking).
