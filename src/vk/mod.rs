@@ -6,7 +6,9 @@
 //! Lifetime model: every object is owned by a Rust value and destroyed by its
 //! `Drop`. Values hold an `Arc` of the device, so the device outlives them.
 //! The renderer waits for the frame's fence before it drops anything that
-//! frame used, so `Drop` never frees what the GPU may still read.
+//! frame used, so `Drop` never frees what the GPU may still read. Pipelines
+//! are shared: equal ones come from the context's `PipelineStore` and are
+//! destroyed when the last holder (or the store's short keep list) lets go.
 
 mod context;
 mod device;
