@@ -113,8 +113,15 @@ fn main() -> anyhow::Result<()> {
             let changed = resolve(technique, &[change])?;
             for mode in [Mode::None, Mode::Cache, Mode::Reuse] {
                 mode.apply(&ctx);
+                let created = ctx.pipelines().counts().created;
                 let mut r =
                     Renderer::new(&ctx, scene.clone(), technique, &defaults, size, size, 0.0)?;
+                if matches!(mode, Mode::None) && change == live {
+                    println!(
+                        "{technique}: {} pipelines per build (tonemap included)",
+                        ctx.pipelines().counts().created - created
+                    );
+                }
                 // Warm: the first frame pays first-use costs no change should.
                 if frames {
                     r.render_frame(0.0)?;

@@ -8,6 +8,9 @@
 //! Whatever a frame in flight may still use is handed to
 //! `Frames::defer_release` and dropped after that frame's fence
 //! (`vk/frame.rs`), so `Drop` never frees what the GPU may still read.
+//! Pipelines are shared: equal ones come from the context's `PipelineStore`
+//! and are destroyed when the last holder (or the store's short keep list)
+//! lets go.
 
 mod context;
 mod device;

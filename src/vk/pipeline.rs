@@ -2,7 +2,7 @@
 //! graphics pipelines. Bindings are declared by number (constants shared with
 //! GLSL through `shader_bindings.rs`), never by call order.
 
-use super::pipeline_store::{FixedState, PipelineKey, SharedPipeline, Specialization};
+use super::pipeline_store::{PipelineKey, SharedPipeline, Specialization, Stages};
 use super::{Buffer, Context, Image, VkResult};
 use crate::shaders;
 use ash::vk;
@@ -225,17 +225,13 @@ fn pipeline_layout(
 /// The store's key for a pipeline of `stages` over `sets` (see
 /// `pipeline_store`): the set layouts by description, not by handle.
 fn pipeline_key(
-    stages: &[(vk::ShaderStageFlags, &str)],
+    stages: Stages,
     specialization: &Specialization,
     sets: &[&DescriptorSetLayout],
     push_size: u32,
-    fixed: Option<FixedState>,
 ) -> PipelineKey {
     PipelineKey {
-        stages: stages
-            .iter()
-            .map(|&(stage, name)| (stage, name.to_string(), ENTRY_POINT))
-            .collect(),
+        stages,
         specialization: specialization.clone(),
         sets: sets
             .iter()
@@ -247,7 +243,6 @@ fn pipeline_key(
             })
             .collect(),
         push_size,
-        fixed,
     }
 }
 
@@ -363,7 +358,12 @@ impl ComputePipeline {
         push_size: u32,
     ) -> VkResult<Self> {
         let stages = [(vk::ShaderStageFlags::COMPUTE, shader)];
-        let key = pipeline_key(&stages, specialization, sets, push_size, None);
+        let key = pipeline_key(
+            Stages::Compute(shader.to_string()),
+            specialization,
+            sets,
+            push_size,
+        );
         let shared = ctx.pipelines().get_or_create(key, |cache| {
             let (raw, layout) = create_with_stages(
                 ctx,
@@ -414,7 +414,7 @@ impl ComputePipeline {
 
 /// How a graphics pipeline is built. Geometry comes from storage buffers
 /// (vertex pulling), so there is no vertex input state.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct GraphicsPipelineDesc<'a> {
     pub vertex: &'a str,
     pub geometry: Option<&'a str>,
@@ -462,9 +462,11 @@ pub struct GraphicsPipeline {
 }
 
 impl GraphicsPipeline {
+    /// Shader paths are `'static` (they name SPIR-V embedded at build
+    /// time), so the description itself serves as the store's key.
     pub fn new(
         ctx: &Arc<Context>,
-        desc: &GraphicsPipelineDesc,
+        desc: &GraphicsPipelineDesc<'static>,
         sets: &[&DescriptorSetLayout],
     ) -> VkResult<Self> {
         let mut stages = vec![(vk::ShaderStageFlags::VERTEX, desc.vertex)];
@@ -472,21 +474,11 @@ impl GraphicsPipeline {
             stages.push((vk::ShaderStageFlags::GEOMETRY, g));
         }
         stages.push((vk::ShaderStageFlags::FRAGMENT, desc.fragment));
-        let fixed = FixedState {
-            color_formats: desc.color_formats.clone(),
-            depth_format: desc.depth_format,
-            depth_test: desc.depth_test,
-            depth_write: desc.depth_write,
-            additive: desc.additive,
-            cull: desc.cull,
-            topology: desc.topology,
-        };
         let key = pipeline_key(
-            &stages,
+            Stages::Graphics(desc.clone()),
             &desc.specialization,
             sets,
             desc.push_size,
-            Some(fixed),
         );
         let shared = ctx.pipelines().get_or_create(key, |cache| {
             let (raw, layout) = create_with_stages(

@@ -9,8 +9,8 @@
 //! pipeline when nothing that reaches the driver changed.
 //!
 //! The key is everything `vkCreate*Pipelines` reads: each stage's shader (its
-//! path under glsl/, which names one SPIR-V blob embedded at build time) and
-//! entry point, the specialisation constants, the pipeline layout's
+//! path under glsl/, which names one SPIR-V blob embedded at build time; the
+//! entry point is always `main`), the specialisation constants, the pipeline layout's
 //! description (each set's bindings, the push-constant size) and, for
 //! graphics, the fixed-function state and attachment formats. The layout is
 //! keyed by description, not by `VkDescriptorSetLayout` handle: a rebuilt
@@ -30,6 +30,7 @@
 //! it at start (`load`, `save`), after checking its header against this
 //! device.
 
+use super::pipeline::GraphicsPipelineDesc;
 use super::VkResult;
 use ash::vk;
 use std::collections::{HashMap, VecDeque};
@@ -97,29 +98,24 @@ impl Specialization {
 }
 
 /// What a pipeline is created from (see the module comment). Built by
-/// `pipeline.rs` from the same arguments it passes to the driver.
+/// `pipeline.rs` from the same arguments it passes to the driver. The entry
+/// point is `main` for every shader, so it is not part of the key.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub(super) struct PipelineKey {
-    /// (stage, shader path under glsl/, entry point) of each stage.
-    pub stages: Vec<(vk::ShaderStageFlags, String, &'static std::ffi::CStr)>,
+    pub stages: Stages,
     pub specialization: Specialization,
     /// Each set's (binding, descriptor type) list, in set order.
     pub sets: Vec<Vec<(u32, vk::DescriptorType)>>,
     pub push_size: u32,
-    /// Graphics only: the fixed-function state and attachment formats, in
-    /// the order `GraphicsPipelineDesc` declares them.
-    pub fixed: Option<FixedState>,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
-pub(super) struct FixedState {
-    pub color_formats: Vec<vk::Format>,
-    pub depth_format: Option<vk::Format>,
-    pub depth_test: bool,
-    pub depth_write: bool,
-    pub additive: bool,
-    pub cull: vk::CullModeFlags,
-    pub topology: vk::PrimitiveTopology,
+pub(super) enum Stages {
+    /// The compute shader's path under glsl/.
+    Compute(String),
+    /// The whole description: shader paths, fixed-function state,
+    /// attachment formats.
+    Graphics(GraphicsPipelineDesc<'static>),
 }
 
 /// A pipeline and its layout, shared by every technique that asked for the
