@@ -70,6 +70,6 @@ $bin info | sed -n 1p
 start=$(date +%s.%N)
 RUST_LOG=caustics=info /usr/bin/time -f "peak resident memory: %M KiB" \
   $bin render --scene "$glb" --technique direct --width 256 --height 256 --frames 1 \
-  --out out/bench/gltf_first_frame.png 2>&1 | grep -E "loaded in|on the device|direct at|total|geometry|peak|error"
+  --out out/bench/gltf_first_frame.png 2>&1 | grep -E "^  |loaded in|on the device|direct at|geometry|peak|error"
 end=$(date +%s.%N)
-echo "whole command (process start to images written): $(echo "($end - $start) * 1000" | bc) ms"
+printf "whole command (process start to images written): %.0f ms\n" "$(echo "($end - $start) * 1000" | bc)"

@@ -39,7 +39,7 @@ struct DeviceArgs {
 
 #[derive(Args, Clone)]
 struct SceneArgs {
-    /// Scene file (TOML, docs/SCENES.md).
+    /// Scene file: TOML, or a glTF 2.0 file (.gltf/.glb) as a whole scene (docs/SCENES.md).
     #[arg(long, default_value = DEFAULT_SCENE)]
     scene: PathBuf,
     #[arg(long, default_value_t = 512)]
@@ -135,7 +135,7 @@ enum Command {
     },
     /// Open a window and render interactively (keys and mouse: README.md).
     Demo {
-        /// Scene file (TOML, docs/SCENES.md); R reloads it.
+        /// Scene file: TOML, or a glTF 2.0 file (.gltf/.glb) as a whole scene (docs/SCENES.md). R reloads it.
         #[arg(long, default_value = DEFAULT_SCENE)]
         scene: PathBuf,
         #[arg(long, default_value = "direct")]

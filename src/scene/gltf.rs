@@ -17,6 +17,7 @@ use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::mesh::Mode;
 use ::gltf::{json, Document, Semantic};
 use glam::{Mat3, Mat4, Vec2, Vec3};
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -131,7 +132,7 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
             .map_err(|e| fail("", format!("not a valid GLB container: {e}")))?;
         (glb.json, glb.bin)
     } else {
-        (std::borrow::Cow::Borrowed(&bytes[..]), None)
+        (Cow::Borrowed(&bytes[..]), None)
     };
     let root: json::Root = json::deserialize::from_slice(&json_bytes)
         .map_err(|e| fail("", format!("not valid glTF JSON: {e}")))?;
@@ -262,26 +263,26 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
 
 type Fail<'a> = &'a dyn Fn(&str, String) -> GltfError;
 
-/// Every buffer's bytes: the GLB chunk, a base64 `data:` URI or a file
-/// beside the glTF, at least `byteLength` long.
-fn read_buffers(
+/// Every buffer's bytes: the GLB chunk (borrowed, not copied), a base64
+/// `data:` URI or a file beside the glTF, at least `byteLength` long.
+fn read_buffers<'b>(
     document: &Document,
-    blob: Option<&[u8]>,
+    blob: Option<&'b [u8]>,
     dir: &Path,
     fail: Fail,
-) -> Result<Vec<Vec<u8>>, GltfError> {
+) -> Result<Vec<Cow<'b, [u8]>>, GltfError> {
     let mut out = Vec::new();
     for b in document.buffers() {
         let at = format!("buffers[{}]", b.index());
         let data = match b.source() {
-            ::gltf::buffer::Source::Bin => blob.map(<[u8]>::to_vec).ok_or_else(|| {
+            ::gltf::buffer::Source::Bin => blob.map(Cow::Borrowed).ok_or_else(|| {
                 fail(
                     &at,
                     "refers to the GLB binary chunk, but the file has none".into(),
                 )
             })?,
             ::gltf::buffer::Source::Uri(uri) => {
-                read_uri(uri, dir).map_err(|e| fail(&format!("{at}.uri"), e))?
+                Cow::Owned(read_uri(uri, dir).map_err(|e| fail(&format!("{at}.uri"), e))?)
             }
         };
         if data.len() < b.length() {
@@ -393,7 +394,7 @@ fn check_images(document: &Document, dir: &Path, fail: Fail) -> Result<(), GltfE
 
 struct Loader<'a> {
     fail: Fail<'a>,
-    buffers: &'a [Vec<u8>],
+    buffers: &'a [Cow<'a, [u8]>],
     file_name: String,
     dir: &'a Path,
     asset: GltfAsset,
@@ -494,7 +495,7 @@ impl Loader<'_> {
             .ok_or_else(|| (self.fail)(&pos_at, "missing".into()))?;
         self.check_accessor(&pos, &pos_at, Dimensions::Vec3, &[DataType::F32])?;
         let buffers = self.buffers;
-        let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d[..]));
         let positions: Vec<Vec3> = reader
             .read_positions()
             .ok_or_else(|| (self.fail)(&pos_at, "cannot be read".into()))?
