@@ -467,6 +467,25 @@ impl Loader<'_> {
         Ok(())
     }
 
+    /// A vertex attribute besides POSITION: a sound accessor of `n` elements.
+    fn check_attribute(
+        &self,
+        a: &::gltf::Accessor,
+        at: &str,
+        dims: Dimensions,
+        types: &[DataType],
+        n: usize,
+    ) -> Result<(), GltfError> {
+        self.check_accessor(a, at, dims, types)?;
+        if a.count() != n {
+            return Err((self.fail)(
+                at,
+                format!("has {} elements, POSITION has {n}", a.count()),
+            ));
+        }
+        Ok(())
+    }
+
     /// Appends one primitive, transformed by `world`, to the asset's mesh.
     fn primitive(
         &mut self,
@@ -511,13 +530,7 @@ impl Loader<'_> {
         let normals: Option<Vec<Vec3>> = match prim.get(&Semantic::Normals) {
             Some(acc) => {
                 let nat = at(".attributes.NORMAL");
-                self.check_accessor(&acc, &nat, Dimensions::Vec3, &[DataType::F32])?;
-                if acc.count() != n {
-                    return Err((self.fail)(
-                        &nat,
-                        format!("has {} elements, POSITION has {n}", acc.count()),
-                    ));
-                }
+                self.check_attribute(&acc, &nat, Dimensions::Vec3, &[DataType::F32], n)?;
                 let read = reader
                     .read_normals()
                     .ok_or_else(|| (self.fail)(&nat, "cannot be read".into()))?;
@@ -538,18 +551,8 @@ impl Loader<'_> {
         let uvs: Option<Vec<Vec2>> = match prim.get(&Semantic::TexCoords(0)) {
             Some(acc) => {
                 let tat = at(".attributes.TEXCOORD_0");
-                self.check_accessor(
-                    &acc,
-                    &tat,
-                    Dimensions::Vec2,
-                    &[DataType::F32, DataType::U8, DataType::U16],
-                )?;
-                if acc.count() != n {
-                    return Err((self.fail)(
-                        &tat,
-                        format!("has {} elements, POSITION has {n}", acc.count()),
-                    ));
-                }
+                let types = [DataType::F32, DataType::U8, DataType::U16];
+                self.check_attribute(&acc, &tat, Dimensions::Vec2, &types, n)?;
                 let read = reader
                     .read_tex_coords(0)
                     .ok_or_else(|| (self.fail)(&tat, "cannot be read".into()))?;

@@ -163,6 +163,11 @@ pub(super) fn object(t: &Tbl, index: usize, dir: &Path, materials: &mut Material
     };
     let material = material.unwrap_or_default();
     mesh.materials = vec![material; mesh.indices.len()];
+    placed(t, name, mesh)
+}
+
+/// An object of `mesh` with the table's `translate`/`rotate`/`scale` and `animate`.
+fn placed(t: &Tbl, name: String, mesh: Mesh) -> R<Object> {
     Ok(Object {
         name,
         mesh,
@@ -170,6 +175,23 @@ pub(super) fn object(t: &Tbl, index: usize, dir: &Path, materials: &mut Material
         animation: animation(t)?,
         water: None,
     })
+}
+
+/// A mesh read from a file: `material`, when set, replaces the file's
+/// materials; otherwise they join the scene's (`import_materials`).
+fn file_object(
+    t: &Tbl,
+    name: String,
+    mut mesh: Mesh,
+    material: Option<u32>,
+    imported: &[Material],
+    materials: &mut Materials,
+) -> R<Object> {
+    match material {
+        Some(m) => mesh.materials.iter_mut().for_each(|x| *x = m),
+        None => import_materials(t, &mut mesh, imported, materials)?,
+    }
+    placed(t, name, mesh)
 }
 
 fn mesh_object(
@@ -182,39 +204,28 @@ fn mesh_object(
     let rel = t.str("path")?;
     let full = dir.join(rel);
     let loaded = obj::load(&full).map_err(|e| t.err("path", e))?;
-    let mut mesh = loaded.mesh;
-    match material {
-        Some(m) => mesh.materials.iter_mut().for_each(|x| *x = m),
-        None => {
-            if let Some((mtl, why)) = loaded.mtl_errors.first() {
-                return Err(t.err(
-                    "path",
-                    format!(
-                        "cannot read MTL file {} named by OBJ file {}: {why} (set `material` on the object to ignore the MTL)",
-                        mtl.display(),
-                        full.display()
-                    ),
-                ));
-            }
-            if mesh.materials.contains(&obj::NO_MATERIAL) {
-                return Err(t.err(
-                    "material",
-                    format!(
-                        "OBJ file {} has faces without an MTL material: set `material` on the object",
-                        full.display()
-                    ),
-                ));
-            }
-            import_materials(t, &mut mesh, &loaded.materials, materials)?;
+    if material.is_none() {
+        if let Some((mtl, why)) = loaded.mtl_errors.first() {
+            return Err(t.err(
+                "path",
+                format!(
+                    "cannot read MTL file {} named by OBJ file {}: {why} (set `material` on the object to ignore the MTL)",
+                    mtl.display(),
+                    full.display()
+                ),
+            ));
+        }
+        if loaded.mesh.materials.contains(&obj::NO_MATERIAL) {
+            return Err(t.err(
+                "material",
+                format!(
+                    "OBJ file {} has faces without an MTL material: set `material` on the object",
+                    full.display()
+                ),
+            ));
         }
     }
-    Ok(Object {
-        name,
-        mesh,
-        transform: transform(t)?,
-        animation: animation(t)?,
-        water: None,
-    })
+    file_object(t, name, loaded.mesh, material, &loaded.materials, materials)
 }
 
 /// Maps a loaded file's materials (indices into `imported` in
@@ -261,23 +272,12 @@ fn gltf_object(
 ) -> R<Object> {
     let full = dir.join(t.str("path")?);
     let loaded = gltf::load(&full).map_err(|e| t.err("path", e.to_string()))?;
-    let mut mesh = loaded.mesh;
-    match material {
-        Some(m) => mesh.materials.iter_mut().for_each(|x| *x = m),
-        None => {
-            for w in &loaded.warnings {
-                log::warn!("{w}");
-            }
-            import_materials(t, &mut mesh, &loaded.materials, materials)?;
+    if material.is_none() {
+        for w in &loaded.warnings {
+            log::warn!("{w}");
         }
     }
-    Ok(Object {
-        name,
-        mesh,
-        transform: transform(t)?,
-        animation: animation(t)?,
-        water: None,
-    })
+    file_object(t, name, loaded.mesh, material, &loaded.materials, materials)
 }
 
 /// `translate * rotate_z * rotate_y * rotate_x * scale`: scale first, then X, Y, Z rotations, then translation.
