@@ -661,6 +661,12 @@ fn bad_files() -> Vec<Bad> {
             },
         },
         Bad {
+            name: "cycle",
+            at: "nodes[0]",
+            says: "strict trees",
+            edit: |g, _| g.root["nodes"][0]["children"] = json!([0]),
+        },
+        Bad {
             name: "draco",
             at: "extensionsRequired[0]",
             says: "KHR_draco_mesh_compression (compressed geometry) is not supported: the file must be decompressed",

@@ -191,17 +191,19 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
     else {
         return Err(fail("scenes", "the file has no scene".into()));
     };
-    let node_count = document.nodes().count();
-    let mut stack: Vec<(::gltf::Node, Mat4, usize)> = scene
+    // Depth-first in file order. glTF nodes form strict trees: a node met
+    // twice (a cycle, or two parents) is refused, which also bounds the walk.
+    let mut seen = vec![false; document.nodes().count()];
+    let mut stack: Vec<(::gltf::Node, Mat4)> = scene
         .nodes()
-        .map(|n| (n, Mat4::IDENTITY, 0))
+        .map(|n| (n, Mat4::IDENTITY))
         .collect::<Vec<_>>();
     stack.reverse();
-    while let Some((node, parent, depth)) = stack.pop() {
-        if depth > node_count {
+    while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut seen[node.index()], true) {
             return Err(fail(
-                &format!("nodes[{}].children", node.index()),
-                "the node hierarchy has a cycle".into(),
+                &format!("nodes[{}]", node.index()),
+                "the node is met twice in the scene's hierarchy (a cycle, or two parents): glTF nodes form strict trees".into(),
             ));
         }
         let local = Mat4::from_cols_array_2d(&node.transform().matrix());
@@ -226,7 +228,7 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
             reader.light(&light, world);
         }
         let children: Vec<_> = node.children().collect();
-        stack.extend(children.into_iter().rev().map(|c| (c, world, depth + 1)));
+        stack.extend(children.into_iter().rev().map(|c| (c, world)));
     }
     let Loader {
         mut asset,
