@@ -147,6 +147,17 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
             return Err(fail(&format!("extensionsRequired[{i}]"), why));
         }
     }
+    let ignored: Vec<String> = root
+        .extensions_used
+        .iter()
+        .filter(|e| !SUPPORTED_EXTENSIONS.contains(&e.as_str()))
+        .map(|e| {
+            format!(
+                "{}: extension {e} is used by the file but ignored",
+                path.display()
+            )
+        })
+        .collect();
     let document = Document::from_json(root).map_err(|e| match e {
         ::gltf::Error::Validation(errors) => {
             let (p, why) = &errors[0];
@@ -178,7 +189,7 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
             base_color_textures: Vec::new(),
             camera: None,
             lights: Vec::new(),
-            warnings: Vec::new(),
+            warnings: ignored,
             had_normals: true,
         },
         material_map: HashMap::new(),
