@@ -68,7 +68,7 @@ print(f"{path}: {len(idx) // 3} triangles, {total / 2**20:.1f} MiB")
 PY
 $bin info | sed -n 1p
 start=$(date +%s.%N)
-RUST_LOG=caustics=info /usr/bin/time -f "peak resident memory: %M KiB" \
+RUST_LOG=caustics=info /usr/bin/time -f "peak resident memory: %M KiB; process CPU time %U s user + %S s system over %e s elapsed" \
   $bin render --scene "$glb" --technique direct --width 256 --height 256 --frames 1 \
   --out out/bench/gltf_first_frame.png 2>&1 | grep -E "^  |loaded in|on the device|direct at|geometry|peak|error"
 end=$(date +%s.%N)
