@@ -544,6 +544,41 @@ fn a_file_without_camera_or_lights_gets_a_framing_camera_and_a_sun() {
     }
 }
 
+/// Standard base64 with padding (RFC 4648), for `data:` URIs.
+fn base64(bytes: &[u8]) -> String {
+    const ABC: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for c in bytes.chunks(3) {
+        let n = (c[0] as u32) << 16
+            | (*c.get(1).unwrap_or(&0) as u32) << 8
+            | *c.get(2).unwrap_or(&0) as u32;
+        for k in 0..4 {
+            if k <= c.len() {
+                out.push(ABC[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn buffers_in_data_uris_load_like_files() {
+    let dir = temp_dir("data_uri");
+    let mut g = Gltf::new();
+    let cube = shapes::cuboid(Vec3::ZERO, Vec3::ONE);
+    let mesh = g.mesh(&cube, true, None);
+    g.root_node(json!({"mesh": mesh}));
+    let from_file = loader::load(&g.write_gltf(&dir, "file")).unwrap();
+    let uri = format!("data:application/octet-stream;base64,{}", base64(&g.bin));
+    let path = dir.join("embedded.gltf");
+    std::fs::write(&path, serde_json::to_vec(&g.finish(Some(&uri))).unwrap()).unwrap();
+    let embedded = loader::load(&path).unwrap();
+    assert_eq!(embedded.mesh.positions, from_file.mesh.positions);
+    assert_eq!(embedded.mesh.indices, cube.indices);
+}
+
 // ------------------------------------------------------------ the CLI
 
 fn caustics(args: &[&str]) -> (Option<i32>, String, String) {
