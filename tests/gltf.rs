@@ -422,6 +422,14 @@ fn node_hierarchy_matches_the_equivalent_toml_transform() {
         via_gltf.materials[1].name, "model.gltf:white",
         "the file's material joins the scene's"
     );
+    // `material` on the object replaces the file's.
+    let replaced = Scene::from_str(
+        &format!("{gltf_toml}material = \"white\"\n"),
+        &dir.join("replaced.toml"),
+    )
+    .unwrap();
+    assert_eq!(replaced.materials.len(), 1);
+    assert!(replaced.objects[1].mesh.materials.iter().all(|&m| m == 0));
 
     let (a, b) = (reference.triangles(0.0), via_gltf.triangles(0.0));
     assert_eq!(a.len(), b.len());
@@ -703,6 +711,18 @@ fn bad_files() -> Vec<Bad> {
             at: "nodes[0]",
             says: "strict trees",
             edit: |g, _| g.root["nodes"][0]["children"] = json!([0]),
+        },
+        Bad {
+            name: "too_many_lights",
+            at: "extensions.KHR_lights_punctual",
+            says: "at most 8",
+            edit: |g, _| {
+                g.root["extensions"] = json!({"KHR_lights_punctual": {"lights": [
+                    {"type": "point", "intensity": 1.0}]}});
+                for _ in 0..9 {
+                    g.root_node(json!({"extensions": {"KHR_lights_punctual": {"light": 0}}}));
+                }
+            },
         },
         Bad {
             name: "draco",

@@ -931,9 +931,6 @@ pub const DEFAULT_SUN_EXPOSURE: f32 = 0.004;
 /// floor unless `options` leaves it out. Warnings go to the log.
 pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError> {
     let asset = load(path)?;
-    for w in &asset.warnings {
-        log::warn!("{w}");
-    }
     if asset.lights.len() > MAX_LIGHTS as usize {
         return Err(GltfError {
             file: path.to_path_buf(),
@@ -943,6 +940,10 @@ pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError
                 asset.lights.len()
             ),
         });
+    }
+    // Only a file that loads warns: a refused one is one line of error.
+    for w in &asset.warnings {
+        log::warn!("{w}");
     }
     let (lo, hi) = asset
         .mesh
