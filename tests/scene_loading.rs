@@ -892,7 +892,7 @@ fn water_values_are_checked() {
         &base("[[object]]\nshape = \"cone\"\nmaterial = \"white\"\n"),
         "object[1].shape",
         "\"cone\"",
-        "unknown shape `cone`; expected sphere, plane, box, torus, cylinder, mesh or water",
+        "unknown shape `cone`; expected sphere, plane, box, torus, cylinder, mesh, gltf or water",
     );
 }
 

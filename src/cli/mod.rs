@@ -40,7 +40,7 @@ pub struct DeviceArgs {
 
 #[derive(Args, Clone)]
 pub struct SceneArgs {
-    /// Scene file (TOML, docs/SCENES.md).
+    /// Scene file: TOML, or a glTF 2.0 file (.gltf/.glb) as a whole scene (docs/SCENES.md).
     #[arg(long, default_value = DEFAULT_SCENE)]
     pub scene: PathBuf,
     #[arg(long, default_value_t = 512)]
@@ -187,7 +187,7 @@ pub struct BenchArgs {
 
 #[derive(Args)]
 pub struct DemoArgs {
-    /// Scene file (TOML, docs/SCENES.md); R reloads it.
+    /// Scene file: TOML, or a glTF 2.0 file (.gltf/.glb) as a whole scene (docs/SCENES.md). R reloads it.
     #[arg(long, default_value = DEFAULT_SCENE)]
     pub scene: PathBuf,
     #[arg(long, default_value = "direct")]

@@ -29,6 +29,10 @@ pub enum SceneError {
         field: String,
         message: String,
     },
+    /// A glTF file given as the scene (`--scene model.glb`) is bad:
+    /// `FILE: GLTF_PATH: message`.
+    #[error(transparent)]
+    Gltf(#[from] super::gltf::GltfError),
 }
 
 impl SceneError {
@@ -36,6 +40,7 @@ impl SceneError {
     pub fn field(&self) -> Option<&str> {
         match self {
             SceneError::At { field, .. } => Some(field),
+            SceneError::Gltf(e) => Some(&e.at),
             SceneError::Read { .. } => None,
         }
     }
@@ -44,7 +49,7 @@ impl SceneError {
     pub fn line(&self) -> Option<usize> {
         match self {
             SceneError::At { line, .. } => Some(*line),
-            SceneError::Read { .. } => None,
+            SceneError::Read { .. } | SceneError::Gltf(_) => None,
         }
     }
 }

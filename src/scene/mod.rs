@@ -3,12 +3,14 @@
 //!
 //! - `file.rs`: the schema and its validation (every error located `FILE:LINE:COL: FIELD`).
 //! - `node.rs`: the span-carrying TOML tree the schema reads from.
-//! - `shapes.rs`: procedural tessellation; `obj.rs`: OBJ/MTL through tobj.
+//! - `shapes.rs`: procedural tessellation; `obj.rs`: OBJ/MTL through tobj;
+//!   `gltf.rs`: glTF 2.0 files (objects, or a whole scene of one file).
 //! - `water.rs`: water surfaces (Gerstner waves), re-tessellated per time.
 //! - this file: loading, animation and world-space queries.
 
 mod error;
 mod file;
+pub mod gltf;
 mod node;
 pub mod obj;
 pub mod shapes;
@@ -28,8 +30,27 @@ pub const DEFAULT_SCENE: &str = "assets/scenes/ball_lens.toml";
 
 impl Scene {
     /// Reads and validates a scene file. Relative paths inside it (OBJ meshes,
-    /// density grids) resolve against the file's folder.
+    /// density grids) resolve against the file's folder. A `.gltf` or `.glb`
+    /// file is a whole scene of its own ([`gltf::scene`] with the default
+    /// options: a floor, the file's camera and lights or defaults).
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let start = std::time::Instant::now();
+        let scene = if gltf::is_gltf_path(path) {
+            gltf::scene(path, &gltf::GltfSceneOptions::default())?
+        } else {
+            Self::load_toml(path)?
+        };
+        // The load phase's cost (RUST_LOG=info): scripts/gltf-bench.sh reads it.
+        log::info!(
+            "scene {} loaded in {:.1} ms ({} triangles)",
+            path.display(),
+            start.elapsed().as_secs_f64() * 1e3,
+            scene.triangle_count()
+        );
+        Ok(scene)
+    }
+
+    fn load_toml(path: &Path) -> Result<Scene, SceneError> {
         let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
             path: path.to_path_buf(),
             source,

@@ -190,7 +190,7 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
 
 /// Adds each triangle's area-weighted face normal (the unnormalised cross
 /// product) to its vertices, then normalises: smooth, area-weighted normals.
-fn accumulate_normals(mesh: &mut Mesh, range: std::ops::Range<usize>) {
+pub(crate) fn accumulate_normals(mesh: &mut Mesh, range: std::ops::Range<usize>) {
     for t in &mesh.indices[range.clone()] {
         let p = t.map(|i| mesh.positions[i as usize]);
         let n = (p[1] - p[0]).cross(p[2] - p[0]);
@@ -208,7 +208,7 @@ fn accumulate_normals(mesh: &mut Mesh, range: std::ops::Range<usize>) {
 
 /// Vertices left without a usable normal (only degenerate faces, or a zero
 /// normal in the file) take the normal of a face that uses them, or +y.
-fn fix_zero_normals(mesh: &mut Mesh) {
+pub(crate) fn fix_zero_normals(mesh: &mut Mesh) {
     if mesh.normals.iter().all(|n| *n != Vec3::ZERO) {
         return;
     }

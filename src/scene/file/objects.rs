@@ -1,5 +1,5 @@
 //! `[[object]]` tables: procedural shapes, OBJ meshes (with their MTL
-//! materials), transforms and animation.
+//! materials), glTF files (with their materials), transforms and animation.
 
 use super::materials::Materials;
 use super::values::{direction, positive, size2};
@@ -7,7 +7,7 @@ use super::water_surface::{water_surface, WATER_KEYS};
 use crate::scene::node::Tbl;
 use crate::scene::node::R;
 use crate::scene::types::*;
-use crate::scene::{obj, shapes};
+use crate::scene::{gltf, obj, shapes};
 use glam::{Mat4, Quat, Vec3};
 use std::path::Path;
 
@@ -45,13 +45,13 @@ pub(super) fn object(t: &Tbl, index: usize, dir: &Path, materials: &mut Material
         "box" => &["min", "max"],
         "torus" => &["center", "axis", "radii", "segments"],
         "cylinder" => &["p0", "p1", "radius", "caps", "segments"],
-        "mesh" => &["path"],
+        "mesh" | "gltf" => &["path"],
         "water" => &[],
         other => {
             return Err(t.err(
                 "shape",
                 format!(
-                    "unknown shape `{other}`; expected sphere, plane, box, torus, cylinder, mesh or water"
+                    "unknown shape `{other}`; expected sphere, plane, box, torus, cylinder, mesh, gltf or water"
                 ),
             ))
         }
@@ -84,7 +84,7 @@ pub(super) fn object(t: &Tbl, index: usize, dir: &Path, materials: &mut Material
                 ));
             }
         },
-        None if shape == "mesh" => None,
+        None if shape == "mesh" || shape == "gltf" => None,
         None => return Err(t.err("material", "missing required field (the material name)")),
     };
 
@@ -158,10 +158,16 @@ pub(super) fn object(t: &Tbl, index: usize, dir: &Path, materials: &mut Material
                 water: Some(surface),
             });
         }
+        "gltf" => return gltf_object(t, name, dir, material, materials),
         _ => return mesh_object(t, name, dir, material, materials),
     };
     let material = material.unwrap_or_default();
     mesh.materials = vec![material; mesh.indices.len()];
+    placed(t, name, mesh)
+}
+
+/// An object of `mesh` with the table's `translate`/`rotate`/`scale` and `animate`.
+fn placed(t: &Tbl, name: String, mesh: Mesh) -> R<Object> {
     Ok(Object {
         name,
         mesh,
@@ -169,6 +175,23 @@ pub(super) fn object(t: &Tbl, index: usize, dir: &Path, materials: &mut Material
         animation: animation(t)?,
         water: None,
     })
+}
+
+/// A mesh read from a file: `material`, when set, replaces the file's
+/// materials; otherwise they join the scene's (`import_materials`).
+fn file_object(
+    t: &Tbl,
+    name: String,
+    mut mesh: Mesh,
+    material: Option<u32>,
+    imported: &[Material],
+    materials: &mut Materials,
+) -> R<Object> {
+    match material {
+        Some(m) => mesh.materials.iter_mut().for_each(|x| *x = m),
+        None => import_materials(t, &mut mesh, imported, materials)?,
+    }
+    placed(t, name, mesh)
 }
 
 fn mesh_object(
@@ -181,62 +204,80 @@ fn mesh_object(
     let rel = t.str("path")?;
     let full = dir.join(rel);
     let loaded = obj::load(&full).map_err(|e| t.err("path", e))?;
-    let mut mesh = loaded.mesh;
-    match material {
-        Some(m) => mesh.materials.iter_mut().for_each(|x| *x = m),
-        None => {
-            if let Some((mtl, why)) = loaded.mtl_errors.first() {
-                return Err(t.err(
-                    "path",
-                    format!(
-                        "cannot read MTL file {} named by OBJ file {}: {why} (set `material` on the object to ignore the MTL)",
-                        mtl.display(),
-                        full.display()
-                    ),
-                ));
-            }
-            if mesh.materials.contains(&obj::NO_MATERIAL) {
-                return Err(t.err(
-                    "material",
-                    format!(
-                        "OBJ file {} has faces without an MTL material: set `material` on the object",
-                        full.display()
-                    ),
-                ));
-            }
-            // Map the OBJ's materials to scene materials, sharing identical ones
-            // (the same OBJ used twice).
-            let mut map = vec![None; loaded.materials.len()];
-            for x in &mut mesh.materials {
-                let slot = &mut map[*x as usize];
-                let index = match *slot {
-                    Some(i) => i,
-                    None => {
-                        let m = &loaded.materials[*x as usize];
-                        let i = materials.add_mtl(m).ok_or_else(|| {
-                            t.err(
-                                "path",
-                                format!(
-                                    "MTL material name `{}` collides with another material",
-                                    m.name
-                                ),
-                            )
-                        })?;
-                        *slot = Some(i);
-                        i
-                    }
-                };
-                *x = index as u32;
-            }
+    if material.is_none() {
+        if let Some((mtl, why)) = loaded.mtl_errors.first() {
+            return Err(t.err(
+                "path",
+                format!(
+                    "cannot read MTL file {} named by OBJ file {}: {why} (set `material` on the object to ignore the MTL)",
+                    mtl.display(),
+                    full.display()
+                ),
+            ));
+        }
+        if loaded.mesh.materials.contains(&obj::NO_MATERIAL) {
+            return Err(t.err(
+                "material",
+                format!(
+                    "OBJ file {} has faces without an MTL material: set `material` on the object",
+                    full.display()
+                ),
+            ));
         }
     }
-    Ok(Object {
-        name,
-        mesh,
-        transform: transform(t)?,
-        animation: animation(t)?,
-        water: None,
-    })
+    file_object(t, name, loaded.mesh, material, &loaded.materials, materials)
+}
+
+/// Maps a loaded file's materials (indices into `imported` in
+/// `mesh.materials`) to scene materials, adding only those faces use and
+/// sharing identical ones (the same file used twice).
+fn import_materials(
+    t: &Tbl,
+    mesh: &mut Mesh,
+    imported: &[Material],
+    materials: &mut Materials,
+) -> R<()> {
+    let mut map = vec![None; imported.len()];
+    for x in &mut mesh.materials {
+        let slot = &mut map[*x as usize];
+        let index = match *slot {
+            Some(i) => i,
+            None => {
+                let m = &imported[*x as usize];
+                let i = materials.add_mtl(m).ok_or_else(|| {
+                    t.err(
+                        "path",
+                        format!("material name `{}` collides with another material", m.name),
+                    )
+                })?;
+                *slot = Some(i);
+                i
+            }
+        };
+        *x = index as u32;
+    }
+    Ok(())
+}
+
+/// A `shape = "gltf"` object: every triangle of the file's default scene
+/// (its node transforms applied) as one object; the file's camera and
+/// lights are not used (the scene file has its own). `material`, when set,
+/// replaces the file's materials.
+fn gltf_object(
+    t: &Tbl,
+    name: String,
+    dir: &Path,
+    material: Option<u32>,
+    materials: &mut Materials,
+) -> R<Object> {
+    let full = dir.join(t.str("path")?);
+    let loaded = gltf::load(&full).map_err(|e| t.err("path", e.to_string()))?;
+    if material.is_none() {
+        for w in &loaded.warnings {
+            log::warn!("{w}");
+        }
+    }
+    file_object(t, name, loaded.mesh, material, &loaded.materials, materials)
 }
 
 /// `translate * rotate_z * rotate_y * rotate_x * scale`: scale first, then X, Y, Z rotations, then translation.

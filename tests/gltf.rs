@@ -1,0 +1,899 @@
+//! glTF 2.0 scenes (docs/SCENES.md, "glTF 2.0"): the tests write their own
+//! small files with [`Gltf`] (JSON + .bin, or .glb) and check the material
+//! mapping, node transforms against an equivalent TOML scene (the same
+//! `direct` image), a file as a whole scene (`--scene model.glb`), every
+//! rejection through the CLI (exit code 1, one line naming the file and the
+//! glTF path), and the loader's linear scaling.
+
+mod common;
+
+use caustics::params::{ParamSet, Params};
+use caustics::renderer::Renderer;
+use caustics::scene::gltf::{self as loader, LUMENS_PER_WATT};
+use caustics::scene::{shapes, LightKind, MaterialKind, Mesh, Scene};
+use caustics::techniques;
+use common::*;
+use glam::{Mat4, Quat, Vec2, Vec3};
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+// ------------------------------------------------------------ the writer
+
+/// A glTF document being written: one binary buffer, accessors appended.
+struct Gltf {
+    bin: Vec<u8>,
+    root: Value,
+}
+
+impl Gltf {
+    fn new() -> Self {
+        Gltf {
+            bin: Vec::new(),
+            root: json!({
+                "asset": {"version": "2.0"},
+                "scene": 0,
+                "scenes": [{"nodes": []}],
+                "nodes": [], "meshes": [], "materials": [],
+                "accessors": [], "bufferViews": [],
+            }),
+        }
+    }
+
+    fn push(&mut self, key: &str, v: Value) -> usize {
+        let a = self.root[key].as_array_mut().unwrap();
+        a.push(v);
+        a.len() - 1
+    }
+
+    /// Raw bytes as a new buffer view + accessor.
+    fn accessor(&mut self, bytes: &[u8], count: usize, ty: &str, component: u32) -> usize {
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        let view = self.push(
+            "bufferViews",
+            json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()}),
+        );
+        self.bin.extend_from_slice(bytes);
+        self.push(
+            "accessors",
+            json!({"bufferView": view, "count": count, "type": ty, "componentType": component}),
+        )
+    }
+
+    fn vec3s(&mut self, v: &[Vec3]) -> usize {
+        let i = self.accessor(bytemuck::cast_slice(v), v.len(), "VEC3", 5126);
+        // POSITION accessors need min and max (any VEC3 may carry them).
+        let finite = v.iter().filter(|p| p.is_finite());
+        let lo = finite.clone().fold(Vec3::INFINITY, |a, &b| a.min(b));
+        let hi = finite.fold(Vec3::NEG_INFINITY, |a, &b| a.max(b));
+        let (lo, hi) = if lo.x <= hi.x {
+            (lo, hi)
+        } else {
+            (Vec3::ZERO, Vec3::ZERO)
+        };
+        self.root["accessors"][i]["min"] = json!(lo.to_array());
+        self.root["accessors"][i]["max"] = json!(hi.to_array());
+        i
+    }
+
+    fn vec2s(&mut self, v: &[Vec2]) -> usize {
+        self.accessor(bytemuck::cast_slice(v), v.len(), "VEC2", 5126)
+    }
+
+    fn indices(&mut self, t: &[[u32; 3]]) -> usize {
+        self.accessor(bytemuck::cast_slice(t), t.len() * 3, "SCALAR", 5125)
+    }
+
+    /// A mesh of one primitive (`normals`: write the mesh's NORMAL).
+    fn mesh(&mut self, m: &Mesh, normals: bool, material: Option<usize>) -> usize {
+        let pos = self.vec3s(&m.positions);
+        let idx = self.indices(&m.indices);
+        let mut prim = json!({"attributes": {"POSITION": pos}, "indices": idx});
+        if normals {
+            prim["attributes"]["NORMAL"] = json!(self.vec3s(&m.normals));
+        }
+        if let Some(mat) = material {
+            prim["material"] = json!(mat);
+        }
+        self.push("meshes", json!({"primitives": [prim]}))
+    }
+
+    fn material(&mut self, m: Value) -> usize {
+        self.push("materials", m)
+    }
+
+    fn node(&mut self, n: Value) -> usize {
+        self.push("nodes", n)
+    }
+
+    /// Puts a node at the scene root.
+    fn root_node(&mut self, n: Value) -> usize {
+        let i = self.node(n);
+        self.root["scenes"][0]["nodes"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!(i));
+        i
+    }
+
+    fn finish(&mut self, uri: Option<&str>) -> Value {
+        let mut root = self.root.clone();
+        let mut buffer = json!({"byteLength": self.bin.len()});
+        if let Some(u) = uri {
+            buffer["uri"] = json!(u);
+        }
+        root["buffers"] = json!([buffer]);
+        root
+    }
+
+    /// `name.gltf` and `name.bin` in `dir`.
+    fn write_gltf(&mut self, dir: &Path, name: &str) -> PathBuf {
+        let bin = format!("{name}.bin");
+        let root = self.finish(Some(&bin));
+        std::fs::write(dir.join(&bin), &self.bin).unwrap();
+        let path = dir.join(format!("{name}.gltf"));
+        std::fs::write(&path, serde_json::to_vec_pretty(&root).unwrap()).unwrap();
+        path
+    }
+
+    /// `name.glb`: the JSON and BIN chunks, each padded to 4 bytes.
+    fn write_glb(&mut self, dir: &Path, name: &str) -> PathBuf {
+        let mut json = serde_json::to_vec(&self.finish(None)).unwrap();
+        while json.len() % 4 != 0 {
+            json.push(b' ');
+        }
+        let mut bin = self.bin.clone();
+        while bin.len() % 4 != 0 {
+            bin.push(0);
+        }
+        let total = 12 + 8 + json.len() + 8 + bin.len();
+        let mut out = Vec::with_capacity(total);
+        out.extend_from_slice(b"glTF");
+        out.extend_from_slice(&2u32.to_le_bytes());
+        out.extend_from_slice(&(total as u32).to_le_bytes());
+        out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"JSON");
+        out.extend_from_slice(&json);
+        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"BIN\0");
+        out.extend_from_slice(&bin);
+        let path = dir.join(format!("{name}.glb"));
+        std::fs::write(&path, out).unwrap();
+        path
+    }
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::SeqCst);
+    let dir = std::env::temp_dir().join(format!("caustics-gltf-{}-{name}-{n}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn quad() -> Mesh {
+    shapes::plane(Vec3::ZERO, Vec3::Y, None, [4.0, 4.0])
+}
+
+// ------------------------------------------------------------ materials
+
+#[test]
+fn materials_map_to_the_projects_radiometry() {
+    let dir = temp_dir("materials");
+    let mut g = Gltf::new();
+    let glass = g.material(json!({
+        "name": "glass",
+        "pbrMetallicRoughness": {"metallicFactor": 0.0, "roughnessFactor": 0.0},
+        "extensions": {
+            "KHR_materials_transmission": {"transmissionFactor": 1.0},
+            "KHR_materials_volume": {"thicknessFactor": 0.5, "attenuationDistance": 2.0,
+                                     "attenuationColor": [0.5, 0.8, 1.0]},
+            "KHR_materials_ior": {"ior": 1.45}
+        }
+    }));
+    let mirror = g.material(json!({
+        "name": "mirror",
+        "pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.8, 0.7, 1.0],
+                                 "metallicFactor": 1.0, "roughnessFactor": 0.0}
+    }));
+    let floor = g.material(json!({
+        "name": "floor",
+        "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.6, 0.7, 1.0], "metallicFactor": 0.0}
+    }));
+    let thin = g.material(json!({
+        "name": "thin",
+        "pbrMetallicRoughness": {"metallicFactor": 0.0, "roughnessFactor": 0.0},
+        "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0}}
+    }));
+    let brushed = g.material(json!({
+        "name": "brushed",
+        "pbrMetallicRoughness": {"metallicFactor": 1.0, "roughnessFactor": 0.3}
+    }));
+    let lamp = g.material(json!({
+        "name": "lamp", "emissiveFactor": [1.0, 1.0, 1.0],
+        "pbrMetallicRoughness": {"metallicFactor": 0.0}
+    }));
+    let hidden = g.material(json!({
+        "name": "hidden", "alphaMode": "MASK",
+        "pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 0.2], "metallicFactor": 0.0}
+    }));
+    // The glass sphere has no NORMAL: smooth normals are computed.
+    let sphere = sphere_mesh(Vec3::new(0.0, 1.0, 0.0), 0.5, 0, 24);
+    for (m, mat, normals) in [
+        (&sphere, glass, false),
+        (&quad(), mirror, true),
+        (&quad(), floor, true),
+        (&quad(), thin, true),
+        (&quad(), brushed, true),
+        (&quad(), lamp, true),
+        (&quad(), hidden, true),
+    ] {
+        let mesh = g.mesh(m, normals, Some(mat));
+        g.root_node(json!({"mesh": mesh}));
+    }
+    g.root["extensionsUsed"] = json!(["KHR_materials_transmission", "KHR_materials_clearcoat"]);
+    let path = g.write_gltf(&dir, "materials");
+    let a = loader::load(&path).unwrap();
+
+    let by_name = |n: &str| {
+        a.materials
+            .iter()
+            .find(|m| m.name == format!("materials.gltf:{n}"))
+            .unwrap_or_else(|| panic!("material {n} in {:?}", a.materials))
+    };
+    let glass = by_name("glass");
+    assert_eq!(glass.kind, MaterialKind::Dielectric);
+    assert_eq!(glass.ior, 1.45);
+    // σa = -ln(attenuationColor) / attenuationDistance per channel.
+    let expect = Vec3::new(-(0.5f32.ln()), -(0.8f32.ln()), 0.0) / 2.0;
+    assert!(
+        (glass.absorption - expect).abs().max_element() < 1e-6,
+        "{}",
+        glass.absorption
+    );
+    let mirror = by_name("mirror");
+    assert_eq!(mirror.kind, MaterialKind::Mirror);
+    assert_eq!(mirror.color, Vec3::new(0.9, 0.8, 0.7));
+    let floor = by_name("floor");
+    assert_eq!(floor.kind, MaterialKind::Diffuse);
+    assert_eq!(floor.color, Vec3::new(0.5, 0.6, 0.7));
+    let thin = by_name("thin");
+    assert_eq!((thin.kind, thin.ior), (MaterialKind::Dielectric, 1.0));
+    assert_eq!(by_name("brushed").kind, MaterialKind::Mirror);
+    assert_eq!(by_name("lamp").kind, MaterialKind::Diffuse);
+    // alphaMode MASK with a constant alpha below the cutoff: cut out.
+    assert!(a.materials.iter().all(|m| !m.name.ends_with(":hidden")));
+    assert_eq!(a.mesh.indices.len(), sphere.indices.len() + 5 * 2);
+
+    // One warning per material that is not rendered as written, naming
+    // it; none for the ones that map exactly.
+    for name in ["thin", "brushed", "lamp", "hidden"] {
+        let n = a
+            .warnings
+            .iter()
+            .filter(|w| w.contains(&format!("materials.gltf:{name}`")))
+            .count();
+        assert_eq!(n, 1, "{name}: {:#?}", a.warnings);
+    }
+    assert!(a.warnings[0]
+        .ends_with("extension KHR_materials_clearcoat is used by the file but ignored"));
+    assert_eq!(a.warnings.len(), 5, "{:#?}", a.warnings);
+    assert!(a.warnings.iter().any(|w| w.contains("thin-walled")));
+
+    // Computed normals of the sphere point away from its centre (at every
+    // vertex a triangle uses: the UV sphere leaves one pole copy unused).
+    assert!(!a.had_normals);
+    for t in &a.mesh.indices[..sphere.indices.len()] {
+        for &i in t {
+            let (p, n) = (a.mesh.positions[i as usize], a.mesh.normals[i as usize]);
+            let radial = (p - Vec3::new(0.0, 1.0, 0.0)).normalize();
+            assert!(n.dot(radial) > 0.99, "normal {n} at {p}");
+        }
+    }
+}
+
+#[test]
+fn texture_coordinates_and_base_color_texture_are_read() {
+    let dir = temp_dir("texture");
+    std::fs::write(dir.join("tiles.png"), b"not decoded by the loader").unwrap();
+    let mut g = Gltf::new();
+    g.root["images"] = json!([{"uri": "tiles.png"}]);
+    g.root["textures"] = json!([{"source": 0}]);
+    let mat = g.material(json!({
+        "name": "tiles",
+        "pbrMetallicRoughness": {
+            "metallicFactor": 0.0,
+            "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform":
+                {"offset": [0.25, 0.5], "rotation": 0.5, "scale": [2.0, 3.0]}}}
+        }
+    }));
+    let q = quad();
+    let uv = [
+        Vec2::new(0.0, 0.0),
+        Vec2::new(1.0, 0.0),
+        Vec2::new(1.0, 1.0),
+        Vec2::new(0.0, 1.0),
+    ];
+    let mesh = g.mesh(&q, true, Some(mat));
+    let uv_acc = g.vec2s(&uv);
+    g.root["meshes"][mesh]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uv_acc);
+    g.root_node(json!({"mesh": mesh}));
+    let a = loader::load(&g.write_gltf(&dir, "textured")).unwrap();
+    assert_eq!(a.uvs, uv);
+    let t = a.base_color_textures[0].clone().expect("texture reference");
+    assert_eq!((t.texture, t.image, t.tex_coord), (0, 0, 0));
+    assert_eq!(t.file.as_deref(), Some(dir.join("tiles.png").as_path()));
+    assert_eq!(
+        (t.offset, t.rotation, t.scale),
+        (Vec2::new(0.25, 0.5), 0.5, Vec2::new(2.0, 3.0))
+    );
+    assert_eq!(a.warnings.len(), 1, "{:#?}", a.warnings);
+    assert!(
+        a.warnings[0].contains("not applied yet"),
+        "{:#?}",
+        a.warnings
+    );
+}
+
+// ------------------------------------------------------------ transforms
+
+const SIZE: u32 = 32;
+
+/// The `direct` image of `scene` at 32², after two frames.
+fn render_direct(scene: Scene) -> Vec<f32> {
+    let ctx = validated_context();
+    let params = Params::resolve("direct", techniques::direct::DirectParams::specs(), &[]).unwrap();
+    let image = {
+        let mut r = Renderer::new(&ctx, scene, "direct", &params, SIZE, SIZE, 0.0).unwrap();
+        r.render_frame(0.0).unwrap();
+        r.render_frame(0.0).unwrap();
+        r.radiance().unwrap()
+    };
+    assert_validation_clean(&ctx);
+    assert_finite(&image);
+    image
+}
+
+const SCENE_HEAD: &str = r#"
+[camera]
+eye = [2.5, 3.0, 4.0]
+target = [0.0, 0.4, 0.0]
+fov_y = 45.0
+
+[[light]]
+kind = "point"
+position = [1.0, 4.0, 2.0]
+intensity = 30.0
+
+[[material]]
+name = "white"
+kind = "diffuse"
+albedo = 0.8
+
+[[object]]
+shape = "plane"
+material = "white"
+size = [6.0, 6.0]
+"#;
+
+/// A node hierarchy (a root `matrix`, a parent's translation + rotation, a
+/// child's translation + mirroring scale) against one TOML transform: the
+/// same triangles and the same `direct` image.
+#[test]
+fn node_hierarchy_matches_the_equivalent_toml_transform() {
+    let dir = temp_dir("hierarchy");
+    let (m0, t1, c) = (
+        Vec3::new(0.1, 0.0, -0.2),
+        Vec3::new(-0.3, 0.2, 0.1),
+        Vec3::new(0.4, 0.0, 0.2),
+    );
+    let r = Quat::from_rotation_y(30f32.to_radians());
+    let s = Vec3::new(-0.6, 0.8, 0.5);
+    let (lo, hi) = (Vec3::new(-0.5, 0.0, -0.5), Vec3::new(0.5, 1.0, 0.5));
+    let cube = shapes::cuboid(lo, hi);
+
+    let mut g = Gltf::new();
+    let mat = g.material(json!({"name": "white", "pbrMetallicRoughness":
+        {"baseColorFactor": [0.8, 0.8, 0.8, 1.0], "metallicFactor": 0.0}}));
+    let mesh = g.mesh(&cube, true, Some(mat));
+    let child = g.node(json!({"mesh": mesh, "translation": c.to_array(), "scale": s.to_array()}));
+    let parent = g.node(json!({"children": [child], "translation": t1.to_array(),
+                               "rotation": r.to_array()}));
+    g.root_node(json!({"children": [parent],
+        "matrix": Mat4::from_translation(m0).to_cols_array()}));
+    g.write_gltf(&dir, "model");
+
+    let translate = m0 + t1 + r * c;
+    let toml = format!(
+        "{SCENE_HEAD}\n[[object]]\nshape = \"box\"\nmaterial = \"white\"\nmin = {:?}\nmax = {:?}\ntranslate = {:?}\nrotate = [0.0, 30.0, 0.0]\nscale = {:?}\n",
+        lo.to_array(),
+        hi.to_array(),
+        translate.to_array(),
+        s.to_array()
+    );
+    let reference = Scene::from_str(&toml, &dir.join("box.toml")).unwrap();
+    let gltf_toml = format!("{SCENE_HEAD}\n[[object]]\nshape = \"gltf\"\npath = \"model.gltf\"\n");
+    let via_gltf = Scene::from_str(&gltf_toml, &dir.join("gltf.toml")).unwrap();
+    assert_eq!(
+        via_gltf.materials[1].name, "model.gltf:white",
+        "the file's material joins the scene's"
+    );
+    // `material` on the object replaces the file's.
+    let replaced = Scene::from_str(
+        &format!("{gltf_toml}material = \"white\"\n"),
+        &dir.join("replaced.toml"),
+    )
+    .unwrap();
+    assert_eq!(replaced.materials.len(), 1);
+    assert!(replaced.objects[1].mesh.materials.iter().all(|&m| m == 0));
+
+    let (a, b) = (reference.triangles(0.0), via_gltf.triangles(0.0));
+    assert_eq!(a.len(), b.len());
+    for (ta, tb) in a.iter().zip(&b) {
+        for k in 0..3 {
+            assert!(
+                (ta.positions[k] - tb.positions[k]).abs().max_element() < 1e-5,
+                "{ta:?} vs {tb:?}"
+            );
+            assert!((ta.normals[k] - tb.normals[k]).abs().max_element() < 1e-5);
+        }
+    }
+    let (ia, ib) = (render_direct(reference), render_direct(via_gltf));
+    let floor_only = render_direct(Scene::from_str(SCENE_HEAD, &dir.join("floor.toml")).unwrap());
+    let rgb =
+        |img: &[f32]| -> Vec<f32> { img.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect() };
+    let (ia, ib, floor_only) = (rgb(&ia), rgb(&ib), rgb(&floor_only));
+    let peak = ia.iter().copied().fold(0.0f32, f32::max);
+    let max_diff = |a: &[f32], b: &[f32]| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0f32, f32::max)
+    };
+    // The box is in view (the comparison below can fail).
+    assert!(max_diff(&ia, &floor_only) > 0.1 * peak);
+    let worst = max_diff(&ia, &ib);
+    eprintln!("direct 32²: max difference {worst}, peak radiance {peak}");
+    assert!(worst <= 1e-4 * peak, "max difference {worst}, peak {peak}");
+}
+
+// ------------------------------------------------------------ whole scenes
+
+#[test]
+fn a_glb_is_a_scene_with_its_camera_lights_and_a_floor() {
+    let dir = temp_dir("whole");
+    let mut g = Gltf::new();
+    let mat = g.material(json!({"name": "white", "pbrMetallicRoughness": {"metallicFactor": 0.0}}));
+    let mesh = g.mesh(&shapes::cuboid(Vec3::ZERO, Vec3::ONE), true, Some(mat));
+    g.root_node(json!({"mesh": mesh}));
+    g.root["cameras"] =
+        json!([{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}]);
+    // A camera 5 m up +z looking down -z (its node's -z).
+    g.root_node(json!({"camera": 0, "translation": [0.5, 0.5, 5.0]}));
+    g.root["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+    g.root["extensions"] = json!({"KHR_lights_punctual": {"lights": [
+        {"type": "point", "intensity": 20.0 * LUMENS_PER_WATT, "color": [1.0, 0.5, 0.25]},
+        {"type": "spot", "intensity": 683.0, "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.6}},
+        {"type": "directional", "intensity": 1000.0 * LUMENS_PER_WATT}
+    ]}});
+    g.root_node(json!({"extensions": {"KHR_lights_punctual": {"light": 0}},
+                       "translation": [0.0, 3.0, 0.0]}));
+    // Rotated -90° about x: its -z turns to -y.
+    let down = Quat::from_rotation_x(-90f32.to_radians());
+    g.root_node(json!({"extensions": {"KHR_lights_punctual": {"light": 1}},
+                       "translation": [1.0, 4.0, 0.0], "rotation": down.to_array()}));
+    g.root_node(json!({"extensions": {"KHR_lights_punctual": {"light": 2}},
+                       "rotation": down.to_array()}));
+    let path = g.write_glb(&dir, "whole");
+    let s = Scene::load(&path).unwrap();
+
+    assert!((s.camera.eye - Vec3::new(0.5, 0.5, 5.0)).length() < 1e-6);
+    let forward = (s.camera.target - s.camera.eye).normalize();
+    assert!((forward - Vec3::NEG_Z).length() < 1e-6);
+    assert!((s.camera.fov_y_deg - 0.8f32.to_degrees()).abs() < 1e-4);
+
+    assert_eq!(s.lights.len(), 3);
+    let (p, sp, d) = (&s.lights[0], &s.lights[1], &s.lights[2]);
+    assert_eq!(p.kind, LightKind::Point);
+    assert!(
+        (p.intensity - Vec3::new(20.0, 10.0, 5.0))
+            .abs()
+            .max_element()
+            < 1e-4
+    );
+    assert!((p.position - Vec3::new(0.0, 3.0, 0.0)).length() < 1e-6);
+    assert_eq!(sp.kind, LightKind::Spot);
+    assert!((sp.intensity - Vec3::ONE).abs().max_element() < 1e-6);
+    assert!((sp.direction - Vec3::NEG_Y).length() < 1e-5);
+    assert!((sp.cone_angle_deg - 0.6f32.to_degrees()).abs() < 1e-4);
+    assert!((sp.cone_falloff_deg - 0.4f32.to_degrees()).abs() < 1e-4);
+    assert_eq!(d.kind, LightKind::Directional);
+    assert!((d.intensity - Vec3::splat(1000.0)).abs().max_element() < 1e-2);
+    assert!((d.direction - Vec3::NEG_Y).length() < 1e-5);
+
+    // The default floor: diffuse, just below the model.
+    assert_eq!(s.objects.len(), 2);
+    let floor = &s.objects[1];
+    let fm = &s.materials[floor.mesh.materials[0] as usize];
+    assert_eq!(
+        (fm.kind, fm.color),
+        (MaterialKind::Diffuse, Vec3::splat(loader::FLOOR_ALBEDO))
+    );
+    assert!(floor
+        .mesh
+        .positions
+        .iter()
+        .all(|p| p.y < 0.0 && p.y > -0.01));
+}
+
+#[test]
+fn a_file_without_camera_or_lights_gets_a_framing_camera_and_a_sun() {
+    let dir = temp_dir("defaults");
+    let mut g = Gltf::new();
+    let mesh = g.mesh(&shapes::cuboid(Vec3::splat(-1.0), Vec3::ONE), true, None);
+    g.root_node(json!({"mesh": mesh, "translation": [2.0, 1.0, 0.0]}));
+    let s = Scene::load(&g.write_glb(&dir, "bare")).unwrap();
+    assert_eq!(s.lights.len(), 1);
+    assert_eq!(s.lights[0].kind, LightKind::Directional);
+    assert_eq!(
+        s.lights[0].intensity,
+        Vec3::splat(loader::DEFAULT_SUN_IRRADIANCE)
+    );
+    assert!((s.camera.target - Vec3::new(2.0, 1.0, 0.0)).length() < 1e-5);
+    // Every corner of the model is inside the view.
+    let (view, proj) = caustics::frame::camera_matrices(&s.camera, 1.0);
+    for p in &s.objects[0].mesh.positions {
+        let c = (proj * view).project_point3(*p);
+        assert!(c.x.abs() < 1.0 && c.y.abs() < 1.0, "{p} -> {c}");
+    }
+}
+
+/// Standard base64 with padding (RFC 4648), for `data:` URIs.
+fn base64(bytes: &[u8]) -> String {
+    const ABC: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for c in bytes.chunks(3) {
+        let n = (c[0] as u32) << 16
+            | (*c.get(1).unwrap_or(&0) as u32) << 8
+            | *c.get(2).unwrap_or(&0) as u32;
+        for k in 0..4 {
+            if k <= c.len() {
+                out.push(ABC[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn buffers_in_data_uris_load_like_files() {
+    let dir = temp_dir("data_uri");
+    let mut g = Gltf::new();
+    let cube = shapes::cuboid(Vec3::ZERO, Vec3::ONE);
+    let mesh = g.mesh(&cube, true, None);
+    g.root_node(json!({"mesh": mesh}));
+    let from_file = loader::load(&g.write_gltf(&dir, "file")).unwrap();
+    let uri = format!("data:application/octet-stream;base64,{}", base64(&g.bin));
+    let path = dir.join("embedded.gltf");
+    std::fs::write(&path, serde_json::to_vec(&g.finish(Some(&uri))).unwrap()).unwrap();
+    let embedded = loader::load(&path).unwrap();
+    assert_eq!(embedded.mesh.positions, from_file.mesh.positions);
+    assert_eq!(embedded.mesh.indices, cube.indices);
+}
+
+// ------------------------------------------------------------ the CLI
+
+fn caustics(args: &[&str]) -> (Option<i32>, String, String) {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_caustics"));
+    if std::env::var_os("VK_DRIVER_FILES").is_none() {
+        c.env(
+            "VK_DRIVER_FILES",
+            "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json",
+        );
+    }
+    let out = c.args(args).env_remove("RUST_BACKTRACE").output().unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn render_takes_a_glb_as_the_scene() {
+    let dir = temp_dir("cli");
+    let mut g = Gltf::new();
+    let mat = g.material(json!({"name": "white", "pbrMetallicRoughness": {"metallicFactor": 0.0}}));
+    let mesh = g.mesh(&shapes::sphere(Vec3::ZERO, 0.5, 16), true, Some(mat));
+    g.root_node(json!({"mesh": mesh}));
+    let path = g.write_glb(&dir, "ball");
+    let out = dir.join("ball.exr");
+    let (code, stdout, stderr) = caustics(&[
+        "render",
+        "--scene",
+        path.to_str().unwrap(),
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(0), "{stdout}\n{stderr}");
+    assert!(out.exists() && dir.join("ball.png").exists());
+}
+
+/// A file that is bad at `at`: `edit` breaks an otherwise valid one.
+struct Bad {
+    name: &'static str,
+    at: &'static str,
+    says: &'static str,
+    edit: fn(&mut Gltf, &Path),
+}
+
+fn bad_files() -> Vec<Bad> {
+    vec![
+        Bad {
+            name: "missing_buffer",
+            at: "buffers[0].uri",
+            says: "cannot read",
+            edit: |g, _| g.root["buffers_uri_override"] = json!("gone.bin"),
+        },
+        Bad {
+            name: "missing_image",
+            at: "images[0].uri",
+            says: "not found",
+            edit: |g, _| g.root["images"] = json!([{"uri": "missing.png"}]),
+        },
+        Bad {
+            name: "accessor_index",
+            at: "meshes[0].primitives[0].attributes",
+            says: "",
+            edit: |g, _| g.root["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = json!(99),
+        },
+        Bad {
+            name: "accessor_past_view",
+            at: "meshes[0].primitives[0].attributes.NORMAL",
+            says: "bufferView",
+            edit: |g, _| {
+                let n = g.root["meshes"][0]["primitives"][0]["attributes"]["NORMAL"].clone();
+                g.root["accessors"][n.as_u64().unwrap() as usize]["count"] = json!(1000);
+            },
+        },
+        Bad {
+            name: "normal_type",
+            at: "meshes[0].primitives[0].attributes.NORMAL",
+            says: "expected Vec3",
+            edit: |g, _| {
+                let n = g.root["meshes"][0]["primitives"][0]["attributes"]["NORMAL"].clone();
+                g.root["accessors"][n.as_u64().unwrap() as usize]["type"] = json!("VEC2");
+            },
+        },
+        Bad {
+            name: "index_range",
+            at: "meshes[0].primitives[0].indices",
+            says: "out of range",
+            edit: |g, _| {
+                let n = g.root["meshes"][0]["primitives"][0]["indices"].as_u64().unwrap();
+                let view = g.root["accessors"][n as usize]["bufferView"].as_u64().unwrap();
+                let off = g.root["bufferViews"][view as usize]["byteOffset"].as_u64().unwrap();
+                g.bin[off as usize..off as usize + 4].copy_from_slice(&1000u32.to_le_bytes());
+            },
+        },
+        Bad {
+            name: "lines",
+            at: "meshes[0].primitives[0].mode",
+            says: "only TRIANGLES",
+            edit: |g, _| g.root["meshes"][0]["primitives"][0]["mode"] = json!(1),
+        },
+        Bad {
+            name: "nan_position",
+            at: "meshes[0].primitives[0].attributes.POSITION",
+            says: "not finite",
+            edit: |g, _| {
+                let n = g.root["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
+                    .as_u64()
+                    .unwrap();
+                let view = g.root["accessors"][n as usize]["bufferView"].as_u64().unwrap();
+                let off = g.root["bufferViews"][view as usize]["byteOffset"].as_u64().unwrap();
+                let o = off as usize + 12 * 2 + 4;
+                g.bin[o..o + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+            },
+        },
+        Bad {
+            name: "cycle",
+            at: "nodes[0]",
+            says: "strict trees",
+            edit: |g, _| g.root["nodes"][0]["children"] = json!([0]),
+        },
+        Bad {
+            name: "too_many_lights",
+            at: "extensions.KHR_lights_punctual",
+            says: "at most 8",
+            edit: |g, _| {
+                g.root["extensions"] = json!({"KHR_lights_punctual": {"lights": [
+                    {"type": "point", "intensity": 1.0}]}});
+                for _ in 0..9 {
+                    g.root_node(json!({"extensions": {"KHR_lights_punctual": {"light": 0}}}));
+                }
+            },
+        },
+        Bad {
+            name: "draco",
+            at: "extensionsRequired[0]",
+            says: "KHR_draco_mesh_compression (compressed geometry) is not supported: the file must be decompressed",
+            edit: |g, _| {
+                g.root["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
+                g.root["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
+            },
+        },
+        Bad {
+            name: "meshopt",
+            at: "extensionsRequired[1]",
+            says: "EXT_meshopt_compression (compressed geometry) is not supported: the file must be decompressed",
+            edit: |g, _| {
+                g.root["extensionsUsed"] = json!(["KHR_lights_punctual", "EXT_meshopt_compression"]);
+                g.root["extensionsRequired"] = json!(["KHR_lights_punctual", "EXT_meshopt_compression"]);
+            },
+        },
+    ]
+}
+
+/// Writes the cube file with `bad` applied.
+fn write_bad(dir: &Path, bad: &Bad) -> PathBuf {
+    let mut g = Gltf::new();
+    let mesh = g.mesh(&shapes::cuboid(Vec3::ZERO, Vec3::ONE), true, None);
+    g.root_node(json!({"mesh": mesh}));
+    (bad.edit)(&mut g, dir);
+    let uri = g
+        .root
+        .as_object_mut()
+        .unwrap()
+        .remove("buffers_uri_override");
+    let path = g.write_gltf(dir, bad.name);
+    if let Some(uri) = uri {
+        let mut root: Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+        root["buffers"][0]["uri"] = uri;
+        std::fs::write(&path, serde_json::to_vec(&root).unwrap()).unwrap();
+    }
+    path
+}
+
+fn assert_one_line_failure(code: Option<i32>, stdout: &str, stderr: &str, needles: &[&str]) {
+    let what = format!("exit {code:?}\n--- stdout\n{stdout}\n--- stderr\n{stderr}");
+    assert_eq!(code, Some(1), "{what}");
+    assert!(stderr.starts_with("error: "), "{what}");
+    assert_eq!(stderr.lines().count(), 1, "{what}");
+    assert!(!stderr.contains("panicked"), "{what}");
+    for n in needles {
+        assert!(stderr.contains(n), "expected `{n}`: {what}");
+    }
+}
+
+#[test]
+fn bad_files_fail_with_one_line_naming_the_file_and_the_gltf_path() {
+    let dir = temp_dir("bad");
+    for bad in bad_files() {
+        let path = write_bad(&dir, &bad);
+        let p = path.to_str().unwrap();
+        let out = dir.join(format!("{}.png", bad.name));
+        let (code, stdout, stderr) =
+            caustics(&["render", "--scene", p, "--out", out.to_str().unwrap()]);
+        let mut needles = vec![p, bad.at];
+        if !bad.says.is_empty() {
+            needles.push(bad.says);
+        }
+        assert_one_line_failure(code, &stdout, &stderr, &needles);
+        assert!(!out.exists(), "{}", bad.name);
+    }
+
+    // The same through a TOML scene's `shape = "gltf"`: located at the
+    // object's `path`, then the file and the glTF path.
+    let bad = &bad_files()[6];
+    write_bad(&dir, bad);
+    let scene = dir.join("scene.toml");
+    let text = format!(
+        "{SCENE_HEAD}\n[[object]]\nshape = \"gltf\"\npath = \"{}.gltf\"\n",
+        bad.name
+    );
+    let line = text.lines().position(|l| l.starts_with("path =")).unwrap() + 1;
+    std::fs::write(&scene, text).unwrap();
+    let (code, stdout, stderr) = caustics(&["render", "--scene", scene.to_str().unwrap()]);
+    let file = dir.join(format!("{}.gltf", bad.name));
+    assert_one_line_failure(
+        code,
+        &stdout,
+        &stderr,
+        &[
+            &format!("{}:{line}:", scene.display()),
+            "object[1].path",
+            file.to_str().unwrap(),
+            bad.at,
+        ],
+    );
+}
+
+// ------------------------------------------------------------ scaling
+
+/// A grid of `n` x `n` quads (2 n² triangles) with normals and UVs, as .glb.
+fn grid_glb(dir: &Path, n: u32) -> PathBuf {
+    let mut m = Mesh::default();
+    let mut uv = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (u, v) = (i as f32 / n as f32, j as f32 / n as f32);
+            m.positions.push(Vec3::new(u, (u * 7.0).sin() * 0.05, v));
+            m.normals.push(Vec3::Y);
+            uv.push(Vec2::new(u, v));
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let a = j * (n + 1) + i;
+            m.indices.push([a, a + n + 1, a + 1]);
+            m.indices.push([a + 1, a + n + 1, a + n + 2]);
+        }
+    }
+    let mut g = Gltf::new();
+    let mesh = g.mesh(&m, true, None);
+    let uv_acc = g.vec2s(&uv);
+    g.root["meshes"][mesh]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uv_acc);
+    g.root_node(json!({"mesh": mesh}));
+    g.write_glb(dir, &format!("grid{n}"))
+}
+
+/// CPU time of the calling thread in seconds, from the scheduler's own
+/// accounting (`/proc/thread-self/schedstat`, nanoseconds): what the load
+/// costs, untouched by how many other processes share the cores.
+fn thread_cpu_seconds() -> f64 {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat")
+        .expect("/proc/thread-self/schedstat (Linux)");
+    let ns: u64 = text.split_whitespace().next().unwrap().parse().unwrap();
+    ns as f64 * 1e-9
+}
+
+/// The loader's CPU time on `path` (it runs on the calling thread).
+fn load_seconds(path: &Path) -> f64 {
+    let start = thread_cpu_seconds();
+    let a = loader::load(path).unwrap();
+    let s = thread_cpu_seconds() - start;
+    assert!(!a.mesh.indices.is_empty());
+    s
+}
+
+fn median(mut t: Vec<f64>) -> f64 {
+    t.sort_by(f64::total_cmp);
+    t[t.len() / 2]
+}
+
+/// Twice the triangles take at most about twice the time (3x allowed for
+/// noise; a quadratic step would give 4x). Timed as the thread's CPU time
+/// (wall clock on 2 cores shared with parallel tests and builds varied 3x
+/// between runs), the two sizes in turn, median of 7 each; both are large
+/// enough that the allocator serves them alike (fresh pages).
+#[test]
+fn loading_scales_linearly_with_the_triangle_count() {
+    let dir = temp_dir("scaling");
+    // 2 * 226² = 102,152 and 2 * 320² = 204,800 triangles.
+    let (small, large) = (grid_glb(&dir, 226), grid_glb(&dir, 320));
+    load_seconds(&small); // warm the file cache and the allocator
+    load_seconds(&large);
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    for _ in 0..7 {
+        a.push(load_seconds(&small));
+        b.push(load_seconds(&large));
+    }
+    let (a, b) = (median(a), median(b));
+    eprintln!(
+        "load (thread CPU time): 102,152 triangles {:.1} ms, 204,800 {:.1} ms",
+        a * 1e3,
+        b * 1e3
+    );
+    assert!(b < 3.0 * a, "{b} s for twice the triangles of {a} s");
+}
