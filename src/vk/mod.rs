@@ -13,6 +13,7 @@
 mod context;
 mod device;
 mod pipeline;
+mod pipeline_create;
 mod pipeline_store;
 mod profiler;
 mod resources;
