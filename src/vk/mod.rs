@@ -16,6 +16,7 @@ mod context;
 mod device;
 mod frame;
 mod pipeline;
+mod pipeline_create;
 mod pipeline_store;
 mod resources;
 mod swapchain;
