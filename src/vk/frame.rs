@@ -27,8 +27,9 @@
 //! (submit to observed completion), frames still overlap, and per-pass numbers
 //! come only on request (`per_pass`): one submission per pass, each waited for.
 
+use super::ring::Ring;
 use super::sync::ResourceState;
-use super::{Access, Buffer, BufferUsage, Context, VkError, VkResult};
+use super::{Access, Buffer, Context, VkError, VkResult};
 use ash::vk;
 use std::any::Any;
 use std::collections::VecDeque;
@@ -105,54 +106,6 @@ pub struct FrameTiming {
     pub submit_to_done_ms: f64,
 }
 
-/// Host-visible chunks the host writes a frame's data into; reset once the
-/// frame's fence has signalled. Grows by adding a chunk; the chunks are
-/// merged into one at the next reset (the GPU is done with them then).
-struct Ring {
-    chunks: Vec<Buffer>,
-    used: u64,
-}
-
-const RING_ALIGN: u64 = 256;
-const RING_MIN: u64 = 64 * 1024;
-
-impl Ring {
-    /// Copies `bytes` into the ring; returns the chunk's index, its buffer and the offset.
-    fn alloc(&mut self, ctx: &Arc<Context>, bytes: &[u8]) -> VkResult<(usize, vk::Buffer, u64)> {
-        let size = bytes.len() as u64;
-        let offset = self.used.next_multiple_of(RING_ALIGN);
-        let fits = self.chunks.last().is_some_and(|c| offset + size <= c.size);
-        let offset = if fits {
-            offset
-        } else {
-            let last = self.chunks.last().map_or(0, |c| c.size);
-            let capacity = size.max(2 * last).max(RING_MIN);
-            self.chunks.push(Buffer::new(
-                ctx,
-                "upload ring",
-                capacity,
-                BufferUsage::Upload,
-            )?);
-            0
-        };
-        let chunk = self.chunks.last().expect("a chunk");
-        chunk.write_at(offset, bytes);
-        self.used = offset + size;
-        Ok((self.chunks.len() - 1, chunk.raw, offset))
-    }
-
-    fn reset(&mut self, ctx: &Arc<Context>) -> VkResult<()> {
-        if self.chunks.len() > 1 {
-            let total: u64 = self.chunks.iter().map(|c| c.size).sum();
-            self.chunks.clear();
-            self.chunks
-                .push(Buffer::new(ctx, "upload ring", total, BufferUsage::Upload)?);
-        }
-        self.used = 0;
-        Ok(())
-    }
-}
-
 struct Pending {
     names: Vec<String>,
     /// Where in the ring the frame's command buffer copied its timestamps
@@ -226,10 +179,7 @@ impl Frames {
             fence: vk::Fence::null(),
             acquired: vk::Semaphore::null(),
             queries: vk::QueryPool::null(),
-            ring: Ring {
-                chunks: Vec::new(),
-                used: 0,
-            },
+            ring: Ring::new(),
             release: Vec::new(),
             pending: None,
         };
@@ -268,7 +218,7 @@ impl Frames {
     fn destroy_slot(&self, slot: &mut Slot) {
         let d = &self.ctx.device;
         slot.release.clear();
-        slot.ring.chunks.clear();
+        slot.ring.clear();
         unsafe {
             d.destroy_query_pool(slot.queries, None);
             d.destroy_semaphore(slot.acquired, None);
@@ -348,7 +298,7 @@ impl Frames {
                 .collect(),
             TimingSource::Timestamps | TimingSource::FrameClock => match pending.ticks {
                 Some((chunk, offset)) => {
-                    let bytes = slot.ring.chunks[chunk].read_at(offset, pending.names.len() * 16);
+                    let bytes = slot.ring.read(chunk, offset, pending.names.len() * 16);
                     let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&bytes);
                     timings(&ctx, pending.names, &ticks)
                 }
@@ -667,54 +617,4 @@ fn semaphore_infos(
                 .stage_mask(stage)
         })
         .collect()
-}
-
-/// One frame at a time, waited for: tests, the reference, calibrations.
-pub struct Profiler {
-    frames: std::cell::RefCell<Frames>,
-    pub source: TimingSource,
-}
-
-impl Profiler {
-    /// Timestamps in one command buffer on a GPU; one command buffer per
-    /// frame timed by the host clock on a CPU device.
-    pub fn new(ctx: &Arc<Context>, max_passes: u32) -> VkResult<Self> {
-        Self::with(ctx, max_passes, false)
-    }
-
-    /// For measurements that need each pass's time: per-pass host clock on
-    /// a CPU device, timestamps on a GPU.
-    pub fn for_timing(ctx: &Arc<Context>, max_passes: u32) -> VkResult<Self> {
-        Self::with(ctx, max_passes, true)
-    }
-
-    fn with(ctx: &Arc<Context>, max_passes: u32, per_pass: bool) -> VkResult<Self> {
-        let frames = Frames::new(
-            ctx,
-            FrameOptions {
-                frames_in_flight: 1,
-                per_pass,
-                max_passes,
-            },
-        )?;
-        Ok(Profiler {
-            source: frames.source,
-            frames: std::cell::RefCell::new(frames),
-        })
-    }
-
-    /// Records, submits and waits for one frame; returns each pass's time.
-    pub fn frame(
-        &self,
-        record: impl FnOnce(&mut FrameRecorder) -> VkResult<()>,
-    ) -> VkResult<Vec<PassTiming>> {
-        let mut frames = self.frames.borrow_mut();
-        let (mut rec, _) = frames.begin_frame()?;
-        let recorded = record(&mut rec);
-        let submitted = rec.submit(&FrameSync::default());
-        let mut done = frames.wait_all()?;
-        recorded?;
-        submitted?;
-        Ok(done.pop().map(|t| t.passes).unwrap_or_default())
-    }
 }

@@ -18,21 +18,24 @@ mod frame;
 mod pipeline;
 mod pipeline_create;
 mod pipeline_store;
+mod profiler;
 mod resources;
+mod ring;
 mod swapchain;
 mod sync;
 
 pub use context::{Context, ContextOptions, ValidationCounts};
 pub use device::{DeviceInfo, RequiredFeature};
 pub use frame::{
-    FrameOptions, FrameRecorder, FrameSync, FrameTiming, Frames, PassTiming, Profiler,
-    TimingSource, MAX_FRAMES_IN_FLIGHT,
+    FrameOptions, FrameRecorder, FrameSync, FrameTiming, Frames, PassTiming, TimingSource,
+    MAX_FRAMES_IN_FLIGHT,
 };
 pub use pipeline::{
     begin_rendering, begin_rendering_with_depth, end_rendering, BindingKind, ComputePipeline,
     DescriptorSet, DescriptorSetLayout, GraphicsPipeline, GraphicsPipelineDesc, Sampler,
 };
 pub use pipeline_store::{CacheLoad, PipelineCounts, PipelineStore, Specialization};
+pub use profiler::Profiler;
 pub use resources::{Buffer, BufferUsage, Image, ImageDesc};
 pub use swapchain::{Acquired, Surface, Swapchain};
 pub use sync::{barrier, copy_image, Access, BufferAccess, ImageAccess};
