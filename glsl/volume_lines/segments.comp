@@ -8,10 +8,11 @@
 // dielectric's front face (a one-bounce reflection, as Hu's gemstone
 // draws both; flagged invalid for other texels).
 //
-// The view is the caustic map's photon view (src/passes/caustic_map.rs
-// `photon_view`: a frustum fitted to the specular objects' bounding sphere,
-// or an orthographic box for directional light), and the front/back
-// G-buffers are `passes::specular_gbuffer` drawn from it, as Hu's "front-
+// The view is the light's view of the specular objects
+// (src/passes/light_views.rs `photon_view`: a frustum fitted to their
+// bounding sphere, or an orthographic box for directional light), and the
+// front/back G-buffers are `passes::specular_gbuffer` drawn from it by
+// `LightViews`, as Hu's "front-
 // and back-facing depth and normal maps of the specular objects".
 // Two-bounce refraction is Wyman's two-sided image-space refraction
 // (glsl/common/image_space_refraction.glsl, the code image_space runs for
