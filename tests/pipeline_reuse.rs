@@ -81,11 +81,13 @@ fn rebuild_reuses_every_pipeline(technique: &str, scene: &str, change: &str) {
     // The second frame of each, as frames may depend on their index
     // (jittered sampling).
     frame(&mut fresh);
-    assert_eq!(
-        reused_image,
-        frame(&mut fresh),
-        "{technique}: reused pipelines render another image"
-    );
+    let fresh_image = frame(&mut fresh);
+    let what = format!("{technique}: reused pipelines render another image");
+    if technique == "water_photons" {
+        common::assert_equal_up_to_splat_order(&fresh_image, &reused_image, &what);
+    } else {
+        assert_eq!(reused_image, fresh_image, "{what}");
+    }
     drop((renderer, fresh));
     common::assert_validation_clean(&ctx);
 }

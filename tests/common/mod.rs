@@ -265,6 +265,32 @@ pub fn assert_finite(rgba: &[f32]) {
 }
 
 /// rgb summed over an RGBA f32 image.
+/// The largest absolute difference between two images.
+pub fn max_difference(a: &[f32], b: &[f32]) -> f32 {
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f32::max)
+}
+
+/// Asserts that two renders of the same frame by `water_photons` agree up to
+/// the reordering of its splats' floating-point sums. It appends photons with
+/// atomics, so their order in the buffer, and with it the order of the sums
+/// that splat them into the caustic image, may differ from run to run (on
+/// lavapipe it does when the machine is loaded: the order follows its worker
+/// threads). Splats add positive flux, so a pixel is a sum of positive
+/// float32 terms, and reordering N terms changes it by at most about
+/// N·2^-24 of the pixel; with up to ~1000 splats on a pixel that is 6e-5 of
+/// it, hence the bound of 1e-4 of the image's peak.
+pub fn assert_equal_up_to_splat_order(a: &[f32], b: &[f32], what: &str) {
+    let peak = a.iter().fold(0f32, |m, v| m.max(v.abs()));
+    let worst = max_difference(a, b);
+    assert!(
+        worst <= 1e-4 * peak,
+        "{what}: worst difference {worst} of peak {peak}"
+    );
+}
+
 pub fn energy(img: &[f32]) -> f64 {
     img.chunks(4).map(|p| (p[0] + p[1] + p[2]) as f64).sum()
 }
