@@ -121,7 +121,7 @@ pub const WATER_SURFACE_GROUP_SIZE: u32 = 8;
 pub const AIRLIGHT_BINDING_RADIANCE: u32 = 0;
 pub const AIRLIGHT_BINDING_SHADOW_MAP: u32 = 1;
 pub const AIRLIGHT_BINDING_SHADOW_LIGHTS: u32 = 2;
-// Ground truth (src/reference.rs, glsl/reference/), descriptor set 1.
+// Ground truth (src/reference/, glsl/reference/), descriptor set 1.
 /// Running sums over passes, COMPONENT_COUNT rgb images.
 pub const REFERENCE_BINDING_TOTAL: u32 = 0;
 /// This pass's radiance estimates, COMPONENT_COUNT rgb images, folded into
