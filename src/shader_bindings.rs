@@ -12,6 +12,10 @@ pub const BINDING_MATERIALS: u32 = 3;
 pub const BINDING_LIGHTS: u32 = 4;
 pub const BINDING_MEDIUM: u32 = 5;
 pub const BINDING_DENSITY_GRID: u32 = 6;
+/// Per-triangle UVs (leaf order, `GpuTriangleUv`).
+pub const BINDING_TRIANGLE_UVS: u32 = 7;
+/// The albedo texture array (sampler2DArray; src/frame/textures.rs).
+pub const BINDING_ALBEDO_TEXTURES: u32 = 8;
 
 // Material kinds (GpuMaterial.color.w as uint bits).
 pub const MATERIAL_DIFFUSE: u32 = 0;
@@ -58,6 +62,7 @@ pub const DIRECT_BINDING_NORMAL: u32 = 1;
 pub const DIRECT_BINDING_RADIANCE: u32 = 2;
 pub const DIRECT_BINDING_SHADOW_MAP: u32 = 3;
 pub const DIRECT_BINDING_SHADOW_LIGHTS: u32 = 4;
+pub const DIRECT_BINDING_ALBEDO: u32 = 5;
 
 // BVH probe (glsl/tests/bvh_probe.comp, tests/bvh_gpu.rs), descriptor set 1
 // (set 0 is the scene). Numbers kept from the probe's first version.
@@ -80,6 +85,8 @@ pub const CAUSTIC_BINDING_FRONT_POSITION: u32 = 6;
 pub const CAUSTIC_BINDING_FRONT_NORMAL: u32 = 7;
 pub const CAUSTIC_BINDING_BACK_POSITION: u32 = 8;
 pub const CAUSTIC_BINDING_BACK_NORMAL: u32 = 9;
+/// The camera G-buffer's albedo (caustic apply).
+pub const CAUSTIC_BINDING_ALBEDO: u32 = 10;
 /// Photon modes (`photon_mode` parameter of image_space).
 pub const PHOTON_MODE_TRACED: u32 = 0;
 pub const PHOTON_MODE_IMAGE_SPACE: u32 = 1;
@@ -158,6 +165,7 @@ pub const WP_BINDING_CAUSTICS: u32 = 6;
 pub const WP_BINDING_GBUFFER_POSITION: u32 = 7;
 pub const WP_BINDING_GBUFFER_NORMAL: u32 = 8;
 pub const WP_BINDING_RADIANCE: u32 = 9;
+pub const WP_BINDING_GBUFFER_ALBEDO: u32 = 15;
 // water_photons "water view": the photon slot per (texel, cascade, ray
 // type) written by the trace, and the camera's view of the water.
 pub const WP_BINDING_PHOTON_SLOTS: u32 = 10;

@@ -6,7 +6,9 @@
 //! `renderer` or `reference` (docs/ARCHITECTURE.md, "Layers").
 
 mod scene_gpu;
+mod textures;
 mod targets;
 
 pub use scene_gpu::{camera_matrices, GeometryStats, SceneGpu};
 pub use targets::FrameTargets;
+pub use textures::AlbedoTextures;

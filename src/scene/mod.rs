@@ -12,6 +12,7 @@ mod file;
 mod node;
 pub mod obj;
 pub mod shapes;
+pub mod texture;
 mod types;
 pub mod water;
 
@@ -121,6 +122,7 @@ impl Scene {
                 out.push(Triangle {
                     positions: t.map(|i| positions[i as usize]),
                     normals: t.map(|i| normals[i as usize]),
+                    uvs: t.map(|i| mesh.uvs.get(i as usize).copied().unwrap_or_default()),
                     material,
                     object: oi as u32,
                 });

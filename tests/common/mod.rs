@@ -44,6 +44,7 @@ pub fn diffuse(name: &str, albedo: f32) -> Material {
         color: Vec3::splat(albedo),
         ior: 1.0,
         absorption: Vec3::ZERO,
+        texture: None,
     }
 }
 
@@ -54,6 +55,7 @@ pub fn dielectric(name: &str, ior: f32) -> Material {
         color: Vec3::ONE,
         ior,
         absorption: Vec3::ZERO,
+        texture: None,
     }
 }
 
@@ -67,6 +69,7 @@ pub fn floor_mesh(half: f32, y: f32, material: u32) -> Mesh {
             Vec3::new(-half, y, half),
         ],
         normals: vec![Vec3::Y; 4],
+        uvs: Vec::new(),
         indices: vec![[0, 2, 1], [0, 3, 2]],
         materials: vec![material; 2],
     }
@@ -233,6 +236,7 @@ pub fn scene(
         objects,
         medium: None,
         output: Output { exposure: 1.0 },
+        textures: Vec::new(),
     }
 }
 

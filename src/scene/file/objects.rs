@@ -8,7 +8,7 @@ use crate::scene::node::Tbl;
 use crate::scene::node::R;
 use crate::scene::types::*;
 use crate::scene::{obj, shapes};
-use glam::{Mat4, Quat, Vec3};
+use glam::{Mat4, Quat, Vec2, Vec3};
 use std::path::Path;
 
 const COMMON_OBJECT_KEYS: [&str; 7] = [
@@ -212,8 +212,20 @@ fn mesh_object(
                 let index = match *slot {
                     Some(i) => i,
                     None => {
-                        let m = &loaded.materials[*x as usize];
-                        let i = materials.add_mtl(m).ok_or_else(|| {
+                        let mut m = loaded.materials[*x as usize].clone();
+                        if let Some(path) = &loaded.albedo_textures[*x as usize] {
+                            let index = materials.texture(path).map_err(|e| {
+                                t.err(
+                                    "path",
+                                    format!("map_Kd of MTL material `{}`: {e}", m.name),
+                                )
+                            })?;
+                            m.texture = Some(AlbedoTexture {
+                                index,
+                                uv_scale: Vec2::ONE,
+                            });
+                        }
+                        let i = materials.add_mtl(&m).ok_or_else(|| {
                             t.err(
                                 "path",
                                 format!(

@@ -159,6 +159,7 @@ impl ImageSpace {
                 (b::CAUSTIC_BINDING_MAP, BindingKind::Sampled),
                 (b::CAUSTIC_BINDING_POSITION, BindingKind::StorageImage),
                 (b::CAUSTIC_BINDING_NORMAL, BindingKind::StorageImage),
+                (b::CAUSTIC_BINDING_ALBEDO, BindingKind::StorageImage),
                 (b::CAUSTIC_BINDING_RADIANCE, BindingKind::StorageImage),
             ],
         )?;
@@ -173,6 +174,7 @@ impl ImageSpace {
             )
             .write_storage_image(b::CAUSTIC_BINDING_POSITION, &direct.gbuffer.position)
             .write_storage_image(b::CAUSTIC_BINDING_NORMAL, &direct.gbuffer.normal)
+            .write_storage_image(b::CAUSTIC_BINDING_ALBEDO, &direct.gbuffer.albedo)
             .write_storage_image(b::CAUSTIC_BINDING_RADIANCE, &opaque.radiance);
         let apply = ComputePipeline::new(
             ctx,
@@ -271,6 +273,7 @@ impl Technique for ImageSpace {
                     ImageAccess::new(&self.caustics.map, Access::ComputeRead),
                     ImageAccess::new(&self.direct.gbuffer.position, Access::ComputeRead),
                     ImageAccess::new(&self.direct.gbuffer.normal, Access::ComputeRead),
+                    ImageAccess::new(&self.direct.gbuffer.albedo, Access::ComputeRead),
                     ImageAccess::new(&self.opaque.radiance, Access::ComputeWrite),
                 ],
                 &[],
