@@ -208,12 +208,7 @@ impl GpuMaterial {
         Self {
             color: v4(m.color, f32::from_bits(kind)),
             absorption_ior: v4(m.absorption, m.ior),
-            texture: [
-                f32::from_bits(layer as u32),
-                uv_scale.x,
-                uv_scale.y,
-                0.0,
-            ],
+            texture: [f32::from_bits(layer as u32), uv_scale.x, uv_scale.y, 0.0],
         }
     }
 }

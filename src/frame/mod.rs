@@ -6,8 +6,8 @@
 //! `renderer` or `reference` (docs/ARCHITECTURE.md, "Layers").
 
 mod scene_gpu;
-mod textures;
 mod targets;
+mod textures;
 
 pub use scene_gpu::{camera_matrices, GeometryStats, SceneGpu};
 pub use targets::FrameTargets;

@@ -2,8 +2,8 @@
 //! materials, lights, medium and the per-frame uniform block, bound as
 //! descriptor set 0 (glsl/common/scene.glsl) by every pass that reads them.
 
-use crate::bvh::Bvh;
 use super::AlbedoTextures;
+use crate::bvh::Bvh;
 use crate::gpu::{GpuFrame, GpuLight, GpuMaterial, GpuMedium, GpuTriangle, GpuTriangleUv};
 use crate::radiometry::Component;
 use crate::scene::{Camera, Density, MaterialKind, Scene, Triangle};

@@ -178,8 +178,16 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
         let mut map: HashMap<(u32, u32, u32), u32> = HashMap::with_capacity(m.indices.len());
         let mut remap = Vec::with_capacity(m.indices.len());
         for (k, &pi) in m.indices.iter().enumerate() {
-            let ni = if has_normals { m.normal_indices[k] } else { u32::MAX };
-            let ti = if has_uvs { m.texcoord_indices[k] } else { u32::MAX };
+            let ni = if has_normals {
+                m.normal_indices[k]
+            } else {
+                u32::MAX
+            };
+            let ti = if has_uvs {
+                m.texcoord_indices[k]
+            } else {
+                u32::MAX
+            };
             let next = base + map.len() as u32;
             let idx = *map.entry((pi, ni, ti)).or_insert_with(|| {
                 let n = if has_normals {

@@ -231,7 +231,10 @@ mod tests {
         assert_eq!(mesh.positions.len(), mesh.normals.len());
         assert_eq!(mesh.positions.len(), mesh.uvs.len());
         for uv in &mesh.uvs {
-            assert!(uv.cmpge(Vec2::ZERO).all() && uv.cmple(Vec2::ONE).all(), "{uv}");
+            assert!(
+                uv.cmpge(Vec2::ZERO).all() && uv.cmple(Vec2::ONE).all(),
+                "{uv}"
+            );
         }
         assert!(!mesh.indices.is_empty());
         for t in &mesh.indices {

@@ -49,13 +49,7 @@ pub fn load(path: &Path) -> Result<Texture, String> {
     let rgb = decoded.into_rgb32f();
     let texels: Vec<[f32; 3]> = rgb
         .pixels()
-        .map(|p| {
-            if linear {
-                p.0
-            } else {
-                p.0.map(srgb_to_linear)
-            }
-        })
+        .map(|p| if linear { p.0 } else { p.0.map(srgb_to_linear) })
         .collect();
     if let Some(i) = texels.iter().position(|t| !Vec3::from(*t).is_finite()) {
         return Err(format!(
@@ -161,9 +155,7 @@ mod tests {
     #[test]
     fn mip_chain_keeps_the_mean_down_to_one_texel() {
         // A 4x4 checker of 0 and 1: every level's mean is 1/2.
-        let texels = (0..16)
-            .map(|i| [((i % 4 + i / 4) % 2) as f32; 3])
-            .collect();
+        let texels = (0..16).map(|i| [((i % 4 + i / 4) % 2) as f32; 3]).collect();
         let levels = mip_chain(&texture(4, 4, texels), 4);
         assert_eq!(levels.len(), 3);
         for level in &levels {

@@ -284,7 +284,12 @@ impl Image {
         };
         let image = Self::create(ctx, name, desc, true, levels.len() as u32)?;
         let bytes: Vec<u8> = levels.concat();
-        let staging = Buffer::new(ctx, "texture staging", bytes.len() as u64, BufferUsage::Upload)?;
+        let staging = Buffer::new(
+            ctx,
+            "texture staging",
+            bytes.len() as u64,
+            BufferUsage::Upload,
+        )?;
         staging.upload(&bytes)?;
         let range = vk::ImageSubresourceRange {
             aspect_mask: vk::ImageAspectFlags::COLOR,

@@ -215,10 +215,7 @@ fn mesh_object(
                         let mut m = loaded.materials[*x as usize].clone();
                         if let Some(path) = &loaded.albedo_textures[*x as usize] {
                             let index = materials.texture(path).map_err(|e| {
-                                t.err(
-                                    "path",
-                                    format!("map_Kd of MTL material `{}`: {e}", m.name),
-                                )
+                                t.err("path", format!("map_Kd of MTL material `{}`: {e}", m.name))
                             })?;
                             m.texture = Some(AlbedoTexture {
                                 index,
