@@ -299,3 +299,56 @@ fn missing_or_unreadable_textures_are_clear_errors() {
         assert!(!out_png.exists(), "{name}: an image was written");
     }
 }
+
+/// OBJ `vt` reach the triangles with v flipped (OBJ's v = 0 is the image's
+/// bottom row), an MTL `map_Kd` becomes the material's texture (albedo 1
+/// without `Kd`), one file used twice is decoded once, `uv_scale` without a
+/// texture is refused, and the canonical pool_tiles scene has its texture.
+#[test]
+fn obj_texcoords_map_kd_and_fields_load() {
+    let dir = temp_dir("obj");
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 255, 255]))
+        .save(dir.join("white.png"))
+        .unwrap();
+    std::fs::write(
+        dir.join("quad.obj"),
+        "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 0 1\nvt 0 0\nvt 1 0\nvt 1 0.25\nusemtl tiles\nf 1/1 3/3 2/2\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("quad.mtl"), "newmtl tiles\nmap_Kd white.png\n").unwrap();
+    let text = scene_text("albedo_texture = \"white.png\"").replace(
+        "shape = \"plane\"\nsize = [20.0, 20.0]\ntangent = [1.0, 0.0, 0.0]\nmaterial = \"floor\"",
+        "shape = \"mesh\"\npath = \"quad.obj\"",
+    );
+    let path = dir.join("obj.toml");
+    std::fs::write(&path, text).unwrap();
+    let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.textures.len(), 1, "white.png decoded once");
+    let mtl = &scene.materials[scene.material_index("quad.obj:tiles").unwrap() as usize];
+    assert_eq!(mtl.texture.map(|t| t.index), Some(0));
+    assert_eq!(mtl.color, glam::Vec3::ONE);
+    let tri = scene
+        .triangles(0.0)
+        .into_iter()
+        .find(|t| t.object == 0)
+        .unwrap();
+    let mut uvs = tri.uvs.to_vec();
+    uvs.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    let expected = [(0.0, 1.0), (1.0, 0.75), (1.0, 1.0)].map(|(u, v)| glam::Vec2::new(u, v));
+    assert_eq!(uvs, expected);
+
+    let path = dir.join("uv_scale.toml");
+    std::fs::write(&path, scene_text("uv_scale = [2.0, 2.0]")).unwrap();
+    let err = Scene::load(&path).unwrap_err().to_string();
+    assert!(
+        err.contains(": material[0].uv_scale: needs an `albedo_texture`"),
+        "{err}"
+    );
+
+    let pool = Scene::load(Path::new("assets/scenes/pool_tiles.toml")).unwrap();
+    assert_eq!(pool.textures.len(), 1);
+    assert_eq!(
+        (pool.textures[0].width, pool.textures[0].height),
+        (128, 128)
+    );
+}

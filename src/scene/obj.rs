@@ -111,21 +111,24 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
         || path.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     );
-    let converted: Vec<Material> = materials
+    let mut converted: Vec<Material> = materials
         .iter()
         .map(|m| convert_material(&prefix, m))
         .collect();
-    let albedo_textures = materials
-        .iter()
-        .zip(&converted)
-        .map(|(m, c)| {
-            m.diffuse_texture
-                .as_deref()
-                .map(str::trim)
-                .filter(|t| c.kind == MaterialKind::Diffuse && !t.is_empty())
-                .map(|t| dir.join(t))
-        })
-        .collect();
+    let mut albedo_textures = Vec::with_capacity(materials.len());
+    for (m, c) in materials.iter().zip(&mut converted) {
+        let texture = m
+            .diffuse_texture
+            .as_deref()
+            .map(str::trim)
+            .filter(|t| c.kind == MaterialKind::Diffuse && !t.is_empty())
+            .map(|t| dir.join(t));
+        // `Kd` scales `map_Kd`; without a `Kd` the texture stands alone.
+        if texture.is_some() && m.diffuse.is_none() {
+            c.color = Vec3::ONE;
+        }
+        albedo_textures.push(texture);
+    }
 
     let mut mesh = Mesh::default();
     let mut all_normals = true;
