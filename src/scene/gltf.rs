@@ -825,6 +825,7 @@ fn convert_material(name: String, m: &::gltf::Material) -> (Material, bool, Vec<
         ));
     }
     let mut out = Material {
+        texture: None,
         name,
         kind: MaterialKind::Diffuse,
         color: base,
@@ -967,6 +968,7 @@ pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError
     if options.floor {
         let material = materials.len() as u32;
         materials.push(Material {
+            texture: None,
             name: "floor".into(),
             kind: MaterialKind::Diffuse,
             color: Vec3::splat(FLOOR_ALBEDO),
@@ -1019,6 +1021,7 @@ pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError
         camera,
         lights,
         materials,
+        textures: Vec::new(),
         objects,
         medium: None,
         output: Output { exposure },

@@ -8,7 +8,7 @@ use crate::scene::node::Tbl;
 use crate::scene::node::R;
 use crate::scene::types::*;
 use crate::scene::{gltf, obj, shapes};
-use glam::{Mat4, Quat, Vec3};
+use glam::{Mat4, Quat, Vec2, Vec3};
 use std::path::Path;
 
 const COMMON_OBJECT_KEYS: [&str; 7] = [
@@ -185,11 +185,12 @@ fn file_object(
     mut mesh: Mesh,
     material: Option<u32>,
     imported: &[Material],
+    texture: &mut ImportTexture,
     materials: &mut Materials,
 ) -> R<Object> {
     match material {
         Some(m) => mesh.materials.iter_mut().for_each(|x| *x = m),
-        None => import_materials(t, &mut mesh, imported, materials)?,
+        None => import_materials(t, &mut mesh, imported, texture, materials)?,
     }
     placed(t, name, mesh)
 }
@@ -225,8 +226,36 @@ fn mesh_object(
             ));
         }
     }
-    file_object(t, name, loaded.mesh, material, &loaded.materials, materials)
+    // An MTL `map_Kd` is the material's texture, at the OBJ's own UVs.
+    let mut texture = |materials: &mut Materials, i: usize| -> R<Option<AlbedoTexture>> {
+        let Some(path) = &loaded.albedo_textures[i] else {
+            return Ok(None);
+        };
+        let index = materials.texture(path).map_err(|e| {
+            t.err(
+                "path",
+                format!("map_Kd of MTL material `{}`: {e}", loaded.materials[i].name),
+            )
+        })?;
+        Ok(Some(AlbedoTexture {
+            index,
+            uv_scale: Vec2::ONE,
+        }))
+    };
+    file_object(
+        t,
+        name,
+        loaded.mesh,
+        material,
+        &loaded.materials,
+        &mut texture,
+        materials,
+    )
 }
+
+/// The albedo texture of a loaded file's material `i` (added to the
+/// scene's textures), if it has one.
+type ImportTexture<'a> = dyn FnMut(&mut Materials, usize) -> R<Option<AlbedoTexture>> + 'a;
 
 /// Maps a loaded file's materials (indices into `imported` in
 /// `mesh.materials`) to scene materials, adding only those faces use and
@@ -235,6 +264,7 @@ fn import_materials(
     t: &Tbl,
     mesh: &mut Mesh,
     imported: &[Material],
+    texture: &mut ImportTexture,
     materials: &mut Materials,
 ) -> R<()> {
     let mut map = vec![None; imported.len()];
@@ -243,8 +273,9 @@ fn import_materials(
         let index = match *slot {
             Some(i) => i,
             None => {
-                let m = &imported[*x as usize];
-                let i = materials.add_mtl(m).ok_or_else(|| {
+                let mut m = imported[*x as usize].clone();
+                m.texture = texture(materials, *x as usize)?;
+                let i = materials.add_mtl(&m).ok_or_else(|| {
                     t.err(
                         "path",
                         format!("material name `{}` collides with another material", m.name),
@@ -277,7 +308,15 @@ fn gltf_object(
             log::warn!("{w}");
         }
     }
-    file_object(t, name, loaded.mesh, material, &loaded.materials, materials)
+    file_object(
+        t,
+        name,
+        loaded.mesh,
+        material,
+        &loaded.materials,
+        &mut |_, _| Ok(None),
+        materials,
+    )
 }
 
 /// `translate * rotate_z * rotate_y * rotate_x * scale`: scale first, then X, Y, Z rotations, then translation.
