@@ -38,6 +38,22 @@ pub fn load(path: &Path) -> Result<Texture, String> {
     let decoded = reader
         .decode()
         .map_err(|e| format!("cannot decode texture {}: {e}", path.display()))?;
+    from_image(decoded, path)
+}
+
+/// An image file's bytes held in memory (a glTF image in a buffer view or
+/// a `data:` URI), decoded as [`load`] decodes a file; `name` stands for
+/// the path in the texture and its errors.
+pub fn decode(bytes: &[u8], name: &Path) -> Result<Texture, String> {
+    let decoded = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| format!("cannot read texture {}: {e}", name.display()))?
+        .decode()
+        .map_err(|e| format!("cannot decode texture {}: {e}", name.display()))?;
+    from_image(decoded, name)
+}
+
+fn from_image(decoded: DynamicImage, path: &Path) -> Result<Texture, String> {
     let (width, height) = (decoded.width(), decoded.height());
     if width == 0 || height == 0 {
         return Err(format!("texture {} is empty", path.display()));

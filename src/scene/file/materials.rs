@@ -75,14 +75,22 @@ impl Materials {
     /// The index in `Scene::textures` of the texture file `path`, decoding
     /// it on first use. The error says why (without a scene location).
     pub(super) fn texture(&mut self, path: &Path) -> Result<u32, String> {
-        if let Some(&i) = self.texture_by_path.get(path) {
-            return Ok(i);
+        match self.texture_by_path.get(path) {
+            Some(&i) => Ok(i),
+            None => Ok(self.add_texture(texture::load(path)?)),
         }
-        let t = texture::load(path)?;
+    }
+
+    /// The index in `Scene::textures` of a decoded texture: the one of the
+    /// same `path` if already added (the same image named twice).
+    pub(super) fn add_texture(&mut self, t: Texture) -> u32 {
+        if let Some(&i) = self.texture_by_path.get(&t.path) {
+            return i;
+        }
         let i = self.textures.len() as u32;
+        self.texture_by_path.insert(t.path.clone(), i);
         self.textures.push(t);
-        self.texture_by_path.insert(path.to_path_buf(), i);
-        Ok(i)
+        i
     }
 
     /// The materials and the textures they index.

@@ -302,19 +302,30 @@ fn gltf_object(
     materials: &mut Materials,
 ) -> R<Object> {
     let full = dir.join(t.str("path")?);
-    let loaded = gltf::load(&full).map_err(|e| t.err("path", e.to_string()))?;
+    let mut loaded = gltf::load(&full).map_err(|e| t.err("path", e.to_string()))?;
     if material.is_none() {
         for w in &loaded.warnings {
             log::warn!("{w}");
         }
+        // The file's textures read the UVs through their KHR_texture_transform.
+        loaded.transform_uvs();
     }
+    // A base colour texture joins the scene's textures (an image file shared
+    // with any other use of it); its transform is already in the UVs.
+    let textures = &loaded.base_color_textures;
+    let mut texture = |materials: &mut Materials, i: usize| -> R<Option<AlbedoTexture>> {
+        Ok(textures[i].as_ref().map(|t| AlbedoTexture {
+            index: materials.add_texture(t.pixels.clone()),
+            uv_scale: Vec2::ONE,
+        }))
+    };
     file_object(
         t,
         name,
         loaded.mesh,
         material,
         &loaded.materials,
-        &mut |_, _| Ok(None),
+        &mut texture,
         materials,
     )
 }
