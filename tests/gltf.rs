@@ -386,17 +386,8 @@ fn textured_gltf_floor_matches_the_toml_albedo_texture() {
     let png = checker_png();
     std::fs::write(dir.join("checker.png"), &png).unwrap();
     let floor = shapes::plane(Vec3::ZERO, Vec3::Y, None, [6.0, 6.0]);
-    let head = r#"
-[camera]
-eye = [2.5, 3.0, 4.0]
-target = [0.0, 0.0, 0.0]
-fov_y = 45.0
-
-[[light]]
-kind = "point"
-position = [1.0, 4.0, 2.0]
-intensity = 30.0
-"#;
+    // The camera, the light and the "white" material, without the floor.
+    let head = SCENE_HEAD.split("\n[[object]]").next().unwrap();
     // image: the glTF `images[0]` (JSON), given the writer for buffer views.
     let write = |name: &str, glb: bool, image: &dyn Fn(&mut Gltf) -> Value| {
         let mut g = Gltf::new();
@@ -463,7 +454,7 @@ size = [6.0, 6.0]
         let text = format!("{head}\n[[object]]\nshape = \"gltf\"\npath = \"{name}\"\n");
         let scene = Scene::from_str(&text, &dir.join(format!("{name}.toml"))).unwrap();
         assert_eq!(scene.textures.len(), 1, "{name}");
-        let m = scene.materials[0].texture.expect("textured material");
+        let m = scene.materials[1].texture.expect("textured material");
         assert_eq!(m.uv_scale, Vec2::ONE, "{name}: the transform is in the UVs");
         let worst = max_diff(&reference, &render_direct(scene));
         eprintln!("{name}: direct 32², max difference {worst}, peak {peak}");
