@@ -1,7 +1,8 @@
 //! glTF 2.0 files (`.gltf` with its buffers, or `.glb`) through the `gltf`
 //! crate: the meshes of the default scene with their node transforms, the
-//! materials mapped to the project's radiometry, the file's camera and its
-//! `KHR_lights_punctual` lights. docs/SCENES.md ("glTF 2.0") states every
+//! materials mapped to the project's radiometry (base colour textures
+//! decoded, `KHR_texture_transform` applied to `TEXCOORD_0`), the file's
+//! camera and its `KHR_lights_punctual` lights. docs/SCENES.md ("glTF 2.0") states every
 //! rule and mapping; `load` reads a file into a [`GltfAsset`], `scene` makes
 //! a whole scene of one (`caustics render --scene model.glb`).
 //!
