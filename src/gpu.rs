@@ -26,6 +26,20 @@ pub struct GpuTriangle {
     pub n2: [f32; 4],
 }
 
+/// The texture coordinates of one triangle, in the same (leaf) order as the
+/// triangle buffer but a buffer of their own (binding BINDING_TRIANGLE_UVS):
+/// BVH traversal reads only `GpuTriangle`, and widening that to 128 bytes
+/// would add a third to the memory every ray's intersection tests fetch, for
+/// data only a diffuse hit's shading needs (once per hit, not per test).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuTriangleUv {
+    /// xy: UV of vertex 0; zw: UV of vertex 1.
+    pub uv01: [f32; 4],
+    /// xy: UV of vertex 2; zw: unused.
+    pub uv2: [f32; 4],
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct GpuBvhNode {
@@ -44,6 +58,9 @@ pub struct GpuMaterial {
     pub color: [f32; 4],
     /// rgb absorption (1/m); w = ior.
     pub absorption_ior: [f32; 4],
+    /// x = albedo texture layer (int bits, -1: none); yz = uv_scale; w unused.
+    /// A diffuse albedo is `color.rgb` times the layer at `uv * uv_scale`.
+    pub texture: [f32; 4],
 }
 
 #[repr(C)]
@@ -125,7 +142,10 @@ const _: () = {
     assert!(size_of::<GpuTriangle>() == 96);
     assert!(size_of::<GpuBvhNode>() == 32);
     assert!(offset_of!(GpuBvhNode, count) == 28);
-    assert!(size_of::<GpuMaterial>() == 32);
+    assert!(size_of::<GpuTriangleUv>() == 32);
+    assert!(offset_of!(GpuTriangleUv, uv2) == 16);
+    assert!(size_of::<GpuMaterial>() == 48);
+    assert!(offset_of!(GpuMaterial, texture) == 32);
     assert!(size_of::<GpuLight>() == 64);
     assert!(size_of::<GpuMedium>() == 96);
     assert!(offset_of!(GpuMedium, dims) == 80);
@@ -164,6 +184,16 @@ impl GpuTriangle {
     }
 }
 
+impl GpuTriangleUv {
+    pub fn new(t: &Triangle) -> Self {
+        let [a, b, c] = t.uvs;
+        Self {
+            uv01: [a.x, a.y, b.x, b.y],
+            uv2: [c.x, c.y, 0.0, 0.0],
+        }
+    }
+}
+
 impl GpuMaterial {
     pub fn new(m: &Material) -> Self {
         let kind = match m.kind {
@@ -171,9 +201,14 @@ impl GpuMaterial {
             MaterialKind::Mirror => b::MATERIAL_MIRROR,
             MaterialKind::Dielectric => b::MATERIAL_DIELECTRIC,
         };
+        let (layer, uv_scale) = match m.texture {
+            Some(t) if m.kind == MaterialKind::Diffuse => (t.index as i32, t.uv_scale),
+            _ => (-1, glam::Vec2::ONE),
+        };
         Self {
             color: v4(m.color, f32::from_bits(kind)),
             absorption_ior: v4(m.absorption, m.ior),
+            texture: [f32::from_bits(layer as u32), uv_scale.x, uv_scale.y, 0.0],
         }
     }
 }

@@ -15,6 +15,10 @@ pub const BINDING_MATERIALS: u32 = 3;
 pub const BINDING_LIGHTS: u32 = 4;
 pub const BINDING_MEDIUM: u32 = 5;
 pub const BINDING_DENSITY_GRID: u32 = 6;
+/// Per-triangle UVs (leaf order, `GpuTriangleUv`).
+pub const BINDING_TRIANGLE_UVS: u32 = 7;
+/// The albedo texture array (sampler2DArray; src/frame/textures.rs).
+pub const BINDING_ALBEDO_TEXTURES: u32 = 8;
 
 // Material kinds (GpuMaterial.color.w as uint bits).
 pub const MATERIAL_DIFFUSE: u32 = 0;
@@ -61,6 +65,7 @@ pub const DIRECT_BINDING_NORMAL: u32 = 1;
 pub const DIRECT_BINDING_RADIANCE: u32 = 2;
 pub const DIRECT_BINDING_SHADOW_MAP: u32 = 3;
 pub const DIRECT_BINDING_SHADOW_LIGHTS: u32 = 4;
+pub const DIRECT_BINDING_ALBEDO: u32 = 5;
 
 // BVH probe (glsl/tests/bvh_probe.comp, tests/bvh_gpu.rs), descriptor set 1
 // (set 0 is the scene). Numbers kept from the probe's first version.
@@ -83,6 +88,8 @@ pub const CAUSTIC_BINDING_FRONT_POSITION: u32 = 6;
 pub const CAUSTIC_BINDING_FRONT_NORMAL: u32 = 7;
 pub const CAUSTIC_BINDING_BACK_POSITION: u32 = 8;
 pub const CAUSTIC_BINDING_BACK_NORMAL: u32 = 9;
+/// The camera G-buffer's albedo (caustic apply).
+pub const CAUSTIC_BINDING_ALBEDO: u32 = 10;
 /// Photon modes (`photon_mode` parameter of image_space).
 pub const PHOTON_MODE_TRACED: u32 = 0;
 pub const PHOTON_MODE_IMAGE_SPACE: u32 = 1;

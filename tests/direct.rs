@@ -42,6 +42,7 @@ fn diffuse(name: &str) -> Material {
         color: Vec3::splat(ALBEDO),
         ior: 1.0,
         absorption: Vec3::ZERO,
+        texture: None,
     }
 }
 
@@ -57,6 +58,7 @@ fn plane() -> Object {
                 Vec3::new(-h, 0.0, h),
             ],
             normals: vec![Vec3::Y; 4],
+            uvs: Vec::new(),
             indices: vec![[0, 2, 1], [0, 3, 2]],
             materials: vec![0, 0],
         },
@@ -115,6 +117,7 @@ fn scene(lights: Vec<Light>, with_box: bool) -> Scene {
         objects,
         medium: None,
         output: Output { exposure: 1.0 },
+        textures: Vec::new(),
     }
 }
 

@@ -68,77 +68,6 @@ const MAX_BLOCK_MEAN: f64 = 0.015;
 const MAX_BLOCK_WORST: f64 = 0.05;
 const MAX_FLIP_MEAN: f32 = 0.045;
 
-/// rgb summed, the quantity compared per pixel.
-fn sum_rgb(img: &[f32], i: usize) -> f64 {
-    (img[i * 4] + img[i * 4 + 1] + img[i * 4 + 2]) as f64
-}
-
-/// Pixels away from discontinuities of the noise-free `direct` image.
-fn smooth_mask(img: &[f32]) -> Vec<bool> {
-    let s = SIZE as i32;
-    (0..s * s)
-        .map(|i| {
-            let (x, y) = (i % s, i / s);
-            let (mut lo, mut hi) = (f64::MAX, f64::MIN);
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    let (nx, ny) = ((x + dx).clamp(0, s - 1), (y + dy).clamp(0, s - 1));
-                    let v = sum_rgb(img, (ny * s + nx) as usize);
-                    lo = lo.min(v);
-                    hi = hi.max(v);
-                }
-            }
-            hi - lo <= 0.15 * hi + 0.02
-        })
-        .collect()
-}
-
-struct Blocks {
-    mean: f64,
-    worst: f64,
-    worst_at: (u32, u32),
-    used: usize,
-}
-
-/// Relative error of 16x16 block sums over the pixels in `mask`.
-fn block_errors(actual: &[f32], reference: &[f32], mask: &[bool]) -> Blocks {
-    let n = (SIZE * SIZE) as usize;
-    let mean_r = (0..n).map(|i| sum_rgb(reference, i)).sum::<f64>() / n as f64;
-    let mut b = Blocks {
-        mean: 0.0,
-        worst: 0.0,
-        worst_at: (0, 0),
-        used: 0,
-    };
-    for by in 0..SIZE / BLOCK {
-        for bx in 0..SIZE / BLOCK {
-            let (mut a, mut r, mut count) = (0.0, 0.0, 0);
-            for y in by * BLOCK..(by + 1) * BLOCK {
-                for x in bx * BLOCK..(bx + 1) * BLOCK {
-                    let i = (y * SIZE + x) as usize;
-                    if mask[i] {
-                        a += sum_rgb(actual, i);
-                        r += sum_rgb(reference, i);
-                        count += 1;
-                    }
-                }
-            }
-            if count < (BLOCK * BLOCK / 4) as usize || r / (count as f64) < 0.1 * mean_r {
-                continue;
-            }
-            let e = ((a - r) / r).abs();
-            b.mean += e;
-            b.used += 1;
-            if e > b.worst {
-                b.worst = e;
-                b.worst_at = (bx, by);
-            }
-        }
-    }
-    b.mean /= b.used.max(1) as f64;
-    b
-}
-
 fn load() -> Scene {
     Scene::load(Path::new("assets/scenes/diffuse_room.toml")).unwrap()
 }
@@ -188,9 +117,9 @@ fn direct_matches_reference_direct_component() {
     let sum_a: f64 = (0..n).map(|i| sum_rgb(&actual, i)).sum();
     let sum_r: f64 = (0..n).map(|i| sum_rgb(&truth, i)).sum();
     let energy = ((sum_a - sum_r) / sum_r).abs();
-    let mask = smooth_mask(&actual);
-    let blocks = block_errors(&actual, &truth, &mask);
-    let all_blocks = block_errors(&actual, &truth, &vec![true; n]);
+    let mask = smooth_mask(&actual, SIZE);
+    let blocks = block_errors(&actual, &truth, &mask, SIZE, BLOCK);
+    let all_blocks = block_errors(&actual, &truth, &vec![true; n], SIZE, BLOCK);
     let (flip_mean, flip_map) = flip(&actual_ldr, &truth_ldr, SIZE);
     eprintln!(
         "reference: {}M photons in {trace_s:.1} s; Σ direct {sum_a:.1}, Σ reference {sum_r:.1}",

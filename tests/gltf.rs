@@ -47,8 +47,8 @@ impl Gltf {
         a.len() - 1
     }
 
-    /// Raw bytes as a new buffer view + accessor.
-    fn accessor(&mut self, bytes: &[u8], count: usize, ty: &str, component: u32) -> usize {
+    /// Raw bytes as a new buffer view.
+    fn view(&mut self, bytes: &[u8]) -> usize {
         while self.bin.len() % 4 != 0 {
             self.bin.push(0);
         }
@@ -57,6 +57,12 @@ impl Gltf {
             json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()}),
         );
         self.bin.extend_from_slice(bytes);
+        view
+    }
+
+    /// Raw bytes as a new buffer view + accessor.
+    fn accessor(&mut self, bytes: &[u8], count: usize, ty: &str, component: u32) -> usize {
+        let view = self.view(bytes);
         self.push(
             "accessors",
             json!({"bufferView": view, "count": count, "type": ty, "componentType": component}),
@@ -299,7 +305,9 @@ fn materials_map_to_the_projects_radiometry() {
 #[test]
 fn texture_coordinates_and_base_color_texture_are_read() {
     let dir = temp_dir("texture");
-    std::fs::write(dir.join("tiles.png"), b"not decoded by the loader").unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 255, 255]))
+        .save(dir.join("tiles.png"))
+        .unwrap();
     let mut g = Gltf::new();
     g.root["images"] = json!([{"uri": "tiles.png"}]);
     g.root["textures"] = json!([{"source": 0}]);
@@ -322,28 +330,151 @@ fn texture_coordinates_and_base_color_texture_are_read() {
     let uv_acc = g.vec2s(&uv);
     g.root["meshes"][mesh]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uv_acc);
     g.root_node(json!({"mesh": mesh}));
-    let a = loader::load(&g.write_gltf(&dir, "textured")).unwrap();
-    assert_eq!(a.uvs, uv);
+    let mut a = loader::load(&g.write_gltf(&dir, "textured")).unwrap();
+    assert_eq!(a.mesh.uvs, uv);
     let t = a.base_color_textures[0].clone().expect("texture reference");
     assert_eq!((t.texture, t.image, t.tex_coord), (0, 0, 0));
-    assert_eq!(t.file.as_deref(), Some(dir.join("tiles.png").as_path()));
+    assert_eq!(t.pixels.path, dir.join("tiles.png"));
+    assert_eq!((t.pixels.width, t.pixels.height), (2, 2));
     assert_eq!(
         (t.offset, t.rotation, t.scale),
         (Vec2::new(0.25, 0.5), 0.5, Vec2::new(2.0, 3.0))
     );
-    assert_eq!(a.warnings.len(), 1, "{:#?}", a.warnings);
-    assert!(
-        a.warnings[0].contains("not applied yet"),
-        "{:#?}",
-        a.warnings
+    assert!(a.warnings.is_empty(), "{:#?}", a.warnings);
+    // The extension's `T * R * S` (GLSL column-major): scale, then rotate
+    // counter-clockwise in uv, then offset.
+    let (sin, cos) = 0.5f32.sin_cos();
+    let expect = |p: Vec2| {
+        let q = p * Vec2::new(2.0, 3.0);
+        Vec2::new(cos * q.x - sin * q.y, sin * q.x + cos * q.y) + Vec2::new(0.25, 0.5)
+    };
+    assert_eq!(
+        t.transform(Vec2::new(1.0, 0.0)),
+        expect(Vec2::new(1.0, 0.0))
     );
+    let quarter = loader::TextureRef {
+        rotation: std::f32::consts::FRAC_PI_2,
+        offset: Vec2::ZERO,
+        scale: Vec2::ONE,
+        ..t.clone()
+    };
+    assert!((quarter.transform(Vec2::X) - Vec2::Y).length() < 1e-6);
+    a.transform_uvs();
+    for (got, &p) in a.mesh.uvs.iter().zip(&uv) {
+        assert!((*got - expect(p)).length() < 1e-6, "{got} vs {}", expect(p));
+    }
+}
+
+/// A 16 x 16 checker of sRGB 40 and 220 (linear ≈ 0.02 and 0.72).
+fn checker_png() -> Vec<u8> {
+    let img = image::RgbImage::from_fn(16, 16, |x, y| {
+        let c = if (x / 4 + y / 4) % 2 == 0 { 40 } else { 220 };
+        image::Rgb([c, c, c])
+    });
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
+    bytes.into_inner()
+}
+
+/// A floor whose glTF material has a base colour texture (a file beside
+/// the .gltf, a buffer view of a .glb, a data: URI) and a
+/// `KHR_texture_transform` scale renders the same `direct` image as the
+/// TOML floor with that `albedo_texture` and `uv_scale`.
+#[test]
+fn textured_gltf_floor_matches_the_toml_albedo_texture() {
+    let dir = temp_dir("textured_floor");
+    let png = checker_png();
+    std::fs::write(dir.join("checker.png"), &png).unwrap();
+    let floor = shapes::plane(Vec3::ZERO, Vec3::Y, None, [6.0, 6.0]);
+    // The camera, the light and the "white" material, without the floor.
+    let head = SCENE_HEAD.split("\n[[object]]").next().unwrap();
+    // image: the glTF `images[0]` (JSON), given the writer for buffer views.
+    let write = |name: &str, glb: bool, image: &dyn Fn(&mut Gltf) -> Value| {
+        let mut g = Gltf::new();
+        g.root["images"] = json!([image(&mut g)]);
+        g.root["textures"] = json!([{"source": 0}]);
+        g.root["extensionsUsed"] = json!(["KHR_texture_transform"]);
+        let mat = g.material(json!({"name": "tiles", "pbrMetallicRoughness": {
+            "metallicFactor": 0.0,
+            "baseColorTexture": {"index": 0, "extensions":
+                {"KHR_texture_transform": {"scale": [3.0, 2.0]}}}}}));
+        let mesh = g.mesh(&floor, true, Some(mat));
+        let uvs = g.vec2s(&floor.uvs);
+        g.root["meshes"][mesh]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uvs);
+        g.root_node(json!({"mesh": mesh}));
+        let path = if glb {
+            g.write_glb(&dir, name)
+        } else {
+            g.write_gltf(&dir, name)
+        };
+        path.file_name().unwrap().to_str().unwrap().to_owned()
+    };
+    let file = write("file", false, &|_| json!({"uri": "checker.png"}));
+    let view = write(
+        "view",
+        true,
+        &|g| json!({"bufferView": g.view(&png), "mimeType": "image/png"}),
+    );
+    let data = write(
+        "data",
+        false,
+        &|_| json!({"uri": format!("data:image/png;base64,{}", base64(&png))}),
+    );
+
+    let toml = format!(
+        r#"{head}
+[[material]]
+name = "tiles"
+kind = "diffuse"
+albedo = 1.0
+albedo_texture = "checker.png"
+uv_scale = [3.0, 2.0]
+
+[[object]]
+shape = "plane"
+material = "tiles"
+size = [6.0, 6.0]
+"#
+    );
+    let reference = render_direct(Scene::from_str(&toml, &dir.join("toml.toml")).unwrap());
+    let untextured = render_direct(
+        Scene::from_str(
+            &toml.replace(
+                "albedo_texture = \"checker.png\"\nuv_scale = [3.0, 2.0]\n",
+                "",
+            ),
+            &dir.join("plain.toml"),
+        )
+        .unwrap(),
+    );
+    let peak = reference.iter().copied().fold(0.0f32, f32::max);
+    // The texture shows (the comparisons below can fail).
+    assert!(max_diff(&reference, &untextured) > 0.2 * peak);
+    for name in [&file, &view, &data] {
+        let text = format!("{head}\n[[object]]\nshape = \"gltf\"\npath = \"{name}\"\n");
+        let scene = Scene::from_str(&text, &dir.join(format!("{name}.toml"))).unwrap();
+        assert_eq!(scene.textures.len(), 1, "{name}");
+        let m = scene.materials[1].texture.expect("textured material");
+        assert_eq!(m.uv_scale, Vec2::ONE, "{name}: the transform is in the UVs");
+        let worst = max_diff(&reference, &render_direct(scene));
+        eprintln!("{name}: direct 32², max difference {worst}, peak {peak}");
+        assert!(worst <= 1e-5, "{name}: max difference {worst}, peak {peak}");
+    }
 }
 
 // ------------------------------------------------------------ transforms
 
 const SIZE: u32 = 32;
 
-/// The `direct` image of `scene` at 32², after two frames.
+/// Largest absolute difference between two images.
+fn max_diff(a: &[f32], b: &[f32]) -> f32 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0f32, f32::max)
+}
+
+/// The `direct` image of `scene` at 32², after two frames: rgb per pixel.
 fn render_direct(scene: Scene) -> Vec<f32> {
     let ctx = validated_context();
     let params = Params::resolve("direct", techniques::direct::DirectParams::specs(), &[]).unwrap();
@@ -355,7 +486,7 @@ fn render_direct(scene: Scene) -> Vec<f32> {
     };
     assert_validation_clean(&ctx);
     assert_finite(&image);
-    image
+    image.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect()
 }
 
 const SCENE_HEAD: &str = r#"
@@ -444,16 +575,7 @@ fn node_hierarchy_matches_the_equivalent_toml_transform() {
     }
     let (ia, ib) = (render_direct(reference), render_direct(via_gltf));
     let floor_only = render_direct(Scene::from_str(SCENE_HEAD, &dir.join("floor.toml")).unwrap());
-    let rgb =
-        |img: &[f32]| -> Vec<f32> { img.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect() };
-    let (ia, ib, floor_only) = (rgb(&ia), rgb(&ib), rgb(&floor_only));
     let peak = ia.iter().copied().fold(0.0f32, f32::max);
-    let max_diff = |a: &[f32], b: &[f32]| {
-        a.iter()
-            .zip(b)
-            .map(|(x, y)| (x - y).abs())
-            .fold(0.0f32, f32::max)
-    };
     // The box is in view (the comparison below can fail).
     assert!(max_diff(&ia, &floor_only) > 0.1 * peak);
     let worst = max_diff(&ia, &ib);
@@ -652,6 +774,18 @@ fn bad_files() -> Vec<Bad> {
             edit: |g, _| g.root["images"] = json!([{"uri": "missing.png"}]),
         },
         Bad {
+            name: "undecodable_image",
+            at: "images[0].bufferView",
+            says: "cannot decode",
+            edit: |g, _| {
+                let view = g.view(b"not an image");
+                g.root["images"] = json!([{"bufferView": view, "mimeType": "image/png"}]);
+                g.root["textures"] = json!([{"source": 0}]);
+                g.root["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]);
+                g.root["meshes"][0]["primitives"][0]["material"] = json!(0);
+            },
+        },
+        Bad {
             name: "accessor_index",
             at: "meshes[0].primitives[0].attributes",
             says: "",
@@ -795,7 +929,7 @@ fn bad_files_fail_with_one_line_naming_the_file_and_the_gltf_path() {
 
     // The same through a TOML scene's `shape = "gltf"`: located at the
     // object's `path`, then the file and the glTF path.
-    let bad = &bad_files()[6];
+    let bad = &bad_files()[7];
     write_bad(&dir, bad);
     let scene = dir.join("scene.toml");
     let text = format!(

@@ -979,6 +979,7 @@ fn mirror_ring_cardioid_cusp() {
         color: Vec3::splat(RING_REFLECTANCE),
         ior: 1.0,
         absorption: Vec3::ZERO,
+        texture: None,
     };
     let mut ring = caustics::scene::shapes::cylinder(
         Vec3::ZERO,

@@ -557,6 +557,7 @@ fn mirror_reflects_the_floor() {
         color: Vec3::splat(MIRROR_REFLECTANCE),
         ior: 1.0,
         absorption: Vec3::ZERO,
+        texture: None,
     };
     let s = scene(
         camera(Vec3::new(0.3, 2.5, 4.0), Vec3::new(0.0, 0.5, -1.0), 45.0),

@@ -318,6 +318,7 @@ fn glass_slab_transmits_one_minus_fresnel_squared() {
             caustics::scene::Material {
                 // Absorbs in green only: 1/m over the slab's 0.2 m.
                 absorption: Vec3::new(0.0, absorption, 0.0),
+                texture: None,
                 ..dielectric("glass", n)
             },
         ],
@@ -484,6 +485,7 @@ fn mirror_shows_the_reflected_floor_times_its_reflectance() {
             Vec3::new(-6.0, 6.0, -2.0),
         ],
         normals: vec![Vec3::Z; 4],
+        uvs: Vec::new(),
         indices: vec![[0, 1, 2], [0, 2, 3]],
         materials: vec![1, 1],
     };
@@ -493,6 +495,7 @@ fn mirror_shows_the_reflected_floor_times_its_reflectance() {
         color: Vec3::splat(reflectance),
         ior: 1.0,
         absorption: Vec3::ZERO,
+        texture: None,
     };
     let s = scene(
         cam,

@@ -21,6 +21,7 @@ fn mirror(name: &str, reflectance: f32) -> Material {
         color: Vec3::splat(reflectance),
         ior: 1.0,
         absorption: Vec3::ZERO,
+        texture: None,
     }
 }
 
@@ -30,6 +31,7 @@ fn quad(a: Vec3, b: Vec3, c: Vec3, d: Vec3, material: u32) -> Mesh {
     Mesh {
         positions: vec![a, b, c, d],
         normals: vec![n; 4],
+        uvs: Vec::new(),
         indices: vec![[0, 1, 2], [0, 2, 3]],
         materials: vec![material; 2],
     }

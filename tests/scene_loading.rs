@@ -93,6 +93,7 @@ fn every_canonical_scene_loads() {
         "mesh_glass",
         "diffuse_room",
         "water_pool",
+        "pool_tiles",
         "ocean_large",
     ];
     for name in names {

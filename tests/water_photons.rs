@@ -1425,6 +1425,7 @@ fn a_thin_wall_lit_on_one_side_stays_dark_on_the_other() {
             Vec3::new(x, 0.6, -1.0),
         ],
         normals: vec![Vec3::X; 4],
+        uvs: Vec::new(),
         indices: vec![[0, 1, 2], [0, 2, 3]],
         materials: vec![0; 2],
     };

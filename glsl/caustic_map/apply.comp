@@ -37,6 +37,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 1, binding = CAUSTIC_BINDING_MAP) uniform sampler2DArray caustic_map;
 layout(set = 1, binding = CAUSTIC_BINDING_POSITION, rgba32f) uniform readonly image2D g_position;
 layout(set = 1, binding = CAUSTIC_BINDING_NORMAL, rgba32f) uniform readonly image2D g_normal;
+layout(set = 1, binding = CAUSTIC_BINDING_ALBEDO, rgba32f) uniform readonly image2D g_albedo;
 layout(set = 1, binding = CAUSTIC_BINDING_RADIANCE, rgba32f) uniform image2D radiance;
 
 layout(push_constant) uniform Push {
@@ -125,7 +126,7 @@ void main() {
         if (!diffuse_visible(x + n * (1e-4 * max(1.0, bvh_max_abs(x))), to_light, dist)) continue;
         e_sum += flux * cos_t / area;
     }
-    vec3 albedo = materials[material].color.rgb;
+    vec3 albedo = imageLoad(g_albedo, p).rgb;
     vec4 prev = imageLoad(radiance, p);
     vec3 to_eye = frame.eye.xyz - x;
     float eye_dist = length(to_eye);

@@ -173,4 +173,9 @@ uint hit_material(Hit h) {
     return triangle_material(h.triangle);
 }
 
+// Albedo of the (diffuse) surface hit: material colour times texture at the hit's UV.
+vec3 hit_albedo(Hit h) {
+    return material_albedo(hit_material(h), triangle_uv(h.triangle, h.barycentric));
+}
+
 #endif

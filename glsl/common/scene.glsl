@@ -19,6 +19,12 @@ struct Triangle {
     vec4 n2;
 };
 
+// A triangle's UVs (src/gpu.rs GpuTriangleUv), same index as triangles[].
+struct TriangleUv {
+    vec4 uv01; // xy: vertex 0, zw: vertex 1
+    vec4 uv2;  // xy: vertex 2
+};
+
 struct BvhNode {
     vec3 bounds_min;
     uint left_or_first; // inner: left child (right = left + 1); leaf: first triangle
@@ -29,6 +35,7 @@ struct BvhNode {
 struct Material {
     vec4 color;          // rgb albedo/reflectance; w: kind (uint bits)
     vec4 absorption_ior; // rgb absorption 1/m; w: ior
+    vec4 albedo_texture; // x: texture array layer (int bits, -1: none); yz: uv_scale
 };
 
 struct Light {
@@ -70,9 +77,36 @@ layout(set = SCENE_SET, binding = BINDING_MATERIALS, std430) readonly buffer Mat
 layout(set = SCENE_SET, binding = BINDING_LIGHTS, std430) readonly buffer LightBlock { Light lights[]; };
 layout(set = SCENE_SET, binding = BINDING_MEDIUM, std430) readonly buffer MediumBlock { Medium medium; };
 layout(set = SCENE_SET, binding = BINDING_DENSITY_GRID, std430) readonly buffer DensityBlock { float density_grid[]; };
+layout(set = SCENE_SET, binding = BINDING_TRIANGLE_UVS, std430) readonly buffer TriangleUvBlock { TriangleUv triangle_uvs[]; };
+// Every albedo texture, one layer each (src/frame/textures.rs): trilinear, repeat wrap.
+layout(set = SCENE_SET, binding = BINDING_ALBEDO_TEXTURES) uniform sampler2DArray albedo_textures;
 
 uint triangle_material(uint tri) { return floatBitsToUint(triangles[tri].p0.w); }
 uint material_kind(uint m) { return floatBitsToUint(materials[m].color.w); }
 uint light_kind(uint l) { return floatBitsToUint(lights[l].position.w); }
+
+// UV at barycentric b (weights of vertices 1 and 2) of triangle `tri`.
+vec2 triangle_uv(uint tri, vec2 b) {
+    TriangleUv t = triangle_uvs[tri];
+    return (1.0 - b.x - b.y) * t.uv01.xy + b.x * t.uv01.zw + b.y * t.uv2.xy;
+}
+
+// Albedo of diffuse material m at `uv`: its colour times its texture (if
+// any) at uv * uv_scale, filtered over the footprint given by the UV
+// derivatives across a pixel (docs/SCENES.md, "Albedo textures").
+vec3 material_albedo_grad(uint m, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
+    vec3 c = materials[m].color.rgb;
+    int layer = floatBitsToInt(materials[m].albedo_texture.x);
+    if (layer < 0) return c;
+    vec2 s = materials[m].albedo_texture.yz;
+    return c * textureGrad(albedo_textures, vec3(uv * s, float(layer)), duv_dx * s, duv_dy * s).rgb;
+}
+
+// The same at the finest mip level (bilinear): for ray hits, which have no
+// pixel footprint; an estimator that averages many of them per pixel (the
+// reference) filters the texture by its own sampling.
+vec3 material_albedo(uint m, vec2 uv) {
+    return material_albedo_grad(m, uv, vec2(0.0), vec2(0.0));
+}
 
 #endif

@@ -25,6 +25,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 1, binding = DIRECT_BINDING_POSITION, rgba32f) uniform readonly image2D g_position;
 layout(set = 1, binding = DIRECT_BINDING_NORMAL, rgba32f) uniform readonly image2D g_normal;
+layout(set = 1, binding = DIRECT_BINDING_ALBEDO, rgba32f) uniform readonly image2D g_albedo;
 layout(set = 1, binding = DIRECT_BINDING_RADIANCE, rgba32f) uniform writeonly image2D radiance;
 
 layout(push_constant) uniform Push {
@@ -59,7 +60,7 @@ void main() {
         if (v == 0.0) continue;
         e_sum += e * v * medium_transmittance_steps(x, to_light, light_travel(dist, x), pc.medium_steps);
     }
-    vec3 albedo = materials[material].color.rgb;
+    vec3 albedo = imageLoad(g_albedo, p).rgb;
     vec3 to_eye = frame.eye.xyz - x;
     float eye_dist = length(to_eye);
     vec3 tau_eye = medium_transmittance_steps(x, to_eye / eye_dist, eye_dist, pc.medium_steps);

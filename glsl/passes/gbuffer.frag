@@ -1,7 +1,9 @@
 #version 460
 // Camera G-buffer, fragment stage: world position (w = 1: covered) and the
 // smooth normal turned toward the camera (two-sided surfaces) with the
-// material index in w. With `opaque_only` the specular surfaces are left
+// material index in w, and the albedo (glsl/common/scene.glsl
+// `material_albedo_grad`: colour times texture, mip level from the UV's
+// screen-space derivatives). With `opaque_only` the specular surfaces are left
 // out (image_space refracts and reflects them in a later pass).
 #include "scene.glsl"
 
@@ -12,14 +14,20 @@ layout(push_constant) uniform Push {
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) flat in uint v_material;
+layout(location = 3) in vec2 v_uv;
 
 layout(location = 0) out vec4 out_position;
 layout(location = 1) out vec4 out_normal;
+layout(location = 2) out vec4 out_albedo;
 
 void main() {
+    // Derivatives before any branch (they need the whole quad).
+    vec2 duv_dx = dFdx(v_uv);
+    vec2 duv_dy = dFdy(v_uv);
     if (pc.opaque_only != 0u && material_kind(v_material) != MATERIAL_DIFFUSE) discard;
     vec3 n = normalize(v_normal);
     if (dot(n, frame.eye.xyz - v_position) < 0.0) n = -n;
     out_position = vec4(v_position, 1.0);
     out_normal = vec4(n, float(v_material));
+    out_albedo = vec4(material_albedo_grad(v_material, v_uv, duv_dx, duv_dy), 1.0);
 }

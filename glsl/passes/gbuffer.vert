@@ -6,6 +6,7 @@
 layout(location = 0) out vec3 v_position;
 layout(location = 1) out vec3 v_normal;
 layout(location = 2) flat out uint v_material;
+layout(location = 3) out vec2 v_uv;
 
 void main() {
     uint tri = uint(gl_VertexIndex) / 3u;
@@ -16,5 +17,7 @@ void main() {
     v_position = p;
     v_normal = n;
     v_material = floatBitsToUint(t.p0.w);
+    TriangleUv uv = triangle_uvs[tri];
+    v_uv = corner == 0u ? uv.uv01.xy : (corner == 1u ? uv.uv01.zw : uv.uv2.xy);
     gl_Position = frame.view_proj * vec4(p, 1.0);
 }

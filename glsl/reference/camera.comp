@@ -62,8 +62,9 @@ void main() {
         bool front = dot(s.dir, ng) < 0.0;
         if (diffuse) {
             vec3 seen_side = front ? ng : -ng;
-            add_pass(index, COMPONENT_DIRECT, s.weight * direct_light(x, seen_side, m.color.rgb, rng));
-            vec3 weight = s.weight * m.color.rgb / PI;
+            vec3 albedo = hit_albedo(hit);
+            add_pass(index, COMPONENT_DIRECT, s.weight * direct_light(x, seen_side, albedo, rng));
+            vec3 weight = s.weight * albedo / PI;
             if (pc.gather != 0u && any(greaterThan(weight, vec3(0.0)))) {
                 vp.position = vec4(x, 1.0);
                 vp.normal = vec4(seen_side, 0.0);

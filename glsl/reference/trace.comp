@@ -291,7 +291,8 @@ void main() {
         if (floatBitsToUint(m.color.w) == MATERIAL_DIFFUSE) {
             vec3 ng_in = front ? ng : -ng; // the side the photon arrives on
             uint tag = tag_for(specular, scattered_or_bounced, false);
-            connect_surface(x, ng_in, s.weight, m.color.rgb, tag, rng);
+            vec3 albedo = hit_albedo(hit);
+            connect_surface(x, ng_in, s.weight, albedo, tag, rng);
             // A photon straight from the light is the visible points' direct
             // light (camera.comp samples it): every other one is gathered.
             if (pc.gather != 0u && (specular > 0u || scattered_or_bounced)) {
@@ -299,9 +300,9 @@ void main() {
             }
             if (diffuse_left == 0u) return;
             diffuse_left -= 1u;
-            float survive = clamp(luminance(m.color.rgb), 0.05, 1.0);
+            float survive = clamp(luminance(albedo), 0.05, 1.0);
             if (rng_next(rng) >= survive) return;
-            s.weight *= m.color.rgb / survive;
+            s.weight *= albedo / survive;
             s.dir = cosine_hemisphere(vec2(rng_next(rng), rng_next(rng)), ng_in);
             s.origin = offset_origin(x, ng_in);
             scattered_or_bounced = true;

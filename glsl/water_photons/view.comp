@@ -180,7 +180,7 @@ vec3 radiance_along(vec3 o, vec3 d, out float t_hit) {
     if (dot(n, d) > 0.0) n = -n;
     ivec2 q;
     if (seen_directly(x, n, q)) return imageLoad(opaque_radiance, q).rgb;
-    vec3 albedo = materials[m].color.rgb;
+    vec3 albedo = hit_albedo(h);
     return albedo / PI
         * (component_weight(COMPONENT_DIRECT) * direct_irradiance(x, n)
            + component_weight(COMPONENT_SURFACE_CAUSTICS) * gather(x, n));

@@ -41,6 +41,7 @@ fn tri(a: Vec3, b: Vec3, c: Vec3) -> Triangle {
     Triangle {
         positions: [a, b, c],
         normals: [n; 3],
+        uvs: [glam::Vec2::ZERO; 3],
         material: 0,
         object: 0,
     }
@@ -550,6 +551,7 @@ fn mesh_triangles(mesh: &crate::scene::Mesh) -> Vec<Triangle> {
         .map(|t| Triangle {
             positions: t.map(|i| mesh.positions[i as usize]),
             normals: t.map(|i| mesh.normals[i as usize]),
+            uvs: [glam::Vec2::ZERO; 3],
             material: 0,
             object: 0,
         })

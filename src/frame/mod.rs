@@ -7,6 +7,8 @@
 
 mod scene_gpu;
 mod targets;
+mod textures;
 
 pub use scene_gpu::{camera_matrices, GeometryStats, SceneGpu};
 pub use targets::FrameTargets;
+pub use textures::AlbedoTextures;

@@ -2,8 +2,9 @@
 //! materials, lights, medium and the per-frame uniform block, bound as
 //! descriptor set 0 (glsl/common/scene.glsl) by every pass that reads them.
 
+use super::AlbedoTextures;
 use crate::bvh::Bvh;
-use crate::gpu::{GpuFrame, GpuLight, GpuMaterial, GpuMedium, GpuTriangle};
+use crate::gpu::{GpuFrame, GpuLight, GpuMaterial, GpuMedium, GpuTriangle, GpuTriangleUv};
 use crate::radiometry::Component;
 use crate::scene::{Camera, Density, MaterialKind, Scene, Triangle};
 use crate::shader_bindings as b;
@@ -11,6 +12,7 @@ use crate::vk::{
     BindingKind, Buffer, BufferUsage, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder,
     VkResult,
 };
+use ash::vk;
 use glam::{Mat4, Vec3};
 use std::cell::Cell;
 use std::sync::Arc;
@@ -27,6 +29,10 @@ pub struct GeometryStats {
 
 pub struct SceneGpu {
     pub triangles: Buffer,
+    /// UVs per triangle, leaf order (`GpuTriangleUv`). Never re-uploaded:
+    /// the motions keep every triangle's UVs.
+    pub triangle_uvs: Buffer,
+    pub albedo_textures: AlbedoTextures,
     pub bvh_nodes: Buffer,
     pub materials: Buffer,
     pub lights: Buffer,
@@ -99,6 +105,8 @@ impl SceneGpu {
                 (b::BINDING_LIGHTS, BindingKind::Storage),
                 (b::BINDING_MEDIUM, BindingKind::Storage),
                 (b::BINDING_DENSITY_GRID, BindingKind::Storage),
+                (b::BINDING_TRIANGLE_UVS, BindingKind::Storage),
+                (b::BINDING_ALBEDO_TEXTURES, BindingKind::Sampled),
             ],
         )
     }
@@ -140,6 +148,16 @@ impl SceneGpu {
             gpu_triangles
         };
         let triangles_buf = Buffer::with_data::<GpuTriangle>(ctx, "triangles", &tri_data, storage)?;
+        let mut uvs: Vec<GpuTriangleUv> = bvh
+            .triangle_order
+            .iter()
+            .map(|&i| GpuTriangleUv::new(&triangles[i as usize]))
+            .collect();
+        if uvs.is_empty() {
+            uvs.push(bytemuck::Zeroable::zeroed());
+        }
+        let uvs_buf = Buffer::with_data(ctx, "triangle uvs", &uvs, storage)?;
+        let albedo_textures = AlbedoTextures::new(ctx, &scene.textures)?;
         let nodes_buf = Buffer::with_data(ctx, "bvh nodes", &bvh.nodes, storage)?;
         let materials_buf = Buffer::with_data(ctx, "materials", &materials, storage)?;
         let lights_buf = Buffer::with_data(ctx, "lights", &lights, storage)?;
@@ -159,7 +177,14 @@ impl SceneGpu {
             .write_buffer(b::BINDING_MATERIALS, &materials_buf)
             .write_buffer(b::BINDING_LIGHTS, &lights_buf)
             .write_buffer(b::BINDING_MEDIUM, &medium_buf)
-            .write_buffer(b::BINDING_DENSITY_GRID, &grid_buf);
+            .write_buffer(b::BINDING_DENSITY_GRID, &grid_buf)
+            .write_buffer(b::BINDING_TRIANGLE_UVS, &uvs_buf)
+            .write_sampled_image(
+                b::BINDING_ALBEDO_TEXTURES,
+                &albedo_textures.image,
+                &albedo_textures.sampler,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            );
         // The load phases' costs (RUST_LOG=info): scripts/gltf-bench.sh reads them.
         log::info!(
             "scene on the device: world-space triangles {world_ms:.1} ms, BVH build {:.1} ms, upload {:.1} ms",
@@ -169,6 +194,8 @@ impl SceneGpu {
         Ok(SceneGpu {
             triangle_count: triangles.len() as u32,
             triangles: triangles_buf,
+            triangle_uvs: uvs_buf,
+            albedo_textures,
             bvh_nodes: nodes_buf,
             materials: materials_buf,
             lights: lights_buf,

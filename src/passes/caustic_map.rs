@@ -329,6 +329,7 @@ impl CausticMap {
                 (b::CAUSTIC_BINDING_MAP, BindingKind::Sampled),
                 (b::CAUSTIC_BINDING_POSITION, BindingKind::StorageImage),
                 (b::CAUSTIC_BINDING_NORMAL, BindingKind::StorageImage),
+                (b::CAUSTIC_BINDING_ALBEDO, BindingKind::StorageImage),
                 (b::CAUSTIC_BINDING_RADIANCE, BindingKind::StorageImage),
             ],
         )?;
@@ -344,6 +345,7 @@ impl CausticMap {
             )
             .write_storage_image(b::CAUSTIC_BINDING_POSITION, &gbuffer.position)
             .write_storage_image(b::CAUSTIC_BINDING_NORMAL, &gbuffer.normal)
+            .write_storage_image(b::CAUSTIC_BINDING_ALBEDO, &gbuffer.albedo)
             .write_storage_image(b::CAUSTIC_BINDING_RADIANCE, radiance);
         let apply = ComputePipeline::new(
             ctx,
@@ -493,6 +495,7 @@ impl CausticMap {
                     ImageAccess::new(&self.map, Access::ComputeRead),
                     ImageAccess::new(&gbuffer.position, Access::ComputeRead),
                     ImageAccess::new(&gbuffer.normal, Access::ComputeRead),
+                    ImageAccess::new(&gbuffer.albedo, Access::ComputeRead),
                     ImageAccess::new(radiance, Access::ComputeWrite),
                 ],
                 &[],

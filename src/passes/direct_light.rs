@@ -115,6 +115,7 @@ impl DirectLight {
             &[
                 (b::DIRECT_BINDING_POSITION, BindingKind::StorageImage),
                 (b::DIRECT_BINDING_NORMAL, BindingKind::StorageImage),
+                (b::DIRECT_BINDING_ALBEDO, BindingKind::StorageImage),
                 (b::DIRECT_BINDING_RADIANCE, BindingKind::StorageImage),
                 (b::DIRECT_BINDING_SHADOW_MAP, BindingKind::Sampled),
                 (b::DIRECT_BINDING_SHADOW_LIGHTS, BindingKind::Uniform),
@@ -127,6 +128,7 @@ impl DirectLight {
         // puts them in GENERAL layout.
         set.write_storage_image(b::DIRECT_BINDING_POSITION, &gbuffer.position)
             .write_storage_image(b::DIRECT_BINDING_NORMAL, &gbuffer.normal)
+            .write_storage_image(b::DIRECT_BINDING_ALBEDO, &gbuffer.albedo)
             .write_sampled_image(
                 b::DIRECT_BINDING_SHADOW_MAP,
                 &shadows.map,
@@ -193,6 +195,7 @@ impl DirectLight {
                 &[
                     ImageAccess::new(&self.gbuffer.position, Access::ComputeRead),
                     ImageAccess::new(&self.gbuffer.normal, Access::ComputeRead),
+                    ImageAccess::new(&self.gbuffer.albedo, Access::ComputeRead),
                     ImageAccess::new(&self.shadows.map, Access::ComputeRead),
                     ImageAccess::discard(&targets.radiance, Access::ComputeWrite),
                 ],

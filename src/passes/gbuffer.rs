@@ -8,6 +8,11 @@
 //!   0 for background (cleared to zero).
 //! - `normal`: xyz unit smooth normal flipped to face the camera (surfaces are
 //!   two-sided); w = material index as a float (exact below 2^24).
+//! - `albedo`: rgb the surface's albedo (diffuse; reflectance for a
+//!   mirror): material colour times its albedo texture, filtered over the
+//!   pixel's footprint (trilinear, mip level from the UV derivatives). The
+//!   lookup is done once here so every technique shading the G-buffer reads
+//!   the same value; w = 1.
 //!
 //! `GBufferContents::Opaque` leaves the specular surfaces out (`image_space`
 //! sees the opaque scene behind them and adds them by image-space refraction).
@@ -22,6 +27,8 @@ use std::sync::Arc;
 
 pub const POSITION_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const NORMAL_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+/// 32-bit: an untextured albedo passes through exactly.
+pub const ALBEDO_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
 /// Which surfaces the G-buffer holds.
@@ -36,6 +43,7 @@ pub enum GBufferContents {
 pub struct GBuffer {
     pub position: Image,
     pub normal: Image,
+    pub albedo: Image,
     pub depth: Image,
     pub contents: GBufferContents,
     pipeline: GraphicsPipeline,
@@ -63,6 +71,11 @@ impl GBuffer {
             "gbuffer normal+material",
             ImageDesc::new_2d(width, height, NORMAL_FORMAT, color_usage),
         )?;
+        let albedo = Image::new(
+            ctx,
+            "gbuffer albedo",
+            ImageDesc::new_2d(width, height, ALBEDO_FORMAT, color_usage),
+        )?;
         let depth = Image::new(
             ctx,
             "gbuffer depth",
@@ -74,7 +87,7 @@ impl GBuffer {
             ),
         )?;
         let mut desc = GraphicsPipelineDesc::new("passes/gbuffer.vert", "passes/gbuffer.frag");
-        desc.color_formats = vec![POSITION_FORMAT, NORMAL_FORMAT];
+        desc.color_formats = vec![POSITION_FORMAT, NORMAL_FORMAT, ALBEDO_FORMAT];
         desc.depth_format = Some(DEPTH_FORMAT);
         desc.depth_test = true;
         desc.depth_write = true;
@@ -85,6 +98,7 @@ impl GBuffer {
         Ok(Self {
             position,
             normal,
+            albedo,
             depth,
             contents,
             pipeline,
@@ -110,9 +124,13 @@ impl GBuffer {
                 &[
                     ImageAccess::discard(&self.position, Access::ColorAttachment),
                     ImageAccess::discard(&self.normal, Access::ColorAttachment),
+                    ImageAccess::discard(&self.albedo, Access::ColorAttachment),
                     ImageAccess::discard(&self.depth, Access::DepthAttachment),
                 ],
-                &[BufferAccess::new(&scene.triangles, Access::VertexRead)],
+                &[
+                    BufferAccess::new(&scene.triangles, Access::VertexRead),
+                    BufferAccess::new(&scene.triangle_uvs, Access::VertexRead),
+                ],
             );
             let extent = self.extent();
             begin_rendering(
@@ -122,6 +140,7 @@ impl GBuffer {
                 &[
                     (self.position.view, Some([0.0; 4])),
                     (self.normal.view, Some([0.0; 4])),
+                    (self.albedo.view, Some([0.0; 4])),
                 ],
                 Some(self.depth.view),
             );

@@ -1,7 +1,8 @@
 //! glTF 2.0 files (`.gltf` with its buffers, or `.glb`) through the `gltf`
 //! crate: the meshes of the default scene with their node transforms, the
-//! materials mapped to the project's radiometry, the file's camera and its
-//! `KHR_lights_punctual` lights. docs/SCENES.md ("glTF 2.0") states every
+//! materials mapped to the project's radiometry (base colour textures
+//! decoded, `KHR_texture_transform` applied to `TEXCOORD_0`), the file's
+//! camera and its `KHR_lights_punctual` lights. docs/SCENES.md ("glTF 2.0") states every
 //! rule and mapping; `load` reads a file into a [`GltfAsset`], `scene` makes
 //! a whole scene of one (`caustics render --scene model.glb`).
 //!
@@ -11,6 +12,7 @@
 //! crate's reader touches it, so no file makes the loader panic.
 
 use super::obj::{accumulate_normals, fix_zero_normals};
+use super::texture;
 use super::types::*;
 use crate::shader_bindings::MAX_LIGHTS;
 use ::gltf::accessor::{DataType, Dimensions};
@@ -69,23 +71,37 @@ impl fmt::Display for GltfError {
 
 impl std::error::Error for GltfError {}
 
-/// A material's `baseColorTexture`, kept for the scene's textures (not
-/// applied yet: the scene model has no textures on this branch).
-#[derive(Clone, Debug, PartialEq)]
+/// A material's `baseColorTexture`: its image decoded, and the
+/// `KHR_texture_transform` its UVs go through.
+#[derive(Clone, Debug)]
 pub struct TextureRef {
     /// Index into the file's `textures`.
     pub texture: usize,
     /// Index into the file's `images`.
     pub image: usize,
-    /// The image file, for an image given by a relative or `file:` URI.
-    pub file: Option<PathBuf>,
+    /// The image, decoded. Its `path` is the image file for a relative or
+    /// `file:` URI (shared with a scene's `albedo_texture` of that file),
+    /// else `<glTF file>#images[i]`.
+    pub pixels: Texture,
     /// The `TEXCOORD_n` set the texture reads (after `KHR_texture_transform`'s override).
     pub tex_coord: u32,
     /// `KHR_texture_transform`: uv' = T(offset) R(rotation) S(scale) uv.
     pub offset: Vec2,
-    /// Radians, counter-clockwise in uv.
+    /// Radians (the extension's GLSL: u' = u cos r - v sin r, v' = u sin r + v cos r).
     pub rotation: f32,
     pub scale: Vec2,
+}
+
+impl TextureRef {
+    /// `KHR_texture_transform` of one texture coordinate, the extension's
+    /// `translation * rotation * scale` (GLSL column-major matrices): an
+    /// affine map, so transforming the vertices' UVs equals transforming
+    /// every interpolated UV.
+    pub fn transform(&self, uv: Vec2) -> Vec2 {
+        let s = uv * self.scale;
+        let (sin, cos) = self.rotation.sin_cos();
+        Vec2::new(cos * s.x - sin * s.y, sin * s.x + cos * s.y) + self.offset
+    }
 }
 
 /// A glTF file read and converted.
@@ -93,9 +109,10 @@ pub struct TextureRef {
 pub struct GltfAsset {
     /// Every triangle of the default scene in the file's root space (node
     /// transforms applied); `materials` index [`GltfAsset::materials`].
+    /// `mesh.uvs` is `TEXCOORD_0` per vertex ((0, 0) where a primitive has
+    /// none), before any `KHR_texture_transform`
+    /// ([`GltfAsset::transform_uvs`]).
     pub mesh: Mesh,
-    /// `TEXCOORD_0` per vertex of `mesh` ((0, 0) where a primitive has none).
-    pub uvs: Vec<Vec2>,
     /// The materials the triangles use, converted (named `<file name>:<material name>`).
     pub materials: Vec<Material>,
     /// Per material, its `baseColorTexture`.
@@ -118,8 +135,9 @@ pub fn is_gltf_path(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
 }
 
-/// Reads a glTF file (its buffers relative to it). Images are checked to
-/// exist, not decoded.
+/// Reads a glTF file (its buffers relative to it). Every image file must
+/// exist; the base colour textures of the materials the scene uses are
+/// decoded.
 pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
     let fail = |at: &str, message: String| GltfError {
         file: path.to_path_buf(),
@@ -184,7 +202,6 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
         dir,
         asset: GltfAsset {
             mesh: Mesh::default(),
-            uvs: Vec::new(),
             materials: Vec::new(),
             base_color_textures: Vec::new(),
             camera: None,
@@ -195,6 +212,8 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
         material_map: HashMap::new(),
         material_names: HashMap::new(),
         computed: Vec::new(),
+        images: HashMap::new(),
+        gltf_path: path,
     };
     let Some(scene) = document
         .default_scene()
@@ -256,22 +275,28 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
         accumulate_normals(&mut asset.mesh, range);
     }
     fix_zero_normals(&mut asset.mesh);
-    let textured: Vec<&str> = asset
-        .materials
-        .iter()
-        .zip(&asset.base_color_textures)
-        .filter(|(_, t)| t.is_some())
-        .map(|(m, _)| m.name.as_str())
-        .collect();
-    if !textured.is_empty() {
-        let w = format!(
-            "{}: baseColorTexture of {} is read but not applied yet (the scene has no textures): the base colour factor alone is used",
-            path.display(),
-            textured.join(", ")
-        );
-        asset.warnings.push(w);
-    }
     Ok(asset)
+}
+
+impl GltfAsset {
+    /// Puts each vertex's UV through the `KHR_texture_transform` of its
+    /// material's base colour texture, for rendering with the file's
+    /// materials (a replacing material reads the untransformed
+    /// `TEXCOORD_0`). A vertex belongs to one primitive, hence one
+    /// material.
+    pub fn transform_uvs(&mut self) {
+        let mut done = vec![false; self.mesh.uvs.len()];
+        for (t, &m) in self.mesh.indices.iter().zip(&self.mesh.materials) {
+            let Some(tex) = &self.base_color_textures[m as usize] else {
+                continue;
+            };
+            for &i in t {
+                if !std::mem::replace(&mut done[i as usize], true) {
+                    self.mesh.uvs[i as usize] = tex.transform(self.mesh.uvs[i as usize]);
+                }
+            }
+        }
+    }
 }
 
 type Fail<'a> = &'a dyn Fn(&str, String) -> GltfError;
@@ -417,6 +442,9 @@ struct Loader<'a> {
     material_names: HashMap<String, usize>,
     /// Index ranges whose normals are computed (primitives without NORMAL).
     computed: Vec<std::ops::Range<usize>>,
+    /// Images decoded so far, by index into the file's `images`.
+    images: HashMap<usize, Texture>,
+    gltf_path: &'a Path,
 }
 
 impl Loader<'_> {
@@ -631,8 +659,8 @@ impl Loader<'_> {
             None => out.normals.extend(std::iter::repeat_n(Vec3::ZERO, n)),
         }
         match uvs {
-            Some(uv) => self.asset.uvs.extend(uv),
-            None => self.asset.uvs.extend(std::iter::repeat_n(Vec2::ZERO, n)),
+            Some(uv) => out.uvs.extend(uv),
+            None => out.uvs.extend(std::iter::repeat_n(Vec2::ZERO, n)),
         }
         let first = out.indices.len();
         for t in indices.chunks_exact(3) {
@@ -669,7 +697,7 @@ impl Loader<'_> {
         };
         let name = format!("{}:{label}", self.file_name);
         let (material, cut_out, notes) = convert_material(name.clone(), m);
-        let texture = self.texture_ref(m);
+        let texture = self.texture_ref(m)?;
         if !notes.is_empty() {
             let at = m.index().map_or("the default material".to_owned(), |i| {
                 format!("materials[{i}]")
@@ -690,16 +718,13 @@ impl Loader<'_> {
         Ok(index)
     }
 
-    fn texture_ref(&self, m: &::gltf::Material) -> Option<TextureRef> {
-        let info = m.pbr_metallic_roughness().base_color_texture()?;
+    /// A material's base colour texture, its image decoded (once per image).
+    fn texture_ref(&mut self, m: &::gltf::Material) -> Result<Option<TextureRef>, GltfError> {
+        let Some(info) = m.pbr_metallic_roughness().base_color_texture() else {
+            return Ok(None);
+        };
         let texture = info.texture();
         let image = texture.source();
-        let file = match image.source() {
-            ::gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => {
-                uri_file(uri, self.dir)
-            }
-            _ => None,
-        };
         let (mut offset, mut rotation, mut scale, mut tex_coord) =
             (Vec2::ZERO, 0.0, Vec2::ONE, info.tex_coord());
         if let Some(t) = info.texture_transform() {
@@ -708,15 +733,73 @@ impl Loader<'_> {
             scale = Vec2::from(t.scale());
             tex_coord = t.tex_coord().unwrap_or(tex_coord);
         }
-        Some(TextureRef {
+        if tex_coord != 0 {
+            let at = m.index().map_or("the default material".to_owned(), |i| {
+                format!("materials[{i}]")
+            });
+            self.asset.warnings.push(format!(
+                "{}: {at}: the base colour texture reads TEXCOORD_{tex_coord}: TEXCOORD_0 is used (the only set read)",
+                self.gltf_path.display()
+            ));
+        }
+        let pixels = match self.images.get(&image.index()) {
+            Some(p) => p.clone(),
+            None => {
+                let p = self.decode_image(&image)?;
+                self.images.insert(image.index(), p.clone());
+                p
+            }
+        };
+        Ok(Some(TextureRef {
             texture: texture.index(),
             image: image.index(),
-            file,
+            pixels,
             tex_coord,
             offset,
             rotation,
             scale,
-        })
+        }))
+    }
+
+    /// An image's texels: from its buffer view, its `data:` URI or its file
+    /// (docs/SCENES.md lists the formats). Errors name `images[i].uri` or
+    /// `images[i].bufferView`.
+    fn decode_image(&self, image: &::gltf::Image) -> Result<Texture, GltfError> {
+        let i = image.index();
+        let embedded = PathBuf::from(format!("{}#images[{i}]", self.gltf_path.display()));
+        match image.source() {
+            ::gltf::image::Source::View { view, .. } => {
+                let at = format!("images[{i}].bufferView");
+                let buffer = &self.buffers[view.buffer().index()];
+                let bytes = buffer
+                    .get(view.offset()..view.offset() + view.length())
+                    .ok_or_else(|| {
+                        (self.fail)(
+                            &at,
+                            format!(
+                                "bufferView {} (bytes {}..{}) runs past the end of buffer {} ({} bytes)",
+                                view.index(),
+                                view.offset(),
+                                view.offset() + view.length(),
+                                view.buffer().index(),
+                                buffer.len()
+                            ),
+                        )
+                    })?;
+                texture::decode(bytes, &embedded).map_err(|e| (self.fail)(&at, e))
+            }
+            ::gltf::image::Source::Uri { uri, .. } => {
+                let at = format!("images[{i}].uri");
+                if uri.starts_with("data:") {
+                    let bytes = read_uri(uri, self.dir).map_err(|e| (self.fail)(&at, e))?;
+                    return texture::decode(&bytes, &embedded).map_err(|e| (self.fail)(&at, e));
+                }
+                let file = uri_file(uri, self.dir).ok_or_else(|| {
+                    (self.fail)(&at, format!("unsupported URI scheme in `{uri}`"))
+                })?;
+                texture::load(&file).map_err(|e| (self.fail)(&at, e))
+            }
+        }
     }
 
     /// A glTF camera on a node: it looks down the node's -z with +y up.
@@ -825,6 +908,7 @@ fn convert_material(name: String, m: &::gltf::Material) -> (Material, bool, Vec<
         ));
     }
     let mut out = Material {
+        texture: None,
         name,
         kind: MaterialKind::Diffuse,
         color: base,
@@ -930,7 +1014,7 @@ pub const DEFAULT_SUN_EXPOSURE: f32 = 0.004;
 /// camera (else one framing the model), its lights (else a sun), and a
 /// floor unless `options` leaves it out. Warnings go to the log.
 pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError> {
-    let asset = load(path)?;
+    let mut asset = load(path)?;
     if asset.lights.len() > MAX_LIGHTS as usize {
         return Err(GltfError {
             file: path.to_path_buf(),
@@ -954,7 +1038,24 @@ pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError
         });
     let center = (lo + hi) * 0.5;
     let radius = ((hi - lo).length() * 0.5).max(1e-3);
+    asset.transform_uvs();
     let mut materials = asset.materials;
+    // One texture per image, in the order materials first use them.
+    let mut textures: Vec<Texture> = Vec::new();
+    for (m, t) in materials.iter_mut().zip(asset.base_color_textures) {
+        let Some(t) = t else { continue };
+        let index = match textures.iter().position(|x| x.path == t.pixels.path) {
+            Some(i) => i,
+            None => {
+                textures.push(t.pixels);
+                textures.len() - 1
+            }
+        };
+        m.texture = Some(AlbedoTexture {
+            index: index as u32,
+            uv_scale: Vec2::ONE,
+        });
+    }
     let mut objects = vec![Object {
         name: path
             .file_stem()
@@ -967,6 +1068,7 @@ pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError
     if options.floor {
         let material = materials.len() as u32;
         materials.push(Material {
+            texture: None,
             name: "floor".into(),
             kind: MaterialKind::Diffuse,
             color: Vec3::splat(FLOOR_ALBEDO),
@@ -1019,6 +1121,7 @@ pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError
         camera,
         lights,
         materials,
+        textures,
         objects,
         medium: None,
         output: Output { exposure },

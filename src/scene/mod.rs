@@ -14,6 +14,7 @@ pub mod gltf;
 mod node;
 pub mod obj;
 pub mod shapes;
+pub mod texture;
 mod types;
 pub mod water;
 
@@ -142,6 +143,7 @@ impl Scene {
                 out.push(Triangle {
                     positions: t.map(|i| positions[i as usize]),
                     normals: t.map(|i| normals[i as usize]),
+                    uvs: t.map(|i| mesh.uvs.get(i as usize).copied().unwrap_or_default()),
                     material,
                     object: oi as u32,
                 });

@@ -6,11 +6,13 @@
 //! - Normals: when every face vertex has a normal in the file, those are used
 //!   (normalised); otherwise smooth, area-weighted vertex normals are computed
 //!   over shared positions.
+//! - Texture coordinates (`vt`) are kept, with v flipped (OBJ's v = 0 is the
+//!   image's bottom row, the renderer's the top row); without them UVs are 0.
 //! - Materials from the MTL become scene materials named `"<obj file name>:<mtl name>"`
-//!   (see [`convert_material`]).
+//!   (see [`convert_material`]); a diffuse one's `map_Kd` is its albedo texture.
 
 use super::types::{Material, MaterialKind, Mesh};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::collections::HashMap;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
@@ -25,6 +27,9 @@ pub struct ObjMesh {
     pub mesh: Mesh,
     /// MTL materials converted, named `"<obj file name>:<mtl name>"`.
     pub materials: Vec<Material>,
+    /// Per material, the `map_Kd` file of a diffuse one (resolved against
+    /// the OBJ's folder): the caller decodes it and sets `Material::texture`.
+    pub albedo_textures: Vec<Option<PathBuf>>,
     /// The MTL files the OBJ names that could not be read (path, why).
     pub mtl_errors: Vec<(PathBuf, String)>,
     /// Whether the file gave normals for every face vertex.
@@ -51,6 +56,7 @@ pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
             color: Vec3::ONE,
             ior: ni.filter(|&n| n >= 1.0).unwrap_or(1.5),
             absorption: Vec3::ZERO,
+            texture: None,
         }
     } else if illum == 3 {
         Material {
@@ -59,6 +65,7 @@ pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
             color: rgb(m.specular, 1.0),
             ior: 1.0,
             absorption: Vec3::ZERO,
+            texture: None,
         }
     } else {
         Material {
@@ -67,6 +74,7 @@ pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
             color: rgb(m.diffuse, 0.8),
             ior: 1.0,
             absorption: Vec3::ZERO,
+            texture: None,
         }
     }
 }
@@ -103,14 +111,27 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
         || path.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     );
-    let materials: Vec<Material> = materials
+    let mut converted: Vec<Material> = materials
         .iter()
         .map(|m| convert_material(&prefix, m))
         .collect();
+    let mut albedo_textures = Vec::with_capacity(materials.len());
+    for (m, c) in materials.iter().zip(&mut converted) {
+        let texture = m
+            .diffuse_texture
+            .as_deref()
+            .map(str::trim)
+            .filter(|t| c.kind == MaterialKind::Diffuse && !t.is_empty())
+            .map(|t| dir.join(t));
+        // `Kd` scales `map_Kd`; without a `Kd` the texture stands alone.
+        if texture.is_some() && m.diffuse.is_none() {
+            c.color = Vec3::ONE;
+        }
+        albedo_textures.push(texture);
+    }
 
     let mut mesh = Mesh::default();
     let mut all_normals = true;
-    let mut computed_ranges = Vec::new();
     for model in &models {
         let m = &model.mesh;
         if m.indices.len() % 3 != 0 || m.indices.is_empty() {
@@ -138,51 +159,75 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
         let nnorm = m.normals.len() / 3;
         let has_normals = m.normal_indices.len() == m.indices.len()
             && m.normal_indices.iter().all(|&i| (i as usize) < nnorm);
-        let base = mesh.positions.len() as u32;
-        if has_normals {
-            // Split vertices by (position, normal) pair.
-            let mut map: HashMap<(u32, u32), u32> = HashMap::with_capacity(m.indices.len());
-            let mut remap = Vec::with_capacity(m.indices.len());
-            for (&pi, &ni) in m.indices.iter().zip(&m.normal_indices) {
-                let next = base + map.len() as u32;
-                let idx = *map.entry((pi, ni)).or_insert_with(|| {
-                    let n = Vec3::from_slice(&m.normals[ni as usize * 3..ni as usize * 3 + 3]);
-                    mesh.positions.push(positions[pi as usize]);
-                    mesh.normals.push(if n.is_finite() {
-                        n.normalize_or_zero()
-                    } else {
-                        Vec3::ZERO
-                    });
-                    next
-                });
-                remap.push(idx);
-            }
-            for t in remap.chunks_exact(3) {
-                mesh.indices.push([t[0], t[1], t[2]]);
-                mesh.materials.push(material);
-            }
-        } else {
-            all_normals = false;
-            mesh.positions.extend_from_slice(&positions);
-            mesh.normals.extend(std::iter::repeat_n(Vec3::ZERO, npos));
-            let first = mesh.indices.len();
+        let ntex = m.texcoords.len() / 2;
+        let has_uvs = m.texcoord_indices.len() == m.indices.len()
+            && m.texcoord_indices.iter().all(|&i| (i as usize) < ntex);
+        all_normals &= has_normals;
+        // Without normals in the file: smooth, area-weighted normals over
+        // shared positions (each face's unnormalised cross product summed).
+        let mut smooth = Vec::new();
+        if !has_normals {
+            smooth = vec![Vec3::ZERO; npos];
             for t in m.indices.chunks_exact(3) {
-                mesh.indices.push([base + t[0], base + t[1], base + t[2]]);
-                mesh.materials.push(material);
+                let p = [t[0], t[1], t[2]].map(|i| positions[i as usize]);
+                let n = (p[1] - p[0]).cross(p[2] - p[0]);
+                for &i in t {
+                    smooth[i as usize] += n;
+                }
             }
-            computed_ranges.push(first..mesh.indices.len());
+        }
+        // One vertex per distinct (position, normal, texcoord) triple.
+        let base = mesh.positions.len() as u32;
+        let mut map: HashMap<(u32, u32, u32), u32> = HashMap::with_capacity(m.indices.len());
+        let mut remap = Vec::with_capacity(m.indices.len());
+        for (k, &pi) in m.indices.iter().enumerate() {
+            let ni = if has_normals {
+                m.normal_indices[k]
+            } else {
+                u32::MAX
+            };
+            let ti = if has_uvs {
+                m.texcoord_indices[k]
+            } else {
+                u32::MAX
+            };
+            let next = base + map.len() as u32;
+            let idx = *map.entry((pi, ni, ti)).or_insert_with(|| {
+                let n = if has_normals {
+                    Vec3::from_slice(&m.normals[ni as usize * 3..ni as usize * 3 + 3])
+                } else {
+                    smooth[pi as usize]
+                };
+                let uv = if has_uvs {
+                    let t = &m.texcoords[ti as usize * 2..ti as usize * 2 + 2];
+                    Vec2::new(t[0], 1.0 - t[1])
+                } else {
+                    Vec2::ZERO
+                };
+                mesh.positions.push(positions[pi as usize]);
+                mesh.normals.push(if n.is_finite() {
+                    n.normalize_or_zero()
+                } else {
+                    Vec3::ZERO
+                });
+                mesh.uvs.push(if uv.is_finite() { uv } else { Vec2::ZERO });
+                next
+            });
+            remap.push(idx);
+        }
+        for t in remap.chunks_exact(3) {
+            mesh.indices.push([t[0], t[1], t[2]]);
+            mesh.materials.push(material);
         }
     }
     if mesh.indices.is_empty() {
         return Err(format!("OBJ file {} has no faces", path.display()));
     }
-    for range in computed_ranges {
-        accumulate_normals(&mut mesh, range);
-    }
     fix_zero_normals(&mut mesh);
     Ok(ObjMesh {
         mesh,
-        materials,
+        materials: converted,
+        albedo_textures,
         mtl_errors: mtl_errors.into_inner(),
         had_normals: all_normals,
     })

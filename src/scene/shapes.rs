@@ -3,9 +3,13 @@
 //! All meshes are in the object's local space. Triangles wind
 //! counter-clockwise seen from the side their normal points to, and normals of
 //! closed shapes point outward. `materials` is left empty: the caller fills it.
+//!
+//! Texture coordinates (docs/SCENES.md, "UV parameterisations"): every shape
+//! maps onto [0, 1]², u and v along the directions named at each shape, v
+//! growing away from the texture's top row.
 
 use super::types::Mesh;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::f32::consts::{PI, TAU};
 
 /// Default tessellation of curved shapes (segments around the main circle).
@@ -44,7 +48,9 @@ fn grid(mesh: &mut Mesh, base: u32, cols: u32, rows: u32) {
     }
 }
 
-/// UV sphere: `segments` around the y axis, `segments / 2` (at least 2) from pole to pole, smooth normals.
+/// UV sphere: `segments` around the y axis, `segments / 2` (at least 2) from
+/// pole to pole, smooth normals. UV: u = φ / 2π (φ the angle from +x toward
+/// +z), v = θ / π (θ from the +y pole).
 pub fn sphere(center: Vec3, radius: f32, segments: u32) -> Mesh {
     let slices = segments.max(MIN_SEGMENTS);
     let stacks = (segments / 2).max(2);
@@ -65,6 +71,10 @@ pub fn sphere(center: Vec3, radius: f32, segments: u32) -> Mesh {
             };
             mesh.positions.push(center + radius * d);
             mesh.normals.push(d);
+            mesh.uvs.push(Vec2::new(
+                i as f32 / slices as f32,
+                j as f32 / stacks as f32,
+            ));
         }
     }
     grid(&mut mesh, 0, slices, stacks);
@@ -74,6 +84,8 @@ pub fn sphere(center: Vec3, radius: f32, segments: u32) -> Mesh {
 /// A w x h rectangle centred at `center` facing `normal`, its w side along
 /// `tangent` (projected onto the plane; any perpendicular when `None`).
 /// The caller guarantees unit `normal` and a tangent not parallel to it.
+/// UV: u from 0 to 1 along the w side (the tangent), v from 0 to 1 along
+/// `normal x tangent`.
 pub fn plane(center: Vec3, normal: Vec3, tangent: Option<Vec3>, size: [f32; 2]) -> Mesh {
     let u = match tangent {
         Some(t) => (t - normal * normal.dot(t)).normalize(),
@@ -89,12 +101,24 @@ pub fn plane(center: Vec3, normal: Vec3, tangent: Option<Vec3>, size: [f32; 2]) 
             center - hu + hv,
         ],
         normals: vec![normal; 4],
+        uvs: QUAD_UVS.to_vec(),
         indices: vec![[0, 1, 2], [0, 2, 3]],
         materials: Vec::new(),
     }
 }
 
+/// UVs of the corners of a quad `c - u - v, c + u - v, c + u + v, c - u + v`.
+const QUAD_UVS: [Vec2; 4] = [
+    Vec2::new(0.0, 0.0),
+    Vec2::new(1.0, 0.0),
+    Vec2::new(1.0, 1.0),
+    Vec2::new(0.0, 1.0),
+];
+
 /// Axis-aligned box, 24 vertices, 12 triangles, flat outward normals.
+/// UV: each face is [0, 1]² on its own, u along the face's first in-plane
+/// axis and v along its second, the pair turning counter-clockwise seen from
+/// outside (faces ±x: (y, z) / (z, y), ±y: (z, x) / (x, z), ±z: (x, y) / (y, x)).
 pub fn cuboid(min: Vec3, max: Vec3) -> Mesh {
     let mid = (min + max) * 0.5;
     let half = (max - min) * 0.5;
@@ -113,6 +137,7 @@ pub fn cuboid(min: Vec3, max: Vec3) -> Mesh {
             mesh.positions
                 .extend([fc - hu - hv, fc + hu - hv, fc + hu + hv, fc - hu + hv]);
             mesh.normals.extend([n; 4]);
+            mesh.uvs.extend(QUAD_UVS);
             mesh.indices
                 .extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
         }
@@ -120,7 +145,9 @@ pub fn cuboid(min: Vec3, max: Vec3) -> Mesh {
     mesh
 }
 
-/// Torus around unit `axis`: `segments` around the axis, `segments / 2` (at least 3) around the tube.
+/// Torus around unit `axis`: `segments` around the axis, `segments / 2` (at
+/// least 3) around the tube. UV: u = angle around the axis / 2π, v = angle
+/// around the tube / 2π (0 on the outer equator).
 pub fn torus(center: Vec3, axis: Vec3, major: f32, minor: f32, segments: u32) -> Mesh {
     let (u, v) = basis(axis);
     let cols = segments.max(MIN_SEGMENTS);
@@ -136,6 +163,8 @@ pub fn torus(center: Vec3, axis: Vec3, major: f32, minor: f32, segments: u32) ->
             let n = radial * cq + axis * sq;
             mesh.positions.push(center + radial * major + n * minor);
             mesh.normals.push(n);
+            mesh.uvs
+                .push(Vec2::new(i as f32 / cols as f32, j as f32 / rows as f32));
         }
     }
     grid(&mut mesh, 0, cols, rows);
@@ -143,6 +172,9 @@ pub fn torus(center: Vec3, axis: Vec3, major: f32, minor: f32, segments: u32) ->
 }
 
 /// Cylinder from `p0` to `p1` (distinct): smooth sides, optional flat caps.
+/// UV: the side has u = angle around the axis / 2π, v = 0 at `p0` and 1 at
+/// `p1`; each cap maps the disc into [0, 1]² from above, (u, v) = (1 + (x, y)
+/// / radius) / 2 in the cap's basis (the side's angle 0 at +u).
 pub fn cylinder(p0: Vec3, p1: Vec3, radius: f32, caps: bool, segments: u32) -> Mesh {
     let w = (p1 - p0).normalize();
     let (u, v) = basis(w);
@@ -154,10 +186,11 @@ pub fn cylinder(p0: Vec3, p1: Vec3, radius: f32, caps: bool, segments: u32) -> M
         })
         .collect();
     let mut mesh = Mesh::default();
-    for end in [p0, p1] {
-        for &r in &ring {
+    for (v_end, end) in [(0.0, p0), (1.0, p1)] {
+        for (i, &r) in ring.iter().enumerate() {
             mesh.positions.push(end + r * radius);
             mesh.normals.push(r);
+            mesh.uvs.push(Vec2::new(i as f32 / cols as f32, v_end));
         }
     }
     grid(&mut mesh, 0, cols, 1);
@@ -166,9 +199,12 @@ pub fn cylinder(p0: Vec3, p1: Vec3, radius: f32, caps: bool, segments: u32) -> M
             let centre = mesh.positions.len() as u32;
             mesh.positions.push(end);
             mesh.normals.push(n);
+            mesh.uvs.push(Vec2::splat(0.5));
             for &r in &ring[..cols as usize] {
                 mesh.positions.push(end + r * radius);
                 mesh.normals.push(n);
+                let uv = Vec2::new(r.dot(u), r.dot(v)) * 0.5 + 0.5;
+                mesh.uvs.push(uv.clamp(Vec2::ZERO, Vec2::ONE));
             }
             for i in 0..cols {
                 let a = centre + 1 + i;
@@ -193,6 +229,13 @@ mod tests {
     /// (for closed convex-ish shapes) points away from `inside`.
     fn check(mesh: &Mesh, inside: Option<Vec3>) {
         assert_eq!(mesh.positions.len(), mesh.normals.len());
+        assert_eq!(mesh.positions.len(), mesh.uvs.len());
+        for uv in &mesh.uvs {
+            assert!(
+                uv.cmpge(Vec2::ZERO).all() && uv.cmple(Vec2::ONE).all(),
+                "{uv}"
+            );
+        }
         assert!(!mesh.indices.is_empty());
         for t in &mesh.indices {
             let p = t.map(|i| mesh.positions[i as usize]);
@@ -262,5 +305,21 @@ mod tests {
         assert!((ext - Vec3::Y * 4.0).length() < 1e-5);
         let default = plane(Vec3::ZERO, Vec3::Y, None, [1.0, 1.0]);
         check(&default, Some(-Vec3::Y));
+        // u runs along the tangent: the corner at +w/2 has u = 1.
+        assert_eq!(m.uvs[1] - m.uvs[0], Vec2::X);
+    }
+
+    #[test]
+    fn sphere_uv_follows_the_angles() {
+        let m = sphere(Vec3::ZERO, 1.0, 8);
+        for (p, uv) in m.positions.iter().zip(&m.uvs) {
+            let theta = p.y.clamp(-1.0, 1.0).acos();
+            assert!((uv.y - theta / PI).abs() < 1e-5, "{p} {uv}");
+            if p.y.abs() < 0.999 {
+                let phi = p.z.atan2(p.x).rem_euclid(TAU);
+                let u = if uv.x == 1.0 { 0.0 } else { uv.x };
+                assert!((u * TAU - phi).abs() < 1e-4, "{p} {uv}");
+            }
+        }
     }
 }

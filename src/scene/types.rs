@@ -16,6 +16,9 @@ pub struct Scene {
     pub objects: Vec<Object>,
     pub medium: Option<Medium>,
     pub output: Output,
+    /// Decoded albedo textures (`AlbedoTexture::index` points here), one per
+    /// distinct file.
+    pub textures: Vec<Texture>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -68,6 +71,30 @@ pub struct Material {
     pub ior: f32,
     /// Dielectric: Beer-Lambert absorption coefficient inside, 1/m. Others: 0.
     pub absorption: Vec3,
+    /// Diffuse only: the albedo is `color` times this texture at the
+    /// surface's UV (docs/SCENES.md, "Albedo textures").
+    pub texture: Option<AlbedoTexture>,
+}
+
+/// A diffuse material's albedo texture: which one and how often it repeats.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AlbedoTexture {
+    /// Index into `Scene::textures`.
+    pub index: u32,
+    /// The lookup is at `uv * uv_scale` (repeat wrap), so `uv_scale` = (4, 4)
+    /// tiles a [0, 1]² face four times each way.
+    pub uv_scale: Vec2,
+}
+
+/// A decoded image: linear RGB per texel (8-bit files decoded from sRGB,
+/// EXR taken as linear), rows top to bottom. UV (0, 0) is the top-left
+/// corner, the OBJ `vt` (0, 0) the bottom-left: see docs/SCENES.md.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    pub path: PathBuf,
+    pub width: u32,
+    pub height: u32,
+    pub texels: Vec<[f32; 3]>,
 }
 
 /// Triangle geometry in an object's local space.
@@ -76,6 +103,8 @@ pub struct Mesh {
     pub positions: Vec<Vec3>,
     /// One normal per position (computed when the source has none).
     pub normals: Vec<Vec3>,
+    /// One texture coordinate per position, or empty (all zero then).
+    pub uvs: Vec<Vec2>,
     pub indices: Vec<[u32; 3]>,
     /// Scene material index per triangle.
     pub materials: Vec<u32>,
@@ -181,6 +210,7 @@ pub struct Output {
 pub struct Triangle {
     pub positions: [Vec3; 3],
     pub normals: [Vec3; 3],
+    pub uvs: [Vec2; 3],
     pub material: u32,
     pub object: u32,
 }

@@ -136,6 +136,7 @@ impl Water {
         let mut mesh = Mesh {
             positions: Vec::with_capacity(self.vertex_count()),
             normals: Vec::with_capacity(self.vertex_count()),
+            uvs: Vec::with_capacity(self.vertex_count()),
             indices: Vec::with_capacity(2 * nx as usize * nz as usize),
             materials: Vec::new(),
         };
@@ -144,6 +145,9 @@ impl Water {
                 let (p, n) = self.surface_point(self.rest_position(i, j), time);
                 mesh.positions.push(p);
                 mesh.normals.push(n);
+                // UV over the rest grid: u along +x, v along +z.
+                mesh.uvs
+                    .push(Vec2::new(i as f32 / nx as f32, j as f32 / nz as f32));
             }
         }
         let stride = nx + 1;

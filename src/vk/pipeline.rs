@@ -192,6 +192,25 @@ impl Sampler {
     }
 }
 
+impl Sampler {
+    /// Trilinear filtering with repeat wrap over every mip level (tiling
+    /// textures).
+    pub fn repeat_mipmapped(ctx: &Arc<Context>) -> VkResult<Self> {
+        let info = vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::LINEAR)
+            .min_filter(vk::Filter::LINEAR)
+            .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
+            .address_mode_u(vk::SamplerAddressMode::REPEAT)
+            .address_mode_v(vk::SamplerAddressMode::REPEAT)
+            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .max_lod(vk::LOD_CLAMP_NONE);
+        Ok(Self {
+            ctx: ctx.clone(),
+            raw: unsafe { ctx.device.create_sampler(&info, None) }?,
+        })
+    }
+}
+
 impl Drop for Sampler {
     fn drop(&mut self) {
         unsafe { self.ctx.device.destroy_sampler(self.raw, None) };

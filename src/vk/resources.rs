@@ -273,22 +273,128 @@ pub struct Image {
     /// One 2D view per layer.
     pub layer_views: Vec<vk::ImageView>,
     pub desc: ImageDesc,
+    /// Mip levels (1 but for `Image::sampled_with_levels`).
+    pub mip_levels: u32,
     pub(super) state: Cell<ResourceState>,
     allocation: Option<Allocation>,
 }
 
 impl Image {
     pub fn new(ctx: &Arc<Context>, name: &str, desc: ImageDesc) -> VkResult<Image> {
-        Self::create(ctx, name, desc, false)
+        Self::create(ctx, name, desc, false, 1)
     }
 
     /// As `new`, but the full view is a 2D array even with one layer (for
     /// shaders that declare `image2DArray` whatever the layer count).
     pub fn new_array(ctx: &Arc<Context>, name: &str, desc: ImageDesc) -> VkResult<Image> {
-        Self::create(ctx, name, desc, true)
+        Self::create(ctx, name, desc, true, 1)
     }
 
-    fn create(ctx: &Arc<Context>, name: &str, desc: ImageDesc, array: bool) -> VkResult<Image> {
+    /// A read-only sampled 2D array image with one mip level per entry of
+    /// `levels` (level l: every layer's texels, layer after layer, tightly
+    /// packed; level l is `max(1, width >> l)` wide). The data is copied in
+    /// a blocking submission that ends in SHADER_READ_ONLY_OPTIMAL, made
+    /// visible to every later shader read; the image never changes again,
+    /// so its readers declare no access to it (and it must not be passed to
+    /// `barrier`).
+    pub fn sampled_with_levels(
+        ctx: &Arc<Context>,
+        name: &str,
+        desc: ImageDesc,
+        levels: &[&[u8]],
+    ) -> VkResult<Image> {
+        let desc = ImageDesc {
+            usage: desc.usage | vk::ImageUsageFlags::SAMPLED,
+            ..desc
+        };
+        let image = Self::create(ctx, name, desc, true, levels.len() as u32)?;
+        let bytes: Vec<u8> = levels.concat();
+        let staging = Buffer::new(
+            ctx,
+            "texture staging",
+            bytes.len() as u64,
+            BufferUsage::Upload,
+        )?;
+        staging.upload(&bytes)?;
+        let range = vk::ImageSubresourceRange {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            base_mip_level: 0,
+            level_count: image.mip_levels,
+            base_array_layer: 0,
+            layer_count: desc.layers,
+        };
+        ctx.submit_and_wait(|cmd| unsafe {
+            let to_dst = vk::ImageMemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::NONE)
+                .dst_stage_mask(vk::PipelineStageFlags2::COPY)
+                .dst_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                .old_layout(vk::ImageLayout::UNDEFINED)
+                .new_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+                .image(image.raw)
+                .subresource_range(range);
+            ctx.device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().image_memory_barriers(&[to_dst]),
+            );
+            let mut offset = 0u64;
+            let regions: Vec<vk::BufferImageCopy> = levels
+                .iter()
+                .enumerate()
+                .map(|(l, data)| {
+                    let region = vk::BufferImageCopy::default()
+                        .buffer_offset(offset)
+                        .image_subresource(vk::ImageSubresourceLayers {
+                            aspect_mask: vk::ImageAspectFlags::COLOR,
+                            mip_level: l as u32,
+                            base_array_layer: 0,
+                            layer_count: desc.layers,
+                        })
+                        .image_extent(vk::Extent3D {
+                            width: (desc.width >> l).max(1),
+                            height: (desc.height >> l).max(1),
+                            depth: 1,
+                        });
+                    offset += data.len() as u64;
+                    region
+                })
+                .collect();
+            ctx.device.cmd_copy_buffer_to_image(
+                cmd,
+                staging.raw,
+                image.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &regions,
+            );
+            // A fence makes device writes visible to the host only: make the
+            // copy visible to every later submission's shader reads.
+            let to_read = vk::ImageMemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::COPY)
+                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                .dst_access_mask(vk::AccessFlags2::SHADER_SAMPLED_READ)
+                .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+                .new_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)
+                .image(image.raw)
+                .subresource_range(range);
+            ctx.device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().image_memory_barriers(&[to_read]),
+            );
+        })?;
+        image.state.set(ResourceState {
+            layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            ..Default::default()
+        });
+        Ok(image)
+    }
+
+    fn create(
+        ctx: &Arc<Context>,
+        name: &str,
+        desc: ImageDesc,
+        array: bool,
+        mip_levels: u32,
+    ) -> VkResult<Image> {
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(desc.format)
@@ -297,7 +403,7 @@ impl Image {
                 height: desc.height,
                 depth: 1,
             })
-            .mip_levels(1)
+            .mip_levels(mip_levels)
             .array_layers(desc.layers)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
@@ -326,7 +432,7 @@ impl Image {
         }?;
         ctx.set_name(raw, name);
         let aspect = aspect_of(desc.format);
-        let make_view = |base: u32, count: u32, ty: vk::ImageViewType| {
+        let make_view = |base: u32, count: u32, ty: vk::ImageViewType, levels: u32| {
             let info = vk::ImageViewCreateInfo::default()
                 .image(raw)
                 .view_type(ty)
@@ -334,7 +440,7 @@ impl Image {
                 .subresource_range(vk::ImageSubresourceRange {
                     aspect_mask: aspect,
                     base_mip_level: 0,
-                    level_count: 1,
+                    level_count: levels,
                     base_array_layer: base,
                     layer_count: count,
                 });
@@ -351,14 +457,15 @@ impl Image {
             view: vk::ImageView::null(),
             layer_views: Vec::new(),
             desc,
+            mip_levels,
             state: Cell::new(ResourceState::default()),
             allocation: Some(allocation),
         };
-        image.view = make_view(0, desc.layers, ty)?;
+        image.view = make_view(0, desc.layers, ty, mip_levels)?;
         for layer in 0..desc.layers {
             image
                 .layer_views
-                .push(make_view(layer, 1, vk::ImageViewType::TYPE_2D)?);
+                .push(make_view(layer, 1, vk::ImageViewType::TYPE_2D, 1)?);
         }
         Ok(image)
     }

@@ -215,7 +215,7 @@ pub fn barrier(
                 .subresource_range(vk::ImageSubresourceRange {
                     aspect_mask: ia.image.aspect(),
                     base_mip_level: 0,
-                    level_count: 1,
+                    level_count: ia.image.mip_levels,
                     base_array_layer: 0,
                     layer_count: ia.image.desc.layers,
                 }),

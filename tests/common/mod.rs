@@ -44,6 +44,7 @@ pub fn diffuse(name: &str, albedo: f32) -> Material {
         color: Vec3::splat(albedo),
         ior: 1.0,
         absorption: Vec3::ZERO,
+        texture: None,
     }
 }
 
@@ -54,6 +55,7 @@ pub fn dielectric(name: &str, ior: f32) -> Material {
         color: Vec3::ONE,
         ior,
         absorption: Vec3::ZERO,
+        texture: None,
     }
 }
 
@@ -67,6 +69,7 @@ pub fn floor_mesh(half: f32, y: f32, material: u32) -> Mesh {
             Vec3::new(-half, y, half),
         ],
         normals: vec![Vec3::Y; 4],
+        uvs: Vec::new(),
         indices: vec![[0, 2, 1], [0, 3, 2]],
         materials: vec![material; 2],
     }
@@ -233,6 +236,7 @@ pub fn scene(
         objects,
         medium: None,
         output: Output { exposure: 1.0 },
+        textures: Vec::new(),
     }
 }
 
@@ -456,4 +460,85 @@ pub fn first_hit_mask(
                 })
         })
         .collect()
+}
+
+/// rgb summed, the quantity compared per pixel.
+pub fn sum_rgb(img: &[f32], i: usize) -> f64 {
+    (img[i * 4] + img[i * 4 + 1] + img[i * 4 + 2]) as f64
+}
+
+/// Pixels away from discontinuities of a noise-free image (`size`²): the
+/// 3x3 neighbourhood spans at most 15% of its maximum + 0.02.
+pub fn smooth_mask(img: &[f32], size: u32) -> Vec<bool> {
+    let s = size as i32;
+    (0..s * s)
+        .map(|i| {
+            let (x, y) = (i % s, i / s);
+            let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let (nx, ny) = ((x + dx).clamp(0, s - 1), (y + dy).clamp(0, s - 1));
+                    let v = sum_rgb(img, (ny * s + nx) as usize);
+                    lo = lo.min(v);
+                    hi = hi.max(v);
+                }
+            }
+            hi - lo <= 0.15 * hi + 0.02
+        })
+        .collect()
+}
+
+pub struct Blocks {
+    pub mean: f64,
+    pub worst: f64,
+    pub worst_at: (u32, u32),
+    pub used: usize,
+}
+
+/// Relative error of `block`² block sums over the pixels in `mask` (images
+/// `size`²): blocks less than a quarter covered by the mask, or darker than
+/// 10% of the reference's mean (too few photons for a relative error), are
+/// skipped.
+pub fn block_errors(
+    actual: &[f32],
+    reference: &[f32],
+    mask: &[bool],
+    size: u32,
+    block: u32,
+) -> Blocks {
+    let n = (size * size) as usize;
+    let mean_r = (0..n).map(|i| sum_rgb(reference, i)).sum::<f64>() / n as f64;
+    let mut b = Blocks {
+        mean: 0.0,
+        worst: 0.0,
+        worst_at: (0, 0),
+        used: 0,
+    };
+    for by in 0..size / block {
+        for bx in 0..size / block {
+            let (mut a, mut r, mut count) = (0.0, 0.0, 0);
+            for y in by * block..(by + 1) * block {
+                for x in bx * block..(bx + 1) * block {
+                    let i = (y * size + x) as usize;
+                    if mask[i] {
+                        a += sum_rgb(actual, i);
+                        r += sum_rgb(reference, i);
+                        count += 1;
+                    }
+                }
+            }
+            if count < (block * block / 4) as usize || r / (count as f64) < 0.1 * mean_r {
+                continue;
+            }
+            let e = ((a - r) / r).abs();
+            b.mean += e;
+            b.used += 1;
+            if e > b.worst {
+                b.worst = e;
+                b.worst_at = (bx, by);
+            }
+        }
+    }
+    b.mean /= b.used.max(1) as f64;
+    b
 }

@@ -1,10 +1,13 @@
 //! The scene's materials with an index by name, so every name check
 //! (duplicate `[[material]]`, an object's `material`, an MTL material met
 //! again) is one hash lookup: a scene or MTL file with thousands of
-//! materials loads in linear time.
+//! materials loads in linear time. It also holds the albedo textures the
+//! materials use, each file decoded once however many materials name it.
 
-use crate::scene::types::Material;
+use crate::scene::texture;
+use crate::scene::types::{Material, Texture};
 use std::collections::HashMap;
+use std::path::{Path, PathBuf};
 
 #[derive(Default)]
 pub(super) struct Materials {
@@ -13,6 +16,8 @@ pub(super) struct Materials {
     /// The first `defined` come from `[[material]]`; materials that OBJ
     /// files bring through their MTL follow.
     defined: usize,
+    textures: Vec<Texture>,
+    texture_by_path: HashMap<PathBuf, u32>,
 }
 
 impl Materials {
@@ -67,7 +72,29 @@ impl Materials {
         i
     }
 
-    pub(super) fn into_vec(self) -> Vec<Material> {
-        self.list
+    /// The index in `Scene::textures` of the texture file `path`, decoding
+    /// it on first use. The error says why (without a scene location).
+    pub(super) fn texture(&mut self, path: &Path) -> Result<u32, String> {
+        match self.texture_by_path.get(path) {
+            Some(&i) => Ok(i),
+            None => Ok(self.add_texture(texture::load(path)?)),
+        }
+    }
+
+    /// The index in `Scene::textures` of a decoded texture: the one of the
+    /// same `path` if already added (the same image named twice).
+    pub(super) fn add_texture(&mut self, t: Texture) -> u32 {
+        if let Some(&i) = self.texture_by_path.get(&t.path) {
+            return i;
+        }
+        let i = self.textures.len() as u32;
+        self.texture_by_path.insert(t.path.clone(), i);
+        self.textures.push(t);
+        i
+    }
+
+    /// The materials and the textures they index.
+    pub(super) fn into_parts(self) -> (Vec<Material>, Vec<Texture>) {
+        (self.list, self.textures)
     }
 }

@@ -14,7 +14,7 @@ use crate::shader_bindings::MAX_LIGHTS;
 use glam::Vec3;
 use materials::Materials;
 use std::path::Path;
-use values::{direction, non_negative_rgb, unit_rgb};
+use values::{direction, non_negative_rgb, numbers2, unit_rgb};
 
 /// Default vertical field of view, degrees.
 pub const DEFAULT_FOV_Y_DEG: f32 = 45.0;
@@ -66,7 +66,7 @@ pub(crate) fn parse(text: &str, path: &Path) -> R<Scene> {
 
     let mut materials = Materials::default();
     for t in root.tables("material")? {
-        let m = material(&t)?;
+        let m = material(&t, dir, &mut materials)?;
         let name = m.name.clone();
         if let Err(first) = materials.define(m) {
             return Err(t.err(
@@ -101,11 +101,13 @@ pub(crate) fn parse(text: &str, path: &Path) -> R<Scene> {
         None => Output { exposure: 1.0 },
     };
 
+    let (materials, textures) = materials.into_parts();
     Ok(Scene {
         source: path.to_path_buf(),
         camera,
         lights,
-        materials: materials.into_vec(),
+        materials,
+        textures,
         objects,
         medium,
         output,
@@ -220,7 +222,7 @@ fn light(t: &Tbl) -> R<Light> {
     Ok(l)
 }
 
-fn material(t: &Tbl) -> R<Material> {
+fn material(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Material> {
     let name = t.str("name")?;
     if name.trim().is_empty() {
         return Err(t.err("name", "must not be empty"));
@@ -232,11 +234,18 @@ fn material(t: &Tbl) -> R<Material> {
         color: Vec3::ONE,
         ior: 1.0,
         absorption: Vec3::ZERO,
+        texture: None,
     };
     match kind {
         "diffuse" => {
-            t.check_keys(&["name", "kind", "albedo"], "a diffuse material")?;
-            m.color = unit_rgb(t, "albedo", Vec3::splat(0.8))?;
+            t.check_keys(
+                &["name", "kind", "albedo", "albedo_texture", "uv_scale"],
+                "a diffuse material",
+            )?;
+            m.texture = albedo_texture(t, dir, materials)?;
+            // With a texture, `albedo` scales it (glTF's baseColorFactor).
+            let default = if m.texture.is_some() { 1.0 } else { 0.8 };
+            m.color = unit_rgb(t, "albedo", Vec3::splat(default))?;
         }
         "mirror" => {
             t.check_keys(&["name", "kind", "reflectance"], "a mirror material")?;
@@ -263,4 +272,24 @@ fn material(t: &Tbl) -> R<Material> {
         }
     }
     Ok(m)
+}
+
+/// A diffuse material's `albedo_texture` (a path relative to the scene file)
+/// and `uv_scale` (two positive numbers, default [1, 1]).
+fn albedo_texture(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Option<AlbedoTexture>> {
+    let Some(rel) = t.opt_str("albedo_texture")? else {
+        if t.has("uv_scale") {
+            return Err(t.err("uv_scale", "needs an `albedo_texture`"));
+        }
+        return Ok(None);
+    };
+    let index = materials
+        .texture(&dir.join(rel))
+        .map_err(|e| t.err("albedo_texture", e))?;
+    let uv_scale = if t.has("uv_scale") {
+        numbers2(t, "uv_scale", true)?.into()
+    } else {
+        glam::Vec2::ONE
+    };
+    Ok(Some(AlbedoTexture { index, uv_scale }))
 }

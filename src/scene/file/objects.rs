@@ -8,7 +8,7 @@ use crate::scene::node::Tbl;
 use crate::scene::node::R;
 use crate::scene::types::*;
 use crate::scene::{gltf, obj, shapes};
-use glam::{Mat4, Quat, Vec3};
+use glam::{Mat4, Quat, Vec2, Vec3};
 use std::path::Path;
 
 const COMMON_OBJECT_KEYS: [&str; 7] = [
@@ -185,11 +185,12 @@ fn file_object(
     mut mesh: Mesh,
     material: Option<u32>,
     imported: &[Material],
+    texture: &mut ImportTexture,
     materials: &mut Materials,
 ) -> R<Object> {
     match material {
         Some(m) => mesh.materials.iter_mut().for_each(|x| *x = m),
-        None => import_materials(t, &mut mesh, imported, materials)?,
+        None => import_materials(t, &mut mesh, imported, texture, materials)?,
     }
     placed(t, name, mesh)
 }
@@ -225,8 +226,36 @@ fn mesh_object(
             ));
         }
     }
-    file_object(t, name, loaded.mesh, material, &loaded.materials, materials)
+    // An MTL `map_Kd` is the material's texture, at the OBJ's own UVs.
+    let mut texture = |materials: &mut Materials, i: usize| -> R<Option<AlbedoTexture>> {
+        let Some(path) = &loaded.albedo_textures[i] else {
+            return Ok(None);
+        };
+        let index = materials.texture(path).map_err(|e| {
+            t.err(
+                "path",
+                format!("map_Kd of MTL material `{}`: {e}", loaded.materials[i].name),
+            )
+        })?;
+        Ok(Some(AlbedoTexture {
+            index,
+            uv_scale: Vec2::ONE,
+        }))
+    };
+    file_object(
+        t,
+        name,
+        loaded.mesh,
+        material,
+        &loaded.materials,
+        &mut texture,
+        materials,
+    )
 }
+
+/// The albedo texture of a loaded file's material `i` (added to the
+/// scene's textures), if it has one.
+type ImportTexture<'a> = dyn FnMut(&mut Materials, usize) -> R<Option<AlbedoTexture>> + 'a;
 
 /// Maps a loaded file's materials (indices into `imported` in
 /// `mesh.materials`) to scene materials, adding only those faces use and
@@ -235,6 +264,7 @@ fn import_materials(
     t: &Tbl,
     mesh: &mut Mesh,
     imported: &[Material],
+    texture: &mut ImportTexture,
     materials: &mut Materials,
 ) -> R<()> {
     let mut map = vec![None; imported.len()];
@@ -243,8 +273,9 @@ fn import_materials(
         let index = match *slot {
             Some(i) => i,
             None => {
-                let m = &imported[*x as usize];
-                let i = materials.add_mtl(m).ok_or_else(|| {
+                let mut m = imported[*x as usize].clone();
+                m.texture = texture(materials, *x as usize)?;
+                let i = materials.add_mtl(&m).ok_or_else(|| {
                     t.err(
                         "path",
                         format!("material name `{}` collides with another material", m.name),
@@ -271,13 +302,32 @@ fn gltf_object(
     materials: &mut Materials,
 ) -> R<Object> {
     let full = dir.join(t.str("path")?);
-    let loaded = gltf::load(&full).map_err(|e| t.err("path", e.to_string()))?;
+    let mut loaded = gltf::load(&full).map_err(|e| t.err("path", e.to_string()))?;
     if material.is_none() {
         for w in &loaded.warnings {
             log::warn!("{w}");
         }
+        // The file's textures read the UVs through their KHR_texture_transform.
+        loaded.transform_uvs();
     }
-    file_object(t, name, loaded.mesh, material, &loaded.materials, materials)
+    // A base colour texture joins the scene's textures (an image file shared
+    // with any other use of it); its transform is already in the UVs.
+    let textures = &loaded.base_color_textures;
+    let mut texture = |materials: &mut Materials, i: usize| -> R<Option<AlbedoTexture>> {
+        Ok(textures[i].as_ref().map(|t| AlbedoTexture {
+            index: materials.add_texture(t.pixels.clone()),
+            uv_scale: Vec2::ONE,
+        }))
+    };
+    file_object(
+        t,
+        name,
+        loaded.mesh,
+        material,
+        &loaded.materials,
+        &mut texture,
+        materials,
+    )
 }
 
 /// `translate * rotate_z * rotate_y * rotate_x * scale`: scale first, then X, Y, Z rotations, then translation.

@@ -29,6 +29,7 @@ pub const WP_BINDING_DRAW: u32 = 5;
 pub const WP_BINDING_CAUSTICS: u32 = 6;
 pub const WP_BINDING_GBUFFER_POSITION: u32 = 7;
 pub const WP_BINDING_GBUFFER_NORMAL: u32 = 8;
+pub const WP_BINDING_GBUFFER_ALBEDO: u32 = 15;
 pub const WP_BINDING_RADIANCE: u32 = 9;
 // water_photons "water view": the photon slot per (texel, cascade, ray
 // type) written by the trace, and the camera's view of the water.

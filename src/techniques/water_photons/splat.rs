@@ -162,6 +162,7 @@ impl Composite {
                 (bindings::WP_BINDING_CAUSTICS, BindingKind::StorageImage),
                 (bindings::WP_BINDING_GBUFFER_POSITION, BindingKind::StorageImage),
                 (bindings::WP_BINDING_GBUFFER_NORMAL, BindingKind::StorageImage),
+                (bindings::WP_BINDING_GBUFFER_ALBEDO, BindingKind::StorageImage),
                 (bindings::WP_BINDING_RADIANCE, BindingKind::StorageImage),
             ],
         )?;
@@ -169,6 +170,7 @@ impl Composite {
         set.write_storage_image(bindings::WP_BINDING_CAUSTICS, caustics)
             .write_storage_image(bindings::WP_BINDING_GBUFFER_POSITION, &gbuffer.position)
             .write_storage_image(bindings::WP_BINDING_GBUFFER_NORMAL, &gbuffer.normal)
+            .write_storage_image(bindings::WP_BINDING_GBUFFER_ALBEDO, &gbuffer.albedo)
             .write_storage_image(bindings::WP_BINDING_RADIANCE, radiance);
         let pipeline = ComputePipeline::new(
             ctx,
@@ -202,6 +204,7 @@ impl Composite {
                     ImageAccess::new(caustics, Access::ComputeRead),
                     ImageAccess::new(&gbuffer.position, Access::ComputeRead),
                     ImageAccess::new(&gbuffer.normal, Access::ComputeRead),
+                    ImageAccess::new(&gbuffer.albedo, Access::ComputeRead),
                     ImageAccess::new(radiance, Access::ComputeWrite),
                 ],
                 &[],

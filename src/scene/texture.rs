@@ -1,0 +1,195 @@
+//! Albedo textures: decoding image files into linear RGB, and the CPU side
+//! of the GPU texture array (every texture resized to one square layer
+//! size, with its mip chain).
+//!
+//! Lavapipe 22.3 has no descriptor indexing, so the shaders cannot index an
+//! array of differently sized textures: all albedo textures share one 2D
+//! array image (docs/ARCHITECTURE.md, "Albedo textures").
+
+use super::types::Texture;
+use glam::Vec3;
+use image::imageops::{self, FilterType};
+use image::{DynamicImage, Rgb32FImage};
+use std::path::Path;
+
+/// Largest layer of the texture array (texels per side): larger files are
+/// scaled down to it.
+pub const MAX_LAYER_SIZE: u32 = 1024;
+
+/// The sRGB transfer function's inverse (IEC 61966-2-1): an 8-bit code
+/// value `c` / 255 to linear.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Reads a PNG or EXR file (JPEG: see docs/SCENES.md). 8- and 16-bit
+/// integer images are sRGB-encoded and decoded to linear; float images
+/// (EXR) are linear already. Alpha is ignored. The error says why, without
+/// the path (the caller names the file and the field).
+pub fn load(path: &Path) -> Result<Texture, String> {
+    let reader = image::ImageReader::open(path)
+        .map_err(|e| format!("cannot open texture {}: {e}", path.display()))?
+        .with_guessed_format()
+        .map_err(|e| format!("cannot read texture {}: {e}", path.display()))?;
+    let decoded = reader
+        .decode()
+        .map_err(|e| format!("cannot decode texture {}: {e}", path.display()))?;
+    from_image(decoded, path)
+}
+
+/// An image file's bytes held in memory (a glTF image in a buffer view or
+/// a `data:` URI), decoded as [`load`] decodes a file; `name` stands for
+/// the path in the texture and its errors.
+pub fn decode(bytes: &[u8], name: &Path) -> Result<Texture, String> {
+    let decoded = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| format!("cannot read texture {}: {e}", name.display()))?
+        .decode()
+        .map_err(|e| format!("cannot decode texture {}: {e}", name.display()))?;
+    from_image(decoded, name)
+}
+
+fn from_image(decoded: DynamicImage, path: &Path) -> Result<Texture, String> {
+    let (width, height) = (decoded.width(), decoded.height());
+    if width == 0 || height == 0 {
+        return Err(format!("texture {} is empty", path.display()));
+    }
+    let linear = matches!(
+        decoded,
+        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
+    );
+    let rgb = decoded.into_rgb32f();
+    let texels: Vec<[f32; 3]> = rgb
+        .pixels()
+        .map(|p| if linear { p.0 } else { p.0.map(srgb_to_linear) })
+        .collect();
+    if let Some(i) = texels.iter().position(|t| !Vec3::from(*t).is_finite()) {
+        return Err(format!(
+            "texture {}: texel {i} is not finite",
+            path.display()
+        ));
+    }
+    Ok(Texture {
+        path: path.to_path_buf(),
+        width,
+        height,
+        texels,
+    })
+}
+
+/// Side of the texture array's layers for `textures`: the largest width or
+/// height among them rounded up to a power of two, at most
+/// [`MAX_LAYER_SIZE`]; 1 without textures.
+pub fn layer_size(textures: &[Texture]) -> u32 {
+    let largest = textures
+        .iter()
+        .map(|t| t.width.max(t.height))
+        .max()
+        .unwrap_or(1);
+    largest.next_power_of_two().min(MAX_LAYER_SIZE)
+}
+
+/// The mip chain of `texture` resized to `size` x `size` (a power of two):
+/// level 0 resampled with a triangle (bilinear) filter, each next level the
+/// 2x2 box average of the one before, down to 1x1. RGBA, alpha 1, rows top
+/// to bottom. Filtering happens on linear values, as it must for radiometry.
+pub fn mip_chain(texture: &Texture, size: u32) -> Vec<Vec<[f32; 4]>> {
+    let flat: Vec<f32> = texture.texels.iter().flatten().copied().collect();
+    let image = Rgb32FImage::from_raw(texture.width, texture.height, flat)
+        .expect("texel count matches the size");
+    let level0 = if (texture.width, texture.height) == (size, size) {
+        image
+    } else {
+        imageops::resize(&image, size, size, FilterType::Triangle)
+    };
+    let mut levels = vec![level0
+        .pixels()
+        .map(|p| [p.0[0], p.0[1], p.0[2], 1.0])
+        .collect::<Vec<_>>()];
+    let mut side = size as usize;
+    while side > 1 {
+        let prev = levels.last().expect("level 0 exists");
+        let half = side / 2;
+        let mut next = Vec::with_capacity(half * half);
+        for y in 0..half {
+            for x in 0..half {
+                let mut sum = [0.0f32; 4];
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    let t = prev[(2 * y + dy) * side + 2 * x + dx];
+                    for c in 0..4 {
+                        sum[c] += 0.25 * t[c];
+                    }
+                }
+                next.push(sum);
+            }
+        }
+        levels.push(next);
+        side = half;
+    }
+    levels
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    fn texture(width: u32, height: u32, texels: Vec<[f32; 3]>) -> Texture {
+        Texture {
+            path: PathBuf::from("t.png"),
+            width,
+            height,
+            texels,
+        }
+    }
+
+    #[test]
+    fn srgb_decode_matches_the_standard_at_its_ends_and_knee() {
+        assert_eq!(srgb_to_linear(0.0), 0.0);
+        assert!((srgb_to_linear(1.0) - 1.0).abs() < 1e-6);
+        // Both branches meet at the knee (continuity of IEC 61966-2-1).
+        let below = 0.04045 / 12.92;
+        let above = ((0.04045f32 + 0.055) / 1.055).powf(2.4);
+        assert!((below - above).abs() < 1e-6);
+        // Code 188 decodes to about 0.5029 (tables of sRGB).
+        assert!((srgb_to_linear(188.0 / 255.0) - 0.5029).abs() < 1e-4);
+    }
+
+    #[test]
+    fn layer_size_is_a_capped_power_of_two() {
+        assert_eq!(layer_size(&[]), 1);
+        let t = texture(3, 5, vec![[0.0; 3]; 15]);
+        assert_eq!(layer_size(&[t]), 8);
+        let big = texture(3000, 1, vec![[0.0; 3]; 3000]);
+        assert_eq!(layer_size(&[big]), MAX_LAYER_SIZE);
+    }
+
+    #[test]
+    fn mip_chain_keeps_the_mean_down_to_one_texel() {
+        // A 4x4 checker of 0 and 1: every level's mean is 1/2.
+        let texels = (0..16).map(|i| [((i % 4 + i / 4) % 2) as f32; 3]).collect();
+        let levels = mip_chain(&texture(4, 4, texels), 4);
+        assert_eq!(levels.len(), 3);
+        for level in &levels {
+            let mean: f32 = level.iter().map(|t| t[0]).sum::<f32>() / level.len() as f32;
+            assert!((mean - 0.5).abs() < 1e-6, "{mean}");
+        }
+        assert_eq!(levels[2], vec![[0.5, 0.5, 0.5, 1.0]]);
+    }
+
+    #[test]
+    fn a_constant_texture_stays_constant_when_resized() {
+        let levels = mip_chain(&texture(3, 2, vec![[0.25, 0.5, 0.75]; 6]), 4);
+        for level in &levels {
+            for t in level {
+                for (a, b) in t.iter().zip([0.25, 0.5, 0.75, 1.0]) {
+                    assert!((a - b).abs() < 1e-6, "{t:?}");
+                }
+            }
+        }
+    }
+}
