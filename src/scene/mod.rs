@@ -4,7 +4,7 @@
 //! - `file.rs`: the schema and its validation (every error located `FILE:LINE:COL: FIELD`).
 //! - `node.rs`: the span-carrying TOML tree the schema reads from.
 //! - `shapes.rs`: procedural tessellation; `obj.rs`: OBJ/MTL through tobj;
-//!   `gltf.rs`: glTF 2.0 files (objects, or a whole scene of one file).
+//!   `gltf/`: glTF 2.0 files (objects, or a whole scene of one file).
 //! - `water.rs`: water surfaces (Gerstner waves), re-tessellated per time.
 //! - this file: loading, animation and world-space queries.
 

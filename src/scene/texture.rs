@@ -26,7 +26,7 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     }
 }
 
-/// Reads a PNG or EXR file (JPEG: see docs/SCENES.md). 8- and 16-bit
+/// Reads a PNG, JPEG or EXR file. 8- and 16-bit
 /// integer images are sRGB-encoded and decoded to linear; float images
 /// (EXR) are linear already. Alpha is ignored. The error says why, without
 /// the path (the caller names the file and the field).
@@ -157,6 +157,28 @@ mod tests {
         assert!((below - above).abs() < 1e-6);
         // Code 188 decodes to about 0.5029 (tables of sRGB).
         assert!((srgb_to_linear(188.0 / 255.0) - 0.5029).abs() < 1e-4);
+    }
+
+    /// JPEG files decode as sRGB like PNG: a flat colour (its 8x8 blocks
+    /// hold only a DC term, which baseline JPEG at quality 100 keeps to
+    /// within a code) comes back as the decoded sRGB value of its codes.
+    #[test]
+    fn jpeg_decodes_as_srgb() {
+        let rgb = [200u8, 120, 40];
+        let image = image::RgbImage::from_pixel(16, 16, image::Rgb(rgb));
+        let mut bytes = Vec::new();
+        image::codecs::jpeg::JpegEncoder::new_with_quality(&mut bytes, 100)
+            .encode_image(&image)
+            .unwrap();
+        let t = decode(&bytes, Path::new("flat.jpg")).unwrap();
+        assert_eq!((t.width, t.height), (16, 16));
+        for texel in &t.texels {
+            for (c, &code) in texel.iter().zip(&rgb) {
+                let lo = srgb_to_linear((code as f32 - 2.0) / 255.0);
+                let hi = srgb_to_linear((code as f32 + 2.0) / 255.0);
+                assert!((lo..=hi).contains(c), "{c} not within 2 codes of {code}");
+            }
+        }
     }
 
     #[test]

@@ -1,6 +1,8 @@
 //! Frames in flight. `Frames` owns N per-frame contexts (default 2); each has
 //! its command pool and buffer, fence, acquire semaphore (for presentation),
-//! timestamp query pool, upload ring and deferred-release list.
+//! timestamp query pool, upload ring and deferred-release list. (Over 600
+//! lines: `Frames` and its `FrameRecorder` share the slot state and its
+//! invariants below; the ring and the one-frame `Profiler` are apart.)
 //! `begin_frame` waits only for the fence of the frame that last used the
 //! same slot, N frames ago; `FrameRecorder::submit` submits without waiting.
 //!
