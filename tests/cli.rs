@@ -397,7 +397,13 @@ fn bad_arguments_fail_cleanly() {
             vec!["unknown component `nope`", "surface_caustics"],
         ),
         (
-            vec!["render", "--component", "surface_caustics"],
+            vec![
+                "render",
+                "--technique",
+                "direct",
+                "--component",
+                "surface_caustics",
+            ],
             vec![
                 "technique `direct` does not render component `surface_caustics`",
                 "it renders: direct, all",

@@ -100,8 +100,10 @@ pub enum Command {
 pub struct TechniqueArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// Technique name, or `list` (with `render`) to print them with their parameters.
-    #[arg(long, default_value = "direct")]
+    /// Technique name, or `list` (with `render`) to print them with their
+    /// parameters. The default, `image_space` (Wyman's caustic maps), is the
+    /// quickest one that draws caustics on lavapipe.
+    #[arg(long, default_value = "image_space")]
     pub technique: String,
     /// Technique parameter, NAME=VALUE (repeatable; `render --technique list` shows them).
     #[arg(long = "param")]
