@@ -202,7 +202,9 @@ mod enabled {
         }
 
         /// Runs the UI for this frame and uploads changed textures. Called
-        /// after the frame slot's fence wait, before recording.
+        /// before the frame is recorded, while earlier frames may still be
+        /// in flight and sampling the UI's textures: freeing or replacing
+        /// one (below) waits for the device first.
         pub fn prepare(&mut self, window: &Window, data: &UiData) -> anyhow::Result<Vec<Action>> {
             self.primitives.clear();
             if !self.to_free.is_empty() {
@@ -233,6 +235,18 @@ mod enabled {
             self.winit
                 .handle_platform_output(window, output.platform_output);
             self.pixels_per_point = output.pixels_per_point;
+            // A whole-texture delta (no position: the first upload, or a
+            // font atlas rebuilt after a DPI change) makes the renderer
+            // destroy the old image at once; rare enough to wait for.
+            if output
+                .textures_delta
+                .set
+                .values()
+                .flatten()
+                .any(|d| d.pos.is_none())
+            {
+                self.ctx.wait_idle();
+            }
             for (id, deltas) in &output.textures_delta.set {
                 for delta in deltas {
                     self.renderer

@@ -32,7 +32,7 @@ use crate::scene::Scene;
 use crate::shader_bindings as b;
 use crate::vk::{
     barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
-    FrameRecorder, Image, ImageAccess, Sampler, VkResult,
+    FrameRecorder, Image, ImageAccess, Sampler, TargetBinding, VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -65,7 +65,7 @@ pub struct Airlight {
     set: DescriptorSet,
     /// The image the output binding points at (written on the first
     /// `record`, again when the target changes).
-    bound_out: vk::ImageView,
+    bound_out: TargetBinding,
     _layout: DescriptorSetLayout,
     _sampler: Sampler,
 }
@@ -115,7 +115,7 @@ impl Airlight {
             },
             pipeline,
             set,
-            bound_out: vk::ImageView::null(),
+            bound_out: TargetBinding::new(b::AIRLIGHT_BINDING_RADIANCE),
             _layout: layout,
             _sampler: sampler,
         })
@@ -137,13 +137,7 @@ impl Airlight {
         shadows: &ShadowMaps,
         out: &Image,
     ) {
-        if self.bound_out != out.view {
-            // A set may not be updated while a submitted frame can use it.
-            rec.wait_for_other_frames();
-            self.set
-                .write_storage_image(b::AIRLIGHT_BINDING_RADIANCE, out);
-            self.bound_out = out.view;
-        }
+        self.bound_out.bind(rec, &self.set, out);
         let ctx = rec.ctx().clone();
         let (width, height) = (out.extent().width, out.extent().height);
         rec.pass("airlight", |cmd| {

@@ -13,7 +13,7 @@ use crate::passes::specular_gbuffer::{SpecularGBuffer, Viewpoint};
 use crate::shader_bindings as b;
 use crate::vk::{
     barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
-    FrameRecorder, Image, ImageAccess, VkResult,
+    FrameRecorder, Image, ImageAccess, TargetBinding, VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -37,7 +37,7 @@ pub struct CameraRefraction {
     push: RefractionPush,
     pipeline: ComputePipeline,
     set: DescriptorSet,
-    bound_radiance: vk::ImageView,
+    bound_radiance: TargetBinding,
     _layout: DescriptorSetLayout,
 }
 
@@ -109,7 +109,7 @@ impl CameraRefraction {
             push,
             pipeline,
             set,
-            bound_radiance: vk::ImageView::null(),
+            bound_radiance: TargetBinding::new(b::REFRACTION_BINDING_RADIANCE),
             _layout: layout,
         })
     }
@@ -134,13 +134,7 @@ impl CameraRefraction {
         opaque_gbuffer: &GBuffer,
         targets: &FrameTargets,
     ) {
-        if self.bound_radiance != targets.radiance.view {
-            // A set may not be updated while a submitted frame can use it.
-            rec.wait_for_other_frames();
-            self.set
-                .write_storage_image(b::REFRACTION_BINDING_RADIANCE, &targets.radiance);
-            self.bound_radiance = targets.radiance.view;
-        }
+        self.bound_radiance.bind(rec, &self.set, &targets.radiance);
         let ctx = rec.ctx().clone();
         rec.pass("refraction", |cmd| {
             // The specular G-buffer's attachment writes and the opaque

@@ -28,7 +28,7 @@ use crate::scene::Scene;
 use crate::shader_bindings as b;
 use crate::vk::{
     barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
-    FrameRecorder, ImageAccess, Sampler, VkResult,
+    FrameRecorder, ImageAccess, Sampler, TargetBinding, VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -67,7 +67,7 @@ pub struct DirectLight {
     /// The radiance image the set's output binding points at: the frame
     /// targets are not known at construction, so the binding is written on
     /// the first `record` (and again if the targets change).
-    bound_radiance: vk::ImageView,
+    bound_radiance: TargetBinding,
     _layout: DescriptorSetLayout,
     _sampler: Sampler,
 }
@@ -150,7 +150,7 @@ impl DirectLight {
             medium_steps: params.medium_steps,
             lighting,
             set,
-            bound_radiance: vk::ImageView::null(),
+            bound_radiance: TargetBinding::new(b::DIRECT_BINDING_RADIANCE),
             _layout: layout,
             _sampler: sampler,
         })
@@ -169,13 +169,7 @@ impl DirectLight {
         scene: &SceneGpu,
         targets: &FrameTargets,
     ) -> VkResult<()> {
-        if self.bound_radiance != targets.radiance.view {
-            // A set may not be updated while a submitted frame can use it.
-            rec.wait_for_other_frames();
-            self.set
-                .write_storage_image(b::DIRECT_BINDING_RADIANCE, &targets.radiance);
-            self.bound_radiance = targets.radiance.view;
-        }
+        self.bound_radiance.bind(rec, &self.set, &targets.radiance);
         self.shadows.record(rec, scene)?;
         self.gbuffer.record(rec, scene);
         let ctx = rec.ctx().clone();

@@ -69,19 +69,28 @@ impl Renderer {
     }
 
     /// Rebuilds the frame targets, the tonemap and the technique at a new
-    /// size (the demo's window resize). The old ones are released after the
-    /// frames in flight that use them.
+    /// size (the demo's window resize). All three are built before any is
+    /// replaced, so on an error the renderer keeps the old size whole; the
+    /// old ones are released after the frames in flight that use them.
     pub fn resize(&mut self, width: u32, height: u32) -> anyhow::Result<()> {
-        let name = self.technique.name();
-        let old = std::mem::replace(&mut self.technique, Box::new(NoTechnique));
-        self.frames.defer_release(old);
         let targets = FrameTargets::new(&self.ctx, width, height)?;
         let tonemap = Tonemap::new(&self.ctx, &targets.radiance)?;
+        let technique = techniques::create_named(
+            &self.ctx,
+            self.technique.name(),
+            &self.params,
+            &self.scene,
+            &self.scene_gpu,
+            width,
+            height,
+        )?;
+        let old_technique = std::mem::replace(&mut self.technique, technique);
+        self.frames.defer_release(old_technique);
         let old_tonemap = std::mem::replace(&mut self.tonemap, tonemap);
         self.frames.defer_release(old_tonemap);
         let old_targets = std::mem::replace(&mut self.targets, targets);
         self.frames.defer_release(old_targets);
-        self.set_technique(name, &self.params.clone())
+        Ok(())
     }
 
     /// Switches to technique `name` with `params` (keeps the current one on error).

@@ -73,6 +73,18 @@ fn from_image(decoded: DynamicImage, path: &Path) -> Result<Texture, String> {
             path.display()
         ));
     }
+    // An albedo is a reflectance: outside [0, 1] it breaks energy
+    // conservation (and above 65504 the RGBA16F array would hold +Inf).
+    if let Some(i) = texels
+        .iter()
+        .position(|t| t.iter().any(|c| !(0.0..=1.0).contains(c)))
+    {
+        return Err(format!(
+            "texture {}: texel {i} is {:?}, outside [0, 1] (an albedo)",
+            path.display(),
+            texels[i]
+        ));
+    }
     Ok(Texture {
         path: path.to_path_buf(),
         width,
@@ -179,6 +191,22 @@ mod tests {
                 assert!((lo..=hi).contains(c), "{c} not within 2 codes of {code}");
             }
         }
+    }
+
+    /// EXR texels are linear albedos: one above 1 is refused, naming it.
+    #[test]
+    fn exr_albedo_above_one_is_refused() {
+        let mut image = image::Rgb32FImage::from_pixel(2, 2, image::Rgb([0.5, 0.5, 0.5]));
+        image.put_pixel(1, 0, image::Rgb([0.5, 2.0, 0.5]));
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        DynamicImage::ImageRgb32F(image)
+            .write_to(&mut bytes, image::ImageFormat::OpenExr)
+            .unwrap();
+        let e = decode(bytes.get_ref(), Path::new("hot.exr")).unwrap_err();
+        assert!(
+            e.contains("hot.exr") && e.contains("texel 1") && e.contains("[0, 1]"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -34,8 +34,10 @@ pub trait Technique {
     /// Takes new values of `Live` parameters (`params::Apply`) in place:
     /// push constants and switches read at record time. Called by
     /// `Renderer::set_params` only when every changed parameter is live,
-    /// with no frame in flight. Returns false (the default) when the
-    /// technique cannot, and the renderer rebuilds it.
+    /// possibly with frames in flight: change only host state read at
+    /// record time, never a buffer or descriptor set a submitted frame may
+    /// read. Returns false (the default) when the technique cannot, and the
+    /// renderer rebuilds it.
     fn update_live(&mut self, _params: &Params) -> anyhow::Result<bool> {
         Ok(false)
     }

@@ -33,6 +33,7 @@ pub use frame::{
 pub use pipeline::{
     begin_rendering, begin_rendering_with_depth, end_rendering, BindingKind, ComputePipeline,
     DescriptorSet, DescriptorSetLayout, GraphicsPipeline, GraphicsPipelineDesc, Sampler,
+    TargetBinding,
 };
 pub use pipeline_store::{CacheLoad, PipelineCounts, PipelineStore, Specialization};
 pub use profiler::Profiler;

@@ -4,7 +4,7 @@
 
 use super::pipeline_create::{create_graphics, create_with_stages, pipeline_key};
 use super::pipeline_store::{SharedPipeline, Specialization, Stages};
-use super::{Buffer, Context, Image, VkResult};
+use super::{Buffer, Context, FrameRecorder, Image, VkResult};
 use ash::vk;
 use std::sync::Arc;
 
@@ -65,6 +65,39 @@ impl Drop for DescriptorSetLayout {
                 .device
                 .destroy_descriptor_set_layout(self.raw, None)
         };
+    }
+}
+
+/// A storage-image binding of a set that points at the frame's targets,
+/// which a pass does not know when it is built: bound at its first `record`
+/// and again whenever the targets change.
+pub struct TargetBinding {
+    binding: u32,
+    view: vk::ImageView,
+}
+
+impl TargetBinding {
+    pub fn new(binding: u32) -> Self {
+        Self {
+            binding,
+            view: vk::ImageView::null(),
+        }
+    }
+
+    /// Points `set`'s binding at `image` unless it already does. A set may
+    /// not be updated while a submitted frame can use it, so a *re*binding
+    /// first waits for the other frames in flight; the first binding waits
+    /// for none (no submitted frame has used the set yet: a technique just
+    /// built, e.g. after a rebuild parameter changed, starts at once).
+    pub fn bind(&mut self, rec: &mut FrameRecorder, set: &DescriptorSet, image: &Image) {
+        if self.view == image.view {
+            return;
+        }
+        if self.view != vk::ImageView::null() {
+            rec.wait_for_other_frames();
+        }
+        set.write_storage_image(self.binding, image);
+        self.view = image.view;
     }
 }
 

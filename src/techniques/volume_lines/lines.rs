@@ -10,6 +10,7 @@ use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::passes::surface_frame::SurfaceFrame;
 use crate::scene::{Density, Scene};
 use crate::vk::{
+    TargetBinding,
     barrier, begin_rendering, end_rendering, Access, BindingKind, Buffer, BufferAccess,
     BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder,
     GraphicsPipeline, GraphicsPipelineDesc, Image, ImageAccess, ImageDesc,
@@ -77,7 +78,7 @@ pub struct VolumeRays {
     line_pipeline: GraphicsPipeline,
     composite_pipeline: ComputePipeline,
     set: DescriptorSet,
-    bound_radiance: vk::ImageView,
+    bound_radiance: TargetBinding,
     _layout: DescriptorSetLayout,
 }
 
@@ -256,7 +257,7 @@ impl VolumeRays {
             line_pipeline,
             composite_pipeline,
             set,
-            bound_radiance: vk::ImageView::null(),
+            bound_radiance: TargetBinding::new(bindings::VOLUME_LINES_BINDING_RADIANCE),
             _layout: layout,
         })
     }
@@ -270,13 +271,7 @@ impl VolumeRays {
         surface: &SurfaceFrame,
         targets: &FrameTargets,
     ) {
-        if self.bound_radiance != targets.radiance.view {
-            // A set may not be updated while a submitted frame can use it.
-            rec.wait_for_other_frames();
-            self.set
-                .write_storage_image(bindings::VOLUME_LINES_BINDING_RADIANCE, &targets.radiance);
-            self.bound_radiance = targets.radiance.view;
-        }
+        self.bound_radiance.bind(rec, &self.set, &targets.radiance);
         let ctx = rec.ctx().clone();
         rec.pass("volume visibility", |cmd| {
             // The camera G-buffers were written by rasterisation; the

@@ -13,6 +13,7 @@ use crate::passes::gbuffer::GBuffer;
 use crate::passes::specular_gbuffer::SpecularGBuffer;
 use super::bindings;
 use crate::vk::{
+    TargetBinding,
     barrier, Access, BindingKind, Buffer, BufferAccess, ComputePipeline, Context, DescriptorSet,
     DescriptorSetLayout, FrameRecorder, Image, ImageAccess, VkResult,
 };
@@ -22,7 +23,7 @@ use std::sync::Arc;
 pub struct WaterView {
     pipeline: ComputePipeline,
     set: DescriptorSet,
-    bound_radiance: vk::ImageView,
+    bound_radiance: TargetBinding,
     _layout: DescriptorSetLayout,
 }
 
@@ -70,7 +71,7 @@ impl WaterView {
         Ok(Self {
             pipeline,
             set,
-            bound_radiance: vk::ImageView::null(),
+            bound_radiance: TargetBinding::new(bindings::WP_BINDING_RADIANCE),
             _layout: layout,
         })
     }
@@ -90,13 +91,7 @@ impl WaterView {
         specular: &SpecularGBuffer,
         targets: &FrameTargets,
     ) {
-        if self.bound_radiance != targets.radiance.view {
-            // A set may not be updated while a submitted frame can use it.
-            rec.wait_for_other_frames();
-            self.set
-                .write_storage_image(bindings::WP_BINDING_RADIANCE, &targets.radiance);
-            self.bound_radiance = targets.radiance.view;
-        }
+        self.bound_radiance.bind(rec, &self.set, &targets.radiance);
         let ctx = rec.ctx().clone();
         rec.pass("water view", |cmd| {
             // The trace's photon and slot writes, the composite's radiance
