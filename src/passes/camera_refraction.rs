@@ -15,7 +15,6 @@ use crate::vk::{
     barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
     FrameRecorder, Image, ImageAccess, TargetBinding, VkResult,
 };
-use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
 

@@ -274,20 +274,3 @@ impl Renderer {
         self.tonemap.display.download_bytes(4)
     }
 }
-
-/// Stands in for a technique while `resize` rebuilds the real one.
-struct NoTechnique;
-
-impl Technique for NoTechnique {
-    fn name(&self) -> &'static str {
-        "none"
-    }
-    fn record(
-        &mut self,
-        _rec: &mut FrameRecorder,
-        _scene: &SceneGpu,
-        _targets: &FrameTargets,
-    ) -> VkResult<()> {
-        Ok(())
-    }
-}

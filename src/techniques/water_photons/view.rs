@@ -17,7 +17,6 @@ use crate::vk::{
     barrier, Access, BindingKind, Buffer, BufferAccess, ComputePipeline, Context, DescriptorSet,
     DescriptorSetLayout, FrameRecorder, Image, ImageAccess, VkResult,
 };
-use ash::vk;
 use std::sync::Arc;
 
 pub struct WaterView {
