@@ -58,8 +58,10 @@ pub struct GpuMaterial {
     pub color: [f32; 4],
     /// rgb absorption (1/m); w = ior.
     pub absorption_ior: [f32; 4],
-    /// x = albedo texture layer (int bits, -1: none); yz = uv_scale; w unused.
-    /// A diffuse albedo is `color.rgb` times the layer at `uv * uv_scale`.
+    /// x = albedo texture layer (int bits, -1: none); yz = uv_scale; w = alpha
+    /// cutoff (0: opaque). A diffuse albedo is `color.rgb` times the layer at
+    /// `uv * uv_scale`; where the layer's alpha is below the cutoff the
+    /// surface is cut out.
     pub texture: [f32; 4],
 }
 
@@ -201,14 +203,21 @@ impl GpuMaterial {
             MaterialKind::Mirror => b::MATERIAL_MIRROR,
             MaterialKind::Dielectric => b::MATERIAL_DIELECTRIC,
         };
-        let (layer, uv_scale) = match m.texture {
-            Some(t) if m.kind == MaterialKind::Diffuse => (t.index as i32, t.uv_scale),
-            _ => (-1, glam::Vec2::ONE),
+        let (layer, uv_scale, alpha_cutoff) = match m.texture {
+            Some(t) if m.kind == MaterialKind::Diffuse => {
+                (t.index as i32, t.uv_scale, t.alpha_cutoff)
+            }
+            _ => (-1, glam::Vec2::ONE, 0.0),
         };
         Self {
             color: v4(m.color, f32::from_bits(kind)),
             absorption_ior: v4(m.absorption, m.ior),
-            texture: [f32::from_bits(layer as u32), uv_scale.x, uv_scale.y, 0.0],
+            texture: [
+                f32::from_bits(layer as u32),
+                uv_scale.x,
+                uv_scale.y,
+                alpha_cutoff,
+            ],
         }
     }
 }

@@ -365,6 +365,52 @@ fn texture_coordinates_and_base_color_texture_are_read() {
     }
 }
 
+/// `alphaMode = MASK` with a base colour texture: the texture's alpha is
+/// compared with alphaCutoff / the factor's alpha (the spec compares their
+/// product), kept with no warning on a diffuse material; on a mirror
+/// (cut-outs are diffuse-only) it renders opaque with one warning. The
+/// rendering of a cut-out is tested in tests/textures.rs.
+#[test]
+fn mask_with_a_texture_keeps_the_cutoff_over_the_factor_alpha() {
+    let dir = temp_dir("mask");
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([255, 255, 255, 128]))
+        .save(dir.join("leaf.png"))
+        .unwrap();
+    let mut g = Gltf::new();
+    g.root["images"] = json!([{"uri": "leaf.png"}]);
+    g.root["textures"] = json!([{"source": 0}]);
+    let leaf = g.material(json!({
+        "name": "leaf", "alphaMode": "MASK", "alphaCutoff": 0.4,
+        "pbrMetallicRoughness": {"metallicFactor": 0.0,
+            "baseColorFactor": [1.0, 1.0, 1.0, 0.8], "baseColorTexture": {"index": 0}}
+    }));
+    let chrome = g.material(json!({
+        "name": "chrome", "alphaMode": "MASK",
+        "pbrMetallicRoughness": {"metallicFactor": 1.0, "roughnessFactor": 0.0,
+            "baseColorTexture": {"index": 0}}
+    }));
+    for mat in [leaf, chrome] {
+        let mesh = g.mesh(&quad(), true, Some(mat));
+        g.root_node(json!({"mesh": mesh}));
+    }
+    let a = loader::load(&g.write_gltf(&dir, "mask")).unwrap();
+    let t = a.base_color_textures[0].as_ref().expect("leaf texture");
+    assert!((t.alpha_cutoff - 0.5).abs() < 1e-6, "{}", t.alpha_cutoff);
+    assert_eq!(t.pixels.alpha.len(), 4);
+    assert!(
+        (t.pixels.alpha[0] - 128.0 / 255.0).abs() < 1e-6,
+        "alpha is not sRGB-decoded"
+    );
+    let chrome = a.base_color_textures[1].as_ref().expect("chrome texture");
+    assert_eq!(chrome.alpha_cutoff, 0.0);
+    assert_eq!(a.warnings.len(), 1, "{:#?}", a.warnings);
+    assert!(
+        a.warnings[0].contains("chrome") && a.warnings[0].contains("diffuse materials only"),
+        "{}",
+        a.warnings[0]
+    );
+}
+
 /// A 16 x 16 checker of sRGB 40 and 220 (linear ≈ 0.02 and 0.72).
 fn checker_png() -> Vec<u8> {
     let img = image::RgbImage::from_fn(16, 16, |x, y| {

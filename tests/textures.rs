@@ -238,6 +238,9 @@ fn checker_floor_direct_matches_reference() {
 fn missing_or_unreadable_textures_are_clear_errors() {
     let dir = temp_dir("bad");
     std::fs::write(dir.join("garbage.png"), b"this is not a PNG").unwrap();
+    image::RgbImage::from_pixel(1, 1, image::Rgb([255, 255, 255]))
+        .save(dir.join("white.png"))
+        .unwrap();
     std::fs::write(
         dir.join("quad.obj"),
         "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl tiles\nf 1/1 3/3 2/2\n",
@@ -266,6 +269,18 @@ fn missing_or_unreadable_textures_are_clear_errors() {
             "garbage.png",
         ),
         ("mtl.toml", mtl_scene, "object[0].path", "map_Kd"),
+        (
+            "cutoff_alone.toml",
+            scene_text("alpha_cutoff = 0.5"),
+            "material[0].alpha_cutoff",
+            "needs an `albedo_texture`",
+        ),
+        (
+            "cutoff_range.toml",
+            scene_text("albedo_texture = \"white.png\"\nalpha_cutoff = 1.5"),
+            "material[0].alpha_cutoff",
+            "[0, 1]",
+        ),
     ];
     for (name, text, field, needle) in cases {
         let path = dir.join(name);
@@ -349,4 +364,122 @@ fn obj_texcoords_map_kd_and_fields_load() {
         (pool.textures[0].width, pool.textures[0].height),
         (128, 128)
     );
+}
+
+/// A cut-out (`alpha_cutoff`, glTF `alphaMode = MASK`) is absent from every
+/// pass: a 2 m square whose texture's alpha is 1 over u < 0.5 and 0 beyond,
+/// cut at 0.5, renders as the 1 m x 2 m half square it leaves: seen by the
+/// camera and in the floor's shadow (`direct`: G-buffer and shadow-map
+/// rasterisation) and in the reference (every ray against the BVH, same
+/// seed). Bilinear alpha over the four texel columns [1, 1, 0, 0] (repeat
+/// wrap) crosses 0.5 exactly at u = 0 and u = 0.5, the half square's edges,
+/// so only pixels within rounding of an edge may differ.
+#[test]
+fn cut_outs_equal_the_geometry_they_leave() {
+    let dir = temp_dir("cut_out");
+    image::RgbaImage::from_fn(4, 4, |x, _| {
+        image::Rgba([200, 200, 200, if x < 2 { 255 } else { 0 }])
+    })
+    .save(dir.join("half.png"))
+    .unwrap();
+    let scene = |name: &str, stencil: &str| {
+        let text = format!(
+            r#"
+[camera]
+eye = [0.0, 3.0, 2.5]
+target = [0.0, 0.5, 0.0]
+fov_y = 55.0
+
+[[light]]
+kind = "point"
+position = [1.0, 3.0, 1.0]
+intensity = 12.0
+
+[[material]]
+name = "floor"
+kind = "diffuse"
+albedo = 0.8
+
+[[material]]
+name = "stencil"
+kind = "diffuse"
+{stencil}
+
+[[object]]
+shape = "plane"
+size = [20.0, 20.0]
+material = "floor"
+"#
+        );
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+    };
+    let square = |size: &str, x: f32| {
+        format!(
+            "\n[[object]]\nshape = \"plane\"\ncenter = [{x}, 1.0, 0.0]\nnormal = [0.0, 1.0, 0.0]\ntangent = [1.0, 0.0, 0.0]\nsize = {size}\nmaterial = \"stencil\"\n"
+        )
+    };
+    let textured = "albedo_texture = \"half.png\"\n";
+    let cut = scene(
+        "cut.toml",
+        &format!(
+            "{textured}alpha_cutoff = 0.5\n{}",
+            square("[2.0, 2.0]", 0.0)
+        ),
+    );
+    let whole = scene(
+        "whole.toml",
+        &format!("{textured}{}", square("[2.0, 2.0]", 0.0)),
+    );
+    let half = scene(
+        "half.toml",
+        &format!("{textured}{}", square("[1.0, 2.0]", -0.5)),
+    );
+    assert_eq!(cut.materials[1].texture.unwrap().alpha_cutoff, 0.5);
+
+    const SIZE: u32 = 48;
+    let ctx = validated_context();
+    let sum = |img: &[f32]| {
+        img.chunks(4)
+            .map(|p| (p[0] + p[1] + p[2]) as f64)
+            .sum::<f64>()
+    };
+    let compare = |what: &str, cut: &[f32], half: &[f32], whole: &[f32]| {
+        let peak = half.iter().copied().fold(0.0f32, f32::max);
+        let differing = |x: &[f32]| {
+            x.chunks(4)
+                .zip(half.chunks(4))
+                .filter(|(a, b)| (0..3).any(|c| (a[c] - b[c]).abs() > 1e-3 * peak))
+                .count()
+        };
+        let (differing, whole_differing) = (differing(cut), differing(whole));
+        let energy = (sum(cut) - sum(half)).abs() / sum(half);
+        eprintln!(
+            "{what}: {differing} of {} pixels differ from the half square, energy {energy:.5}; the uncut square differs at {whole_differing}",
+            SIZE * SIZE
+        );
+        // The uncut square differs (the comparison can fail) ...
+        assert!(
+            whole_differing > (SIZE * SIZE / 20) as usize,
+            "{what}: {whole_differing}"
+        );
+        // ... the cut-out does not, but for edge pixels.
+        assert!(
+            differing <= (SIZE * SIZE / 100) as usize,
+            "{what}: {differing} pixels"
+        );
+        assert!(energy < 2e-3, "{what}: energy {energy}");
+    };
+    let direct: Vec<Vec<f32>> = [&cut, &half, &whole]
+        .iter()
+        .map(|s| render_direct(&ctx, (*s).clone(), SIZE))
+        .collect();
+    compare("direct", &direct[0], &direct[1], &direct[2]);
+    let reference: Vec<Vec<f32>> = [cut, half, whole]
+        .into_iter()
+        .map(|s| render_reference(&ctx, s, SIZE, 1 << 18))
+        .collect();
+    compare("reference", &reference[0], &reference[1], &reference[2]);
+    assert_validation_clean(&ctx);
 }

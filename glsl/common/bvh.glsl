@@ -101,7 +101,7 @@ bool bvh_traverse(vec3 o, vec3 d, float t_min, float t_max, bool any_hit, out Hi
             for (uint i = first; i < first + count; ++i) {
                 float t;
                 vec2 uv;
-                if (intersect_triangle(o, d, i, closest, t, uv) && t > t_min) {
+                if (intersect_triangle(o, d, i, closest, t, uv) && t > t_min && !triangle_cut_out(i, uv)) {
                     closest = t;
                     found = true;
                     hit.t = t;

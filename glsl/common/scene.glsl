@@ -35,7 +35,7 @@ struct BvhNode {
 struct Material {
     vec4 color;          // rgb albedo/reflectance; w: kind (uint bits)
     vec4 absorption_ior; // rgb absorption 1/m; w: ior
-    vec4 albedo_texture; // x: texture array layer (int bits, -1: none); yz: uv_scale
+    vec4 albedo_texture; // x: texture array layer (int bits, -1: none); yz: uv_scale; w: alpha cutoff
 };
 
 struct Light {
@@ -107,6 +107,25 @@ vec3 material_albedo_grad(uint m, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
 // reference) filters the texture by its own sampling.
 vec3 material_albedo(uint m, vec2 uv) {
     return material_albedo_grad(m, uv, vec2(0.0), vec2(0.0));
+}
+
+// Whether material m is cut out at `uv` (glTF alphaMode MASK, docs/SCENES.md
+// "Cut-outs"): its texture's alpha below the material's cutoff. Every pass
+// asks the same question, rasterised (with the pixel's footprint) or traced
+// (finest level), so a cut-out is absent from the camera, the shadow maps
+// and every ray alike.
+bool material_cut_out_grad(uint m, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
+    float cutoff = materials[m].albedo_texture.w;
+    if (cutoff <= 0.0) return false;
+    int layer = floatBitsToInt(materials[m].albedo_texture.x);
+    vec2 s = materials[m].albedo_texture.yz;
+    return textureGrad(albedo_textures, vec3(uv * s, float(layer)), duv_dx * s, duv_dy * s).a < cutoff;
+}
+
+bool triangle_cut_out(uint tri, vec2 b) {
+    uint m = triangle_material(tri);
+    if (materials[m].albedo_texture.w <= 0.0) return false;
+    return material_cut_out_grad(m, triangle_uv(tri, b), vec2(0.0), vec2(0.0));
 }
 
 #endif

@@ -25,6 +25,7 @@ void main() {
     vec2 duv_dx = dFdx(v_uv);
     vec2 duv_dy = dFdy(v_uv);
     if (pc.opaque_only != 0u && material_kind(v_material) != MATERIAL_DIFFUSE) discard;
+    if (material_cut_out_grad(v_material, v_uv, duv_dx, duv_dy)) discard;
     vec3 n = normalize(v_normal);
     if (dot(n, frame.eye.xyz - v_position) < 0.0) n = -n;
     out_position = vec4(v_position, 1.0);

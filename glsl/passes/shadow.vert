@@ -9,6 +9,8 @@ layout(push_constant) uniform Push {
 } pc;
 
 layout(location = 0) out vec3 v_position;
+layout(location = 1) flat out uint v_material;
+layout(location = 2) out vec2 v_uv;
 
 void main() {
     uint tri = uint(gl_VertexIndex) / 3u;
@@ -16,5 +18,8 @@ void main() {
     Triangle t = triangles[tri];
     vec3 p = corner == 0u ? t.p0.xyz : (corner == 1u ? t.p1.xyz : t.p2.xyz);
     v_position = p;
+    v_material = floatBitsToUint(t.p0.w);
+    TriangleUv uv = triangle_uvs[tri];
+    v_uv = corner == 0u ? uv.uv01.xy : (corner == 1u ? uv.uv01.zw : uv.uv2.xy);
     gl_Position = pc.view_proj * vec4(p, 1.0);
 }

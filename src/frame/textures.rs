@@ -30,6 +30,7 @@ impl AlbedoTextures {
             width: 1,
             height: 1,
             texels: vec![[1.0; 3]],
+            alpha: Vec::new(),
         }];
         let textures = if textures.is_empty() {
             &white[..]

@@ -9,7 +9,7 @@
 use super::types::Texture;
 use glam::Vec3;
 use image::imageops::{self, FilterType};
-use image::{DynamicImage, Rgb32FImage};
+use image::{DynamicImage, Rgba32FImage};
 use std::path::Path;
 
 /// Largest layer of the texture array (texels per side): larger files are
@@ -28,8 +28,8 @@ pub fn srgb_to_linear(c: f32) -> f32 {
 
 /// Reads a PNG, JPEG or EXR file. 8- and 16-bit
 /// integer images are sRGB-encoded and decoded to linear; float images
-/// (EXR) are linear already. Alpha is ignored. The error says why, without
-/// the path (the caller names the file and the field).
+/// (EXR) are linear already. Alpha, when the file has it, is kept as it is
+/// (coverage, never sRGB-encoded) for cut-outs. The error says why.
 pub fn load(path: &Path) -> Result<Texture, String> {
     let reader = image::ImageReader::open(path)
         .map_err(|e| format!("cannot open texture {}: {e}", path.display()))?
@@ -62,11 +62,34 @@ fn from_image(decoded: DynamicImage, path: &Path) -> Result<Texture, String> {
         decoded,
         DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
     );
-    let rgb = decoded.into_rgb32f();
-    let texels: Vec<[f32; 3]> = rgb
+    let has_alpha = decoded.color().has_alpha();
+    let rgba = decoded.into_rgba32f();
+    let texels: Vec<[f32; 3]> = rgba
         .pixels()
-        .map(|p| if linear { p.0 } else { p.0.map(srgb_to_linear) })
+        .map(|p| {
+            let rgb = [p.0[0], p.0[1], p.0[2]];
+            if linear {
+                rgb
+            } else {
+                rgb.map(srgb_to_linear)
+            }
+        })
         .collect();
+    let mut alpha: Vec<f32> = if has_alpha {
+        rgba.pixels().map(|p| p.0[3]).collect()
+    } else {
+        Vec::new()
+    };
+    if let Some(i) = alpha.iter().position(|a| !(0.0..=1.0).contains(a)) {
+        return Err(format!(
+            "texture {}: texel {i} has alpha {}, outside [0, 1]",
+            path.display(),
+            alpha[i]
+        ));
+    }
+    if alpha.iter().all(|&a| a == 1.0) {
+        alpha.clear();
+    }
     if let Some(i) = texels.iter().position(|t| !Vec3::from(*t).is_finite()) {
         return Err(format!(
             "texture {}: texel {i} is not finite",
@@ -90,6 +113,7 @@ fn from_image(decoded: DynamicImage, path: &Path) -> Result<Texture, String> {
         width,
         height,
         texels,
+        alpha,
     })
 }
 
@@ -107,21 +131,31 @@ pub fn layer_size(textures: &[Texture]) -> u32 {
 
 /// The mip chain of `texture` resized to `size` x `size` (a power of two):
 /// level 0 resampled with a triangle (bilinear) filter, each next level the
-/// 2x2 box average of the one before, down to 1x1. RGBA, alpha 1, rows top
-/// to bottom. Filtering happens on linear values, as it must for radiometry.
+/// 2x2 box average of the one before, down to 1x1. RGBA (alpha 1 without
+/// one in the file), rows top to bottom. Filtering happens on linear values,
+/// as it must for radiometry; alpha is coverage, filtered the same way.
 pub fn mip_chain(texture: &Texture, size: u32) -> Vec<Vec<[f32; 4]>> {
-    let flat: Vec<f32> = texture.texels.iter().flatten().copied().collect();
-    let image = Rgb32FImage::from_raw(texture.width, texture.height, flat)
+    let flat: Vec<f32> = texture
+        .texels
+        .iter()
+        .enumerate()
+        .flat_map(|(i, t)| {
+            [
+                t[0],
+                t[1],
+                t[2],
+                texture.alpha.get(i).copied().unwrap_or(1.0),
+            ]
+        })
+        .collect();
+    let image = Rgba32FImage::from_raw(texture.width, texture.height, flat)
         .expect("texel count matches the size");
     let level0 = if (texture.width, texture.height) == (size, size) {
         image
     } else {
         imageops::resize(&image, size, size, FilterType::Triangle)
     };
-    let mut levels = vec![level0
-        .pixels()
-        .map(|p| [p.0[0], p.0[1], p.0[2], 1.0])
-        .collect::<Vec<_>>()];
+    let mut levels = vec![level0.pixels().map(|p| p.0).collect::<Vec<_>>()];
     let mut side = size as usize;
     while side > 1 {
         let prev = levels.last().expect("level 0 exists");
@@ -156,6 +190,7 @@ mod tests {
             width,
             height,
             texels,
+            alpha: Vec::new(),
         }
     }
 

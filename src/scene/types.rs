@@ -84,6 +84,10 @@ pub struct AlbedoTexture {
     /// The lookup is at `uv * uv_scale` (repeat wrap), so `uv_scale` = (4, 4)
     /// tiles a [0, 1]² face four times each way.
     pub uv_scale: Vec2,
+    /// Cut-out threshold (glTF `alphaMode = MASK`): where the texture's
+    /// alpha is below it the surface is absent from every pass (camera and
+    /// shadow rasterisation, every traced ray). 0: opaque.
+    pub alpha_cutoff: f32,
 }
 
 /// A decoded image: linear RGB per texel (8-bit files decoded from sRGB,
@@ -95,6 +99,9 @@ pub struct Texture {
     pub width: u32,
     pub height: u32,
     pub texels: Vec<[f32; 3]>,
+    /// Coverage per texel (stored linearly, never sRGB-decoded), or empty
+    /// when the file has no alpha channel (opaque).
+    pub alpha: Vec<f32>,
 }
 
 /// Triangle geometry in an object's local space.

@@ -239,7 +239,14 @@ fn material(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Material> {
     match kind {
         "diffuse" => {
             t.check_keys(
-                &["name", "kind", "albedo", "albedo_texture", "uv_scale"],
+                &[
+                    "name",
+                    "kind",
+                    "albedo",
+                    "albedo_texture",
+                    "uv_scale",
+                    "alpha_cutoff",
+                ],
                 "a diffuse material",
             )?;
             m.texture = albedo_texture(t, dir, materials)?;
@@ -274,12 +281,15 @@ fn material(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Material> {
     Ok(m)
 }
 
-/// A diffuse material's `albedo_texture` (a path relative to the scene file)
-/// and `uv_scale` (two positive numbers, default [1, 1]).
+/// A diffuse material's `albedo_texture` (a path relative to the scene file),
+/// `uv_scale` (two positive numbers, default [1, 1]) and `alpha_cutoff` (in
+/// [0, 1], default 0: opaque).
 fn albedo_texture(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Option<AlbedoTexture>> {
     let Some(rel) = t.opt_str("albedo_texture")? else {
-        if t.has("uv_scale") {
-            return Err(t.err("uv_scale", "needs an `albedo_texture`"));
+        for key in ["uv_scale", "alpha_cutoff"] {
+            if t.has(key) {
+                return Err(t.err(key, "needs an `albedo_texture`"));
+            }
         }
         return Ok(None);
     };
@@ -291,5 +301,16 @@ fn albedo_texture(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Option<Al
     } else {
         glam::Vec2::ONE
     };
-    Ok(Some(AlbedoTexture { index, uv_scale }))
+    let alpha_cutoff = t.f32_or("alpha_cutoff", 0.0)?;
+    if !(0.0..=1.0).contains(&alpha_cutoff) {
+        return Err(t.err(
+            "alpha_cutoff",
+            format!("must be in [0, 1], got {alpha_cutoff}"),
+        ));
+    }
+    Ok(Some(AlbedoTexture {
+        index,
+        uv_scale,
+        alpha_cutoff,
+    }))
 }

@@ -240,6 +240,7 @@ fn mesh_object(
         Ok(Some(AlbedoTexture {
             index,
             uv_scale: Vec2::ONE,
+            alpha_cutoff: 0.0,
         }))
     };
     file_object(
@@ -317,6 +318,7 @@ fn gltf_object(
         Ok(textures[i].as_ref().map(|t| AlbedoTexture {
             index: materials.add_texture(t.pixels.clone()),
             uv_scale: Vec2::ONE,
+            alpha_cutoff: t.alpha_cutoff,
         }))
     };
     file_object(

@@ -269,8 +269,11 @@ impl Loader<'_> {
             (_, None) => format!("{label}#default"),
         };
         let name = format!("{}:{label}", self.file_name);
-        let (material, cut_out, notes) = convert_material(name.clone(), m);
-        let texture = self.texture_ref(m)?;
+        let (material, coverage, notes) = convert_material(name.clone(), m);
+        let mut texture = self.texture_ref(m)?;
+        if let (Some(t), Coverage::Mask(threshold)) = (texture.as_mut(), coverage) {
+            t.alpha_cutoff = threshold;
+        }
         if !notes.is_empty() {
             let at = m.index().map_or("the default material".to_owned(), |i| {
                 format!("materials[{i}]")
@@ -280,7 +283,7 @@ impl Loader<'_> {
                 notes.join("; ")
             ));
         }
-        let index = if cut_out {
+        let index = if coverage == Coverage::CutOut {
             None
         } else {
             self.asset.materials.push(material);
@@ -334,6 +337,7 @@ impl Loader<'_> {
             offset,
             rotation,
             scale,
+            alpha_cutoff: 0.0,
         }))
     }
 

@@ -2,34 +2,54 @@
 
 use super::*;
 
+/// What `alphaMode` leaves of a material's surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Coverage {
+    Opaque,
+    /// Every triangle cut out (a constant alpha below the cutoff).
+    CutOut,
+    /// Cut out where the base colour texture's alpha is below this.
+    Mask(f32),
+}
+
 /// glTF material -> project material (docs/SCENES.md, "glTF materials"):
-/// the material, whether `alphaMode = MASK` cuts it out entirely, and the
-/// ways it differs from the file (one warning line per material).
+/// the material, what `alphaMode = MASK` leaves of it, and the ways it
+/// differs from the file (one warning line per material).
 pub(super) fn convert_material(
     name: String,
     m: &::gltf::Material,
-) -> (Material, bool, Vec<String>) {
+) -> (Material, Coverage, Vec<String>) {
     let pbr = m.pbr_metallic_roughness();
     let [r, g, b, alpha] = pbr.base_color_factor();
     let base = Vec3::new(r, g, b).clamp(Vec3::ZERO, Vec3::ONE);
     let metallic = pbr.metallic_factor().clamp(0.0, 1.0);
     let roughness = pbr.roughness_factor().clamp(0.0, 1.0);
     let mut notes = Vec::new();
-    let mut cut_out = false;
+    let mut coverage = Coverage::Opaque;
     match m.alpha_mode() {
         ::gltf::material::AlphaMode::Opaque => {}
         ::gltf::material::AlphaMode::Mask => {
-            let cutoff = m.alpha_cutoff().unwrap_or(0.5);
-            if pbr.base_color_texture().is_some() {
-                notes.push("alphaMode MASK with a baseColorTexture: the cut-out is not applied (rendered opaque)".to_owned());
-            } else if alpha < cutoff {
-                // Without a texture alpha is one constant: the whole surface
-                // is either kept or cut out.
-                cut_out = true;
+            // The spec compares alpha = factor × texture alpha with the
+            // cutoff: kept where factor · t >= cutoff, i.e. t >= cutoff /
+            // factor. A texture alpha is at most 1, so a threshold above 1
+            // cuts every triangle (as does a constant alpha below the
+            // cutoff without a texture).
+            let cutoff = m.alpha_cutoff().unwrap_or(0.5).max(0.0);
+            let threshold = if alpha > 0.0 {
+                cutoff / alpha
+            } else {
+                f32::INFINITY
+            };
+            coverage = if threshold > 1.0 {
                 notes.push(format!(
                     "alphaMode MASK with alpha {alpha} below alphaCutoff {cutoff}: its triangles are cut out"
                 ));
-            }
+                Coverage::CutOut
+            } else if threshold > 0.0 && pbr.base_color_texture().is_some() {
+                Coverage::Mask(threshold)
+            } else {
+                Coverage::Opaque
+            };
         }
         ::gltf::material::AlphaMode::Blend => {
             notes.push("alphaMode BLEND is not supported: rendered opaque".to_owned())
@@ -117,5 +137,11 @@ pub(super) fn convert_material(
             "metallic {metallic} rendered as a non-metal (diffuse)"
         ));
     }
-    (out, cut_out, notes)
+    if matches!(coverage, Coverage::Mask(_)) && out.kind != MaterialKind::Diffuse {
+        notes.push(
+            "alphaMode MASK cut-outs apply to diffuse materials only: rendered opaque".to_owned(),
+        );
+        coverage = Coverage::Opaque;
+    }
+    (out, coverage, notes)
 }

@@ -99,6 +99,10 @@ pub struct TextureRef {
     /// Radians (the extension's GLSL: u' = u cos r - v sin r, v' = u sin r + v cos r).
     pub rotation: f32,
     pub scale: Vec2,
+    /// `alphaMode = MASK` on a diffuse material: the surface is cut out
+    /// where the texture's alpha is below this (`AlbedoTexture::alpha_cutoff`);
+    /// 0 for an opaque material.
+    pub alpha_cutoff: f32,
 }
 
 impl TextureRef {

@@ -60,6 +60,7 @@ pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError
     let mut textures: Vec<Texture> = Vec::new();
     for (m, t) in materials.iter_mut().zip(asset.base_color_textures) {
         let Some(t) = t else { continue };
+        let alpha_cutoff = t.alpha_cutoff;
         let index = match textures.iter().position(|x| x.path == t.pixels.path) {
             Some(i) => i,
             None => {
@@ -70,6 +71,7 @@ pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError
         m.texture = Some(AlbedoTexture {
             index: index as u32,
             uv_scale: Vec2::ONE,
+            alpha_cutoff,
         });
     }
     let mut objects = vec![Object {
