@@ -103,3 +103,55 @@ fn water_photons_10_animated_frames_two_in_flight_match_one() {
     assert!(one.first != one.last, "the waves should change the image");
     common::assert_equal_up_to_splat_order(&one.last, &two.last, "1 vs 2 in flight");
 }
+
+/// A rebuild (`set_params`) while two frames of the old technique are in
+/// flight: those frames complete under the new technique, which must not
+/// take their read-backs for its own (its `after_frame` would read buffers
+/// no frame of its has written), while every frame's timings still come
+/// back. `water_photons` reads its photon counts back per frame; the new
+/// ccm_size changes the count requested, so whose counts arrive shows.
+#[test]
+fn a_rebuild_with_frames_in_flight_keeps_read_backs_with_their_technique() {
+    let ctx = common::validated_context();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/water_pool.toml");
+    let scene = Scene::load(&path).expect("scene");
+    let info = techniques::find("water_photons").expect("technique");
+    let resolve = |o: &[&str]| {
+        let o: Vec<String> = o.iter().map(|s| s.to_string()).collect();
+        Params::resolve("water_photons", info.params(), &o).expect("params")
+    };
+    let (before, after) = (resolve(&["ccm_size=64"]), resolve(&["ccm_size=32"]));
+    let mut r =
+        Renderer::new(&ctx, scene, "water_photons", &before, 32, 32, 0.0).expect("renderer");
+    r.set_frame_options(FrameOptions {
+        frames_in_flight: 2,
+        ..FrameOptions::default()
+    })
+    .expect("frames");
+    let requested = |r: &Renderer| {
+        r.technique_counters()
+            .into_iter()
+            .find(|(n, _)| *n == "photons_requested")
+            .map(|(_, v)| v)
+    };
+    r.render_frame(0.0).expect("first frame");
+    let old_requested = requested(&r).expect("counts of the first frame");
+    r.submit_frame(0.0).expect("frame");
+    r.submit_frame(0.0).expect("frame");
+    assert_eq!(r.frames.pending(), 2);
+    assert!(r.set_params(&after).expect("rebuild"), "ccm_size rebuilds");
+    // Reusing the oldest slot completes an old frame: not the new one's.
+    r.submit_frame(0.0).expect("frame");
+    assert_eq!(
+        requested(&r),
+        None,
+        "an old frame's read-back reached the new technique"
+    );
+    let done = r.finish().expect("frames");
+    let new_requested = requested(&r).expect("counts of the new technique's frame");
+    assert_ne!(old_requested, new_requested);
+    // 1 (render_frame) + 3 submitted, every one's timings reported once.
+    assert_eq!(done.len(), 3, "the three frames after the first");
+    drop(r);
+    common::assert_validation_clean(&ctx);
+}

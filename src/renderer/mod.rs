@@ -30,6 +30,12 @@ pub struct Renderer {
     frame_index: u32,
     /// Completed frames whose timings nobody has taken yet.
     completed: Vec<FrameTiming>,
+    /// Counts technique rebuilds: a frame recorded by an older technique
+    /// completes after its replacement, whose `after_frame` must not read
+    /// its own (unwritten) read-backs for that frame.
+    technique_generation: u64,
+    /// The generation that recorded each slot's latest frame.
+    slot_generation: Vec<u64>,
 }
 
 impl Renderer {
@@ -58,6 +64,8 @@ impl Renderer {
             params: params.clone(),
             frame_index: 0,
             completed: Vec::new(),
+            technique_generation: 0,
+            slot_generation: Vec::new(),
         })
     }
 
@@ -84,8 +92,7 @@ impl Renderer {
             width,
             height,
         )?;
-        let old_technique = std::mem::replace(&mut self.technique, technique);
-        self.frames.defer_release(old_technique);
+        self.replace_technique(technique);
         let old_tonemap = std::mem::replace(&mut self.tonemap, tonemap);
         self.frames.defer_release(old_tonemap);
         let old_targets = std::mem::replace(&mut self.targets, targets);
@@ -104,9 +111,35 @@ impl Renderer {
             self.targets.width,
             self.targets.height,
         )?;
+        self.replace_technique(technique);
+        self.params = params.clone();
+        Ok(())
+    }
+
+    /// Puts `technique` in place; the old one is released after the frames
+    /// in flight, which it recorded (and whose read-backs only it knows).
+    fn replace_technique(&mut self, technique: Box<dyn Technique>) {
         let old = std::mem::replace(&mut self.technique, technique);
         self.frames.defer_release(old);
-        self.params = params.clone();
+        self.technique_generation += 1;
+    }
+
+    /// Frames have completed: hands each one's read-backs to the technique
+    /// that recorded it, if that is still the current one, and keeps their
+    /// timings. (Fields, not `&mut self`: a frame recorder may hold `frames`.)
+    fn frames_done(
+        technique: &mut dyn Technique,
+        generation: u64,
+        slot_generation: &[u64],
+        completed: &mut Vec<FrameTiming>,
+        done: Vec<FrameTiming>,
+    ) -> VkResult<()> {
+        for done in done {
+            if slot_generation.get(done.slot) == Some(&generation) {
+                technique.after_frame(done.slot)?;
+            }
+            completed.push(done);
+        }
         Ok(())
     }
 
@@ -148,8 +181,7 @@ impl Renderer {
             self.targets.width,
             self.targets.height,
         )?;
-        let old = std::mem::replace(&mut self.technique, technique);
-        self.frames.defer_release(old);
+        self.replace_technique(technique);
         let old = std::mem::replace(&mut self.scene_gpu, scene_gpu);
         self.frames.defer_release(old);
         self.scene = scene;
@@ -201,11 +233,19 @@ impl Renderer {
         present: impl FnOnce(&mut FrameRecorder, &Image) -> Result<FrameSync, E>,
     ) -> Result<(), E> {
         let (mut rec, done) = self.frames.begin_frame()?;
-        if let Some(done) = done {
-            // Its fence has signalled: its read-backs are current.
-            self.technique.after_frame(done.slot)?;
-            self.completed.push(done);
+        let slot = rec.slot();
+        // Their fences have signalled: their read-backs are current.
+        Self::frames_done(
+            &mut *self.technique,
+            self.technique_generation,
+            &self.slot_generation,
+            &mut self.completed,
+            done,
+        )?;
+        if self.slot_generation.len() <= slot {
+            self.slot_generation.resize(slot + 1, u64::MAX);
         }
+        self.slot_generation[slot] = self.technique_generation;
         if self.scene.is_animated() {
             self.scene_gpu.update_geometry(&mut rec, &self.scene, time);
         }
@@ -239,10 +279,14 @@ impl Renderer {
     /// Waits for every frame in flight; returns the timings of all frames
     /// completed since the last `take_timings`, oldest first.
     pub fn finish(&mut self) -> VkResult<Vec<FrameTiming>> {
-        for done in self.frames.wait_all()? {
-            self.technique.after_frame(done.slot)?;
-            self.completed.push(done);
-        }
+        let done = self.frames.wait_all()?;
+        Self::frames_done(
+            &mut *self.technique,
+            self.technique_generation,
+            &self.slot_generation,
+            &mut self.completed,
+            done,
+        )?;
         Ok(self.take_timings())
     }
 

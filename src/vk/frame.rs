@@ -135,6 +135,10 @@ pub struct Frames {
     next: usize,
     /// Slots with a submitted frame, oldest first.
     order: VecDeque<usize>,
+    /// Frames `FrameRecorder::wait_for_other_frames` completed, oldest
+    /// first, handed out by the next `begin_frame` or `wait_all` so their
+    /// timings and read-backs are not lost.
+    completed_early: Vec<FrameTiming>,
     max_passes: u32,
     pub source: TimingSource,
     /// Host time spent in `begin_frame` waiting for a slot's fence, and in
@@ -159,6 +163,7 @@ impl Frames {
             slots: Vec::new(),
             next: 0,
             order: VecDeque::new(),
+            completed_early: Vec::new(),
             max_passes: options.max_passes,
             source,
             host_wait: Duration::ZERO,
@@ -241,15 +246,16 @@ impl Frames {
     /// Starts the next frame: waits for the fence of the frame that last used
     /// its slot (N frames ago; the only host wait of the loop), then frees
     /// that frame's releases, resets its ring and command pool. Returns the
-    /// recorder and that older frame's timings, if it had one.
-    pub fn begin_frame(&mut self) -> VkResult<(FrameRecorder<'_>, Option<FrameTiming>)> {
+    /// recorder and the timings of every frame completed since the last
+    /// call, oldest first: that older frame's, if it had one, after any that
+    /// `wait_for_other_frames` completed meanwhile.
+    pub fn begin_frame(&mut self) -> VkResult<(FrameRecorder<'_>, Vec<FrameTiming>)> {
         let index = self.next;
-        let done = if self.slots[index].pending.is_some() {
+        let mut done = std::mem::take(&mut self.completed_early);
+        if self.slots[index].pending.is_some() {
             self.order.retain(|&s| s != index);
-            Some(self.complete(index)?)
-        } else {
-            None
-        };
+            done.push(self.complete(index)?);
+        }
         let ctx = self.ctx.clone();
         let slot = &mut self.slots[index];
         slot.ring.reset(&ctx)?;
@@ -317,7 +323,7 @@ impl Frames {
     /// Waits for every frame in flight (oldest first) and returns their
     /// timings: headless `render` and `bench` call it once at the end.
     pub fn wait_all(&mut self) -> VkResult<Vec<FrameTiming>> {
-        let mut out = Vec::new();
+        let mut out = std::mem::take(&mut self.completed_early);
         while let Some(index) = self.order.pop_front() {
             out.push(self.complete(index)?);
         }
@@ -527,12 +533,16 @@ impl FrameRecorder<'_> {
     /// Waits for every other frame in flight. For the rare descriptor-set
     /// rewrite during recording (a technique binding new frame targets):
     /// a set may not be updated while a submitted frame can still use it.
-    /// Their timings are dropped; an error is returned by `submit`.
+    /// Their timings reach the caller of the next `begin_frame` or
+    /// `wait_all`; an error is returned by `submit`.
     pub fn wait_for_other_frames(&mut self) {
         let others: Vec<usize> = self.frames.order.drain(..).collect();
         for index in others {
-            if let Err(e) = self.frames.complete(index) {
-                self.error.get_or_insert(e);
+            match self.frames.complete(index) {
+                Ok(done) => self.frames.completed_early.push(done),
+                Err(e) => {
+                    self.error.get_or_insert(e);
+                }
             }
         }
     }
