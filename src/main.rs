@@ -92,5 +92,6 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Render(args) => cli::render::render(args),
         Command::Reference(args) => cli::reference::reference(args),
         Command::Bench(args) => cli::render::bench(args),
+        Command::Compare(args) => cli::compare::compare(args),
     }
 }

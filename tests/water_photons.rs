@@ -521,8 +521,8 @@ fn caustic_frame(ctx: &Arc<Context>, s: Scene, overrides: &[&str]) -> (Vec<f32>,
 }
 
 /// FLIP mean over the pixels where `mask` holds.
-fn masked_flip_mean(map: &nv_flip::FlipImageFloat, mask: &[bool]) -> f64 {
-    let v = map.to_vec();
+fn masked_flip_mean(map: &caustics::compare::metrics::FlipMap, mask: &[bool]) -> f64 {
+    let v = map.values();
     let (sum, n) = v
         .iter()
         .zip(mask)

@@ -1,6 +1,7 @@
 //! The command line's arguments and what its commands share: device and
 //! validation, scene and size checks, image output. One file per command.
 
+pub mod compare;
 pub mod info;
 pub mod reference;
 pub mod render;
@@ -89,6 +90,8 @@ pub enum Command {
     Reference(ReferenceArgs),
     /// Per-pass GPU timings (min and median over frames) and the frame interval, after a warm-up.
     Bench(BenchArgs),
+    /// Every technique against the ground truth: images, FLIP error maps, a contact sheet and report.md/report.json.
+    Compare(CompareArgs),
     /// Open a window and render interactively (keys and mouse: README.md).
     Demo(DemoArgs),
     /// List Vulkan devices and the features this renderer needs.
@@ -183,6 +186,38 @@ pub struct BenchArgs {
     pub json: Option<PathBuf>,
     #[command(flatten)]
     pub frame: FrameArgs,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+#[derive(Args)]
+pub struct CompareArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// `all` (every technique that applies to the scene) or a comma-separated list.
+    #[arg(long, default_value = "all")]
+    pub techniques: String,
+    /// Photons the reference traces (default 2^23), in two equal half-runs.
+    #[arg(long, conflicts_with_all = ["reference_time", "reference"])]
+    pub photons: Option<u64>,
+    /// Trace the reference for this many seconds instead (two equal half-runs).
+    #[arg(long, conflicts_with = "reference")]
+    pub reference_time: Option<f64>,
+    /// A reference image (EXR, linear radiance, the comparison's size) instead of tracing one: full frames only, no components, no noise estimate.
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
+    /// Diffuse bounces in the reference (0: the single-bounce components the techniques render).
+    #[arg(long, default_value_t = 0)]
+    pub diffuse_bounces: u32,
+    /// Frames timed per technique, after one warm-up frame.
+    #[arg(long, default_value_t = 5)]
+    pub frames: u32,
+    /// Trace the reference even when the cache ($XDG_CACHE_HOME/caustics/references) holds it, and do not store it.
+    #[arg(long)]
+    pub no_cache: bool,
+    /// Output folder.
+    #[arg(long, default_value = "out/compare")]
+    pub out: PathBuf,
     #[command(flatten)]
     pub device: DeviceArgs,
 }

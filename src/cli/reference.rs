@@ -65,7 +65,7 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
 /// Runs reference passes until `photons` are traced or `seconds` have
 /// passed, with a progress bar that shows per pass the photons, the
 /// photon-mapping radius and the remaining noise; then prints the totals.
-fn trace_reference(
+pub(super) fn trace_reference(
     reference: &mut ReferenceRenderer,
     photons: u64,
     seconds: Option<f64>,

@@ -316,34 +316,19 @@ pub fn masked(img: &[f32], mask: &[bool]) -> Vec<f32> {
 
 /// RGB bytes of an RGBA8 image.
 pub fn rgb8(rgba: &[u8]) -> Vec<u8> {
-    rgba.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect()
+    caustics::compare::metrics::rgb8(rgba)
 }
 
-/// glsl/common/tonemap.glsl on the CPU: exposure 1, Reinhard, sRGB, 8 bits
-/// (RGBA). Negative radiance (a difference of two images) reads as 0.
+/// glsl/common/tonemap.glsl on the CPU at exposure 1 (RGBA8), the code
+/// `caustics compare` uses (`caustics::compare::metrics::tonemap`).
 pub fn tonemap(rgba: &[f32]) -> Vec<u8> {
-    let encode = |l: f32| {
-        let x = l.max(0.0);
-        let x = x / (1.0 + x);
-        let s = if x <= 0.0031308 {
-            x * 12.92
-        } else {
-            1.055 * x.powf(1.0 / 2.4) - 0.055
-        };
-        (s.clamp(0.0, 1.0) * 255.0).round() as u8
-    };
-    rgba.chunks(4)
-        .flat_map(|p| [encode(p[0]), encode(p[1]), encode(p[2]), 255])
-        .collect()
+    caustics::compare::metrics::tonemap(rgba, 1.0)
 }
 
-/// FLIP mean error (nv-flip, 67 px/degree) of `test` against `reference`
-/// (tonemapped RGBA8, `size` x `size`) and the error map.
-pub fn flip(test: &[u8], reference: &[u8], size: u32) -> (f32, nv_flip::FlipImageFloat) {
-    let t = nv_flip::FlipImageRgb8::with_data(size, size, &rgb8(test));
-    let r = nv_flip::FlipImageRgb8::with_data(size, size, &rgb8(reference));
-    let map = nv_flip::flip(r, t, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
-    (nv_flip::FlipPool::from_image(&map).mean(), map)
+/// FLIP mean error of `test` against `reference` (tonemapped RGBA8, `size`
+/// x `size`) and the error map: `caustics compare`'s code path.
+pub fn flip(test: &[u8], reference: &[u8], size: u32) -> (f32, caustics::compare::metrics::FlipMap) {
+    caustics::compare::metrics::flip(test, reference, size, size)
 }
 
 /// Writes `<name>_actual.png`, `<name>_reference.png` and
@@ -354,7 +339,7 @@ pub fn write_comparison_pngs(
     size: u32,
     actual: &[u8],
     reference: &[u8],
-    flip_map: &nv_flip::FlipImageFloat,
+    flip_map: &caustics::compare::metrics::FlipMap,
 ) -> String {
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("test-output");
     std::fs::create_dir_all(&dir).unwrap();
@@ -366,7 +351,7 @@ pub fn write_comparison_pngs(
     save("reference", &rgb8(reference));
     save(
         "difference",
-        &flip_map.apply_color_lut(&nv_flip::magma_lut()).to_vec(),
+        &flip_map.magma_rgb8(),
     );
     dir.display().to_string()
 }

@@ -1,0 +1,85 @@
+//! `caustics compare`'s library side: every technique judged against the
+//! ground truth by the same metrics the tests use (`metrics`), the report
+//! both write (`report`, the JSON schema `bench --json` shares), the
+//! contact sheet (`sheet`, labelled with a bitmap `font`) and the key of
+//! the reference cache (`cache_key`).
+
+pub mod font;
+pub mod metrics;
+pub mod report;
+pub mod sheet;
+
+use crate::scene::Scene;
+use std::fmt::Write as _;
+
+/// FNV-1a, 64 bits: a stable hash for cache keys (std's `DefaultHasher`
+/// may change between Rust releases).
+struct Fnv1a(u64);
+
+impl Fnv1a {
+    fn new() -> Self {
+        Fnv1a(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl std::fmt::Write for Fnv1a {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        for b in s.bytes() {
+            self.0 ^= b as u64;
+            self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
+        }
+        Ok(())
+    }
+}
+
+/// What a reference image depends on, besides the scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReferenceKey {
+    pub width: u32,
+    pub height: u32,
+    pub time: f32,
+    pub diffuse_bounces: u32,
+    /// "photons N" or "seconds S".
+    pub budget: String,
+}
+
+/// The reference cache's key: a hash of the loaded scene (every value the
+/// scene file and the files it references resolve to: meshes, textures,
+/// materials, lights, camera, so an edited OBJ or texture changes it even
+/// though the TOML did not), the render settings and the program's version.
+/// Hashing the resolved scene streams its `Debug` form through the hash
+/// without building the string.
+pub fn cache_key(scene: &Scene, key: &ReferenceKey) -> String {
+    let mut h = Fnv1a::new();
+    let _ = write!(
+        h,
+        "{}|{scene:?}|{key:?}",
+        env!("CARGO_PKG_VERSION")
+    );
+    format!("{:016x}", h.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_key_changes_with_the_scene_and_the_settings() {
+        let text = "[camera]\neye = [0, 1, 3]\ntarget = [0, 0, 0]\n[[light]]\nkind = \"point\"\nposition = [0, 2, 0]\nintensity = 1.0\n";
+        let path = std::path::Path::new("k.toml");
+        let scene = Scene::from_str(text, path).unwrap();
+        let brighter = Scene::from_str(&text.replace("intensity = 1.0", "intensity = 2.0"), path).unwrap();
+        let key = ReferenceKey {
+            width: 64,
+            height: 64,
+            time: 0.0,
+            diffuse_bounces: 0,
+            budget: "photons 1000".into(),
+        };
+        let k = cache_key(&scene, &key);
+        assert_eq!(k, cache_key(&scene, &key), "stable");
+        assert_ne!(k, cache_key(&brighter, &key));
+        let wider = ReferenceKey { width: 65, ..key.clone() };
+        assert_ne!(k, cache_key(&scene, &wider));
+    }
+}

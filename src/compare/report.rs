@@ -1,0 +1,205 @@
+//! The JSON both `caustics compare` (report.json) and `caustics bench
+//! --json` write, documented field by field in docs/REPORTS.md, and the
+//! Markdown view of a comparison (report.md).
+
+use super::metrics::Metrics;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Bumped when a field changes meaning or goes away.
+pub const SCHEMA: &str = "caustics-report/1";
+
+/// Where and how it ran: the first fields of every report.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RunInfo {
+    pub schema: String,
+    pub device: String,
+    pub driver: String,
+    /// How frames were timed (`vk::TimingSource::describe`).
+    pub timing_source: String,
+    pub scene: String,
+    pub width: u32,
+    pub height: u32,
+    /// Animation time of the frame, seconds.
+    pub time: f32,
+}
+
+/// One pass over the timed frames.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PassStats {
+    pub name: String,
+    /// Median over frames.
+    pub ms: f64,
+    pub min_ms: f64,
+}
+
+/// A technique's frame cost.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Timing {
+    /// Frames timed (after the warm-up).
+    pub frames: u32,
+    /// Host wall clock over the timed frames / frames.
+    pub frame_ms: f64,
+    pub passes_ms: Vec<PassStats>,
+}
+
+/// The ground truth a comparison used.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ReferenceInfo {
+    /// "traced", "cache" or "file".
+    pub source: String,
+    /// The EXR given with `--reference`, or the cache folder.
+    pub path: Option<String>,
+    pub photons: u64,
+    pub passes: u64,
+    pub trace_seconds: f64,
+    pub diffuse_bounces: u32,
+    /// The reference's own noise: its first half-run against its second
+    /// (equal photon counts), full frame. A technique whose FLIP is below
+    /// this FLIP is indistinguishable from the reference at this budget.
+    pub noise: Option<Metrics>,
+}
+
+/// One component of a technique against the reference's same component.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ComponentResult {
+    pub component: String,
+    pub metrics: Metrics,
+}
+
+/// One technique in a comparison.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct TechniqueResult {
+    pub technique: String,
+    pub params: BTreeMap<String, f32>,
+    pub timing: Timing,
+    /// The full frame against the reference's full frame.
+    pub full: Metrics,
+    /// Each component the technique renders against the reference's
+    /// matching path-type component (none with a `--reference` file).
+    pub components: Vec<ComponentResult>,
+}
+
+/// A technique left out, and why (e.g. `water_photons` without water).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Skipped {
+    pub technique: String,
+    pub reason: String,
+}
+
+/// report.json of `caustics compare`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct CompareReport {
+    #[serde(flatten)]
+    pub run: RunInfo,
+    pub exposure: f32,
+    pub reference: ReferenceInfo,
+    pub techniques: Vec<TechniqueResult>,
+    pub skipped: Vec<Skipped>,
+}
+
+fn signed_percent(x: f64) -> String {
+    format!("{:+.2}%", 100.0 * x)
+}
+
+impl CompareReport {
+    /// report.md: the run, the reference and its noise, one table row per
+    /// technique and component, and the per-pass split.
+    pub fn markdown(&self) -> String {
+        let r = &self.run;
+        let mut md = format!(
+            "# caustics compare: {}\n\n{}x{} at t = {} s on {} ({}), frames timed by {}.\n\n",
+            r.scene, r.width, r.height, r.time, r.device, r.driver, r.timing_source
+        );
+        let re = &self.reference;
+        md += &format!(
+            "Reference: {} ({} photons in {} passes, {:.1} s, {} diffuse bounces){}.\n",
+            re.source,
+            re.photons,
+            re.passes,
+            re.trace_seconds,
+            re.diffuse_bounces,
+            re.path
+                .as_ref()
+                .map(|p| format!(", {p}"))
+                .unwrap_or_default()
+        );
+        match &re.noise {
+            Some(n) => {
+                md += &format!(
+                    "Its own noise (one half-run against the other): FLIP {:.4}, energy {}. A FLIP below it reads as indistinguishable from the reference.\n\n",
+                    n.flip,
+                    signed_percent(n.energy)
+                )
+            }
+            None => md += "Its own noise is unknown (a reference file).\n\n",
+        }
+        md += "FLIP is LDR-FLIP after the display transform at the scene's exposure; energy is (technique − reference) / reference over the image.\n\n";
+        md += "| technique | component | FLIP | energy | RMSE | frame ms |\n";
+        md += "| --- | --- | --- | --- | --- | --- |\n";
+        for t in &self.techniques {
+            let row = |c: &str, m: &Metrics| {
+                format!(
+                    "| {} | {c} | {:.4} | {} | {:.4e} | {:.2} |\n",
+                    t.technique,
+                    m.flip,
+                    signed_percent(m.energy),
+                    m.rmse,
+                    t.timing.frame_ms
+                )
+            };
+            md += &row("full frame", &t.full);
+            for c in &t.components {
+                md += &row(&c.component, &c.metrics);
+            }
+        }
+        for s in &self.skipped {
+            md += &format!("| {} | skipped: {} | | | | |\n", s.technique, s.reason);
+        }
+        md += "\n## Per pass (median ms over the timed frames)\n\n";
+        for t in &self.techniques {
+            let passes: Vec<String> = t
+                .timing
+                .passes_ms
+                .iter()
+                .map(|p| format!("{} {:.3}", p.name, p.ms))
+                .collect();
+            md += &format!("- **{}**: {}\n", t.technique, passes.join(", "));
+        }
+        md
+    }
+}
+
+/// Each pass's median and minimum over `frames`, in the order of the first
+/// frame (a repeated pass name collects all its occurrences).
+pub fn pass_stats(frames: &[crate::vk::FrameTiming]) -> Vec<PassStats> {
+    let mut by_name: Vec<(String, Vec<f64>)> = Vec::new();
+    for f in frames {
+        for (i, p) in f.passes.iter().enumerate() {
+            match by_name.iter_mut().find(|(n, _)| *n == p.name) {
+                Some((_, v)) if v.len() < frames.len() * (i + 1) => v.push(p.ms),
+                Some(_) => {}
+                None => by_name.push((p.name.clone(), vec![p.ms])),
+            }
+        }
+    }
+    by_name
+        .into_iter()
+        .map(|(name, ms)| PassStats {
+            name,
+            ms: median(&ms),
+            min_ms: ms.iter().copied().fold(f64::INFINITY, f64::min),
+        })
+        .collect()
+}
+
+/// The median of `values` (0 for none).
+pub fn median(values: &[f64]) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    match v.len() {
+        0 => 0.0,
+        n if n % 2 == 1 => v[n / 2],
+        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
