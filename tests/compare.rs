@@ -84,9 +84,14 @@ fn compare_writes_every_file_with_the_tests_numbers() {
         "contact_sheet.png".into(),
         "reference_noise_flip.png".into(),
     ];
-    for stem in ["reference", "reference_direct", "reference_surface_caustics", "reference_airlight",
-        "reference_volume_caustics", "reference_other"]
-    {
+    for stem in [
+        "reference",
+        "reference_direct",
+        "reference_surface_caustics",
+        "reference_airlight",
+        "reference_volume_caustics",
+        "reference_other",
+    ] {
         expected.push(format!("{stem}.exr"));
         expected.push(format!("{stem}.png"));
     }
@@ -94,7 +99,11 @@ fn compare_writes_every_file_with_the_tests_numbers() {
     assert_eq!(names, ["direct", "image_space"]);
     for t in &r.techniques {
         let n = &t.technique;
-        expected.extend([format!("{n}.exr"), format!("{n}.png"), format!("{n}_flip.png")]);
+        expected.extend([
+            format!("{n}.exr"),
+            format!("{n}.png"),
+            format!("{n}_flip.png"),
+        ]);
         for c in &t.components {
             let c = &c.component;
             expected.extend([
@@ -115,7 +124,11 @@ fn compare_writes_every_file_with_the_tests_numbers() {
 
     // report.json holds what the tests' metrics give on the written images.
     let exr = |name: &str| read_exr(&out.join(format!("{name}.exr"))).unwrap().2;
-    let image_space = r.techniques.iter().find(|t| t.technique == "image_space").unwrap();
+    let image_space = r
+        .techniques
+        .iter()
+        .find(|t| t.technique == "image_space")
+        .unwrap();
     let caustics_result = image_space
         .components
         .iter()
@@ -132,16 +145,29 @@ fn compare_writes_every_file_with_the_tests_numbers() {
     let (m, _) = metrics::compare(&exr("image_space"), &exr("reference"), 64, 64, r.exposure);
     assert_eq!(m, image_space.full);
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
-    assert!(md.contains(&format!("{:.4}", image_space.full.flip)), "{md}");
+    assert!(
+        md.contains(&format!("{:.4}", image_space.full.flip)),
+        "{md}"
+    );
 
     // The same reference again comes from the cache, bit for bit.
     let again = root.join("again");
     let mut args = base.to_vec();
-    args.extend(["--photons", "524288", "--techniques", "direct", "--out", again.to_str().unwrap()]);
+    args.extend([
+        "--photons",
+        "524288",
+        "--techniques",
+        "direct",
+        "--out",
+        again.to_str().unwrap(),
+    ]);
     let stdout = ok(&caustics(&args, &cache));
     assert!(stdout.contains("reference from the cache"), "{stdout}");
     assert_eq!(report(&again).reference.source, "cache");
-    assert_eq!(read_exr(&again.join("reference.exr")).unwrap().2, exr("reference"));
+    assert_eq!(
+        read_exr(&again.join("reference.exr")).unwrap().2,
+        exr("reference")
+    );
 
     // A technique against its own image: FLIP 0, energy 0.
     let own = root.join("own");
@@ -173,12 +199,22 @@ fn bad_arguments_are_one_line_and_create_nothing() {
     caustics::output::write_exr(&small, 8, 8, &[0.5; 8 * 8 * 4]).unwrap();
     let cases: [(&[&str], &str); 3] = [
         (&["--techniques", "no_such"], "unknown technique `no_such`"),
-        (&["--reference", small.to_str().unwrap()], "is 8x8, the comparison 64x64"),
+        (
+            &["--reference", small.to_str().unwrap()],
+            "is 8x8, the comparison 64x64",
+        ),
         (&["--photons", "0"], "--photons must be at least 1"),
     ];
     for (extra, needle) in cases {
         let mut args = vec![
-            "compare", "--scene", scene, "--width", SIZE, "--height", SIZE, "--out",
+            "compare",
+            "--scene",
+            scene,
+            "--width",
+            SIZE,
+            "--height",
+            SIZE,
+            "--out",
             out.to_str().unwrap(),
         ];
         args.extend_from_slice(extra);

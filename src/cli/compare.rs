@@ -12,8 +12,8 @@ use super::{check_size, check_validation, context, load_scene, CompareArgs};
 use anyhow::Context as _;
 use caustics::compare::metrics::{self, FlipMap};
 use caustics::compare::report::{
-    pass_stats, CompareReport, ComponentResult, ReferenceInfo, RunInfo, Skipped,
-    TechniqueResult, Timing, SCHEMA,
+    pass_stats, CompareReport, ComponentResult, ReferenceInfo, RunInfo, Skipped, TechniqueResult,
+    Timing, SCHEMA,
 };
 use caustics::compare::sheet::{self, Tile};
 use caustics::compare::{cache_key, ReferenceKey};
@@ -102,7 +102,13 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
     };
     staging.write_pair("reference", width, height, &reference.all, exposure)?;
     for (c, img) in &reference.components {
-        staging.write_pair(&format!("reference_{}", c.name()), width, height, img, exposure)?;
+        staging.write_pair(
+            &format!("reference_{}", c.name()),
+            width,
+            height,
+            img,
+            exposure,
+        )?;
     }
     let mut info = reference.info.clone();
     let mut noise_map = None;
@@ -118,10 +124,7 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
     let mut skipped = Vec::new();
     let mut tiles = vec![vec![Tile {
         rgb: metrics::rgb8(&metrics::tonemap(&reference.all, exposure)),
-        lines: vec![
-            "reference".into(),
-            format!("{} photons", info.photons),
-        ],
+        lines: vec!["reference".into(), format!("{} photons", info.photons)],
     }]];
     if let (Some(map), Some(n)) = (&noise_map, &info.noise) {
         tiles[0].push(Tile {
@@ -136,7 +139,15 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
     let mut timing_source = None;
     for name in &names {
         bar.set_message(name.to_string());
-        match run_technique(&ctx, &scene, name, &args, &reference, &staging, &mut timing_source)? {
+        match run_technique(
+            &ctx,
+            &scene,
+            name,
+            &args,
+            &reference,
+            &staging,
+            &mut timing_source,
+        )? {
             Ok((result, image, map)) => {
                 let label = vec![
                     name.to_string(),
@@ -256,12 +267,17 @@ fn reference_images(
         diffuse_bounces: args.diffuse_bounces,
         ..Default::default()
     };
-    let mut r = ReferenceRenderer::new(ctx, scene.clone(), width, height, args.scene.time, settings)?;
+    let mut r =
+        ReferenceRenderer::new(ctx, scene.clone(), width, height, args.scene.time, settings)?;
     // Two equal half-runs: whole passes, so the second stops at exactly
     // twice the first's photons.
     match args.reference_time {
         Some(s) => trace_reference(&mut r, 0, Some(s / 2.0))?,
-        None => trace_reference(&mut r, (args.photons.unwrap_or(DEFAULT_PHOTONS) / 2).max(1), None)?,
+        None => trace_reference(
+            &mut r,
+            (args.photons.unwrap_or(DEFAULT_PHOTONS) / 2).max(1),
+            None,
+        )?,
     }
     let first_half = r.resolve(Component::All)?;
     let half_photons = r.reference.photons;
@@ -289,7 +305,10 @@ fn reference_images(
     };
     if let Some(dir) = &folder {
         if let Err(e) = write_cache(dir, &images, width, height) {
-            eprintln!("warning: could not cache the reference in {}: {e:#}", dir.display());
+            eprintln!(
+                "warning: could not cache the reference in {}: {e:#}",
+                dir.display()
+            );
         }
     }
     Ok(images)
@@ -329,7 +348,12 @@ fn read_cached(dir: &Path, width: u32, height: u32) -> anyhow::Result<Option<Ref
 
 /// Writes a traced reference into the cache: the images first, info.json
 /// last (a folder without it is incomplete and traced again).
-fn write_cache(dir: &Path, images: &ReferenceImages, width: u32, height: u32) -> anyhow::Result<()> {
+fn write_cache(
+    dir: &Path,
+    images: &ReferenceImages,
+    width: u32,
+    height: u32,
+) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir)?;
     output::write_exr(&dir.join("all.exr"), width, height, &images.all)?;
     if let Some(half) = &images.first_half {
@@ -338,7 +362,10 @@ fn write_cache(dir: &Path, images: &ReferenceImages, width: u32, height: u32) ->
     for (c, img) in &images.components {
         output::write_exr(&dir.join(format!("{}.exr", c.name())), width, height, img)?;
     }
-    std::fs::write(dir.join("info.json"), serde_json::to_string_pretty(&images.info)?)?;
+    std::fs::write(
+        dir.join("info.json"),
+        serde_json::to_string_pretty(&images.info)?,
+    )?;
     Ok(())
 }
 
@@ -386,7 +413,13 @@ fn run_technique(
         r.scene_gpu.components = c.mask();
         r.render_frame(time)?;
         let img = r.radiance()?;
-        staging.write_pair(&format!("{name}_{}", c.name()), width, height, &img, exposure)?;
+        staging.write_pair(
+            &format!("{name}_{}", c.name()),
+            width,
+            height,
+            &img,
+            exposure,
+        )?;
         let Some((_, truth)) = reference.components.iter().find(|(rc, _)| *rc == c) else {
             continue;
         };
@@ -434,12 +467,24 @@ impl Staging {
     }
 
     /// `<stem>.exr` (linear radiance) and `<stem>.png` (display transform).
-    fn write_pair(&self, stem: &str, w: u32, h: u32, rgba: &[f32], exposure: f32) -> anyhow::Result<()> {
+    fn write_pair(
+        &self,
+        stem: &str,
+        w: u32,
+        h: u32,
+        rgba: &[f32],
+        exposure: f32,
+    ) -> anyhow::Result<()> {
         if rgba.iter().any(|v| !v.is_finite()) {
             anyhow::bail!("{stem}: the radiance contains NaN or Inf");
         }
         output::write_exr(&self.dir.join(format!("{stem}.exr")), w, h, rgba)?;
-        output::write_png(&self.dir.join(format!("{stem}.png")), w, h, &metrics::tonemap(rgba, exposure))
+        output::write_png(
+            &self.dir.join(format!("{stem}.png")),
+            w,
+            h,
+            &metrics::tonemap(rgba, exposure),
+        )
     }
 
     /// A FLIP map through the magma colour map, `<stem>.png`.

@@ -51,11 +51,7 @@ pub struct ReferenceKey {
 /// without building the string.
 pub fn cache_key(scene: &Scene, key: &ReferenceKey) -> String {
     let mut h = Fnv1a::new();
-    let _ = write!(
-        h,
-        "{}|{scene:?}|{key:?}",
-        env!("CARGO_PKG_VERSION")
-    );
+    let _ = write!(h, "{}|{scene:?}|{key:?}", env!("CARGO_PKG_VERSION"));
     format!("{:016x}", h.0)
 }
 
@@ -68,7 +64,8 @@ mod tests {
         let text = "[camera]\neye = [0, 1, 3]\ntarget = [0, 0, 0]\n[[light]]\nkind = \"point\"\nposition = [0, 2, 0]\nintensity = 1.0\n";
         let path = std::path::Path::new("k.toml");
         let scene = Scene::from_str(text, path).unwrap();
-        let brighter = Scene::from_str(&text.replace("intensity = 1.0", "intensity = 2.0"), path).unwrap();
+        let brighter =
+            Scene::from_str(&text.replace("intensity = 1.0", "intensity = 2.0"), path).unwrap();
         let key = ReferenceKey {
             width: 64,
             height: 64,
@@ -79,7 +76,10 @@ mod tests {
         let k = cache_key(&scene, &key);
         assert_eq!(k, cache_key(&scene, &key), "stable");
         assert_ne!(k, cache_key(&brighter, &key));
-        let wider = ReferenceKey { width: 65, ..key.clone() };
+        let wider = ReferenceKey {
+            width: 65,
+            ..key.clone()
+        };
         assert_ne!(k, cache_key(&scene, &wider));
     }
 }

@@ -327,7 +327,11 @@ pub fn tonemap(rgba: &[f32]) -> Vec<u8> {
 
 /// FLIP mean error of `test` against `reference` (tonemapped RGBA8, `size`
 /// x `size`) and the error map: `caustics compare`'s code path.
-pub fn flip(test: &[u8], reference: &[u8], size: u32) -> (f32, caustics::compare::metrics::FlipMap) {
+pub fn flip(
+    test: &[u8],
+    reference: &[u8],
+    size: u32,
+) -> (f32, caustics::compare::metrics::FlipMap) {
     caustics::compare::metrics::flip(test, reference, size, size)
 }
 
@@ -349,10 +353,7 @@ pub fn write_comparison_pngs(
     };
     save("actual", &rgb8(actual));
     save("reference", &rgb8(reference));
-    save(
-        "difference",
-        &flip_map.magma_rgb8(),
-    );
+    save("difference", &flip_map.magma_rgb8());
     dir.display().to_string()
 }
 
