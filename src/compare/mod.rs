@@ -61,7 +61,7 @@ mod tests {
 
     #[test]
     fn the_key_changes_with_the_scene_and_the_settings() {
-        let text = "[camera]\neye = [0, 1, 3]\ntarget = [0, 0, 0]\n[[light]]\nkind = \"point\"\nposition = [0, 2, 0]\nintensity = 1.0\n";
+        let text = "[camera]\neye = [0, 1, 3]\ntarget = [0, 0, 0]\n[[light]]\nkind = \"point\"\nposition = [0, 2, 0]\nintensity = 1.0\n[[material]]\nname = \"m\"\nkind = \"diffuse\"\n[[object]]\nshape = \"plane\"\nsize = [1, 1]\nmaterial = \"m\"\n";
         let path = std::path::Path::new("k.toml");
         let scene = Scene::from_str(text, path).unwrap();
         let brighter =
