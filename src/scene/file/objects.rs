@@ -210,7 +210,7 @@ fn mesh_object(
             return Err(t.err(
                 "path",
                 format!(
-                    "cannot read MTL file {} named by OBJ file {}: {why} (set `material` on the object to ignore the MTL)",
+                    "MTL file {} named by OBJ file {}: {why} (set `material` on the object to ignore the MTL)",
                     mtl.display(),
                     full.display()
                 ),
