@@ -2,6 +2,7 @@
 //! validation, scene and size checks, image output. One file per command.
 
 pub mod info;
+pub mod interrupt;
 pub mod reference;
 pub mod render;
 
@@ -274,7 +275,8 @@ pub fn checked_technique_run(run: &TechniqueArgs, frames: u32) -> anyhow::Result
     Ok((load_scene(&scene.scene)?, params))
 }
 
-/// Writes both images, or neither: when the PNG fails the EXR just written is removed.
+/// Writes both images, or neither: both are written to temporary names and
+/// renamed together (an interrupt removes the temporaries).
 pub fn write_outputs(
     (exr, png): &(PathBuf, PathBuf),
     width: u32,
@@ -285,11 +287,10 @@ pub fn write_outputs(
     if radiance.iter().any(|v| !v.is_finite()) {
         anyhow::bail!("the rendered radiance contains NaN or Inf; no image written");
     }
-    output::write_exr(exr, width, height, radiance)?;
-    if let Err(e) = output::write_png(png, width, height, display) {
-        let _ = std::fs::remove_file(exr);
-        return Err(e);
-    }
+    output::write_files(vec![
+        output::exr_file(exr, width, height, radiance),
+        output::png_file(png, width, height, display),
+    ])?;
     println!(
         "wrote {} (linear radiance) and {} (tonemapped)",
         exr.display(),

@@ -83,6 +83,9 @@ fn trace_reference(
         ),
     };
     let start = std::time::Instant::now();
+    // SIGINT/SIGTERM while tracing: finish the pass in flight, then write.
+    let finish = super::interrupt::FinishOnSignal::new();
+    let mut interrupted = false;
     loop {
         let elapsed = start.elapsed().as_secs_f64();
         let done = match seconds {
@@ -115,8 +118,19 @@ fn trace_reference(
         if bar.is_hidden() {
             eprintln!("{} photons, {message}", reference.reference.photons);
         }
+        if finish.requested() {
+            interrupted = true;
+            break;
+        }
     }
+    drop(finish);
     bar.finish_and_clear();
+    if interrupted {
+        println!(
+            "interrupted: writing the {} photons traced so far",
+            reference.reference.photons
+        );
+    }
     let noise = reference.noise()?;
     println!(
         "traced {} photons in {} passes, {:.2} s: {:.3} M photons/s; last radius {:.4} m; remaining noise {}",
