@@ -192,3 +192,173 @@ fn zero_and_non_finite_normals_are_recomputed() {
         }
     }
 }
+
+// ---------------------------------------------------------------- physical bounds
+
+const SPHERE: &str = "[[object]]\nshape = \"sphere\"\nradius = 1.0\nmaterial = \"white\"\n";
+
+/// `text` is rejected at `field`, on the line holding `needle`, saying `message`.
+fn rejects(text: &str, field: &str, needle: &str, message: &str) {
+    let file = Path::new("bounds.toml");
+    let e = match Scene::from_str(text, file) {
+        Ok(_) => panic!("accepted a scene that should fail at {field}:\n{text}"),
+        Err(e) => e,
+    };
+    let s = e.to_string();
+    let line = text.lines().position(|l| l.contains(needle)).unwrap() + 1;
+    assert!(
+        s.starts_with(&format!("bounds.toml:{line}:")),
+        "line {line}: {s}"
+    );
+    assert_eq!(e.field(), Some(field), "{s}");
+    assert!(s.contains(message), "expected `{message}` in `{s}`");
+}
+
+#[test]
+fn values_beyond_the_physical_bounds_are_rejected() {
+    let light = |l: &str| {
+        format!(
+            "{}{l}\n{SPHERE}",
+            HEAD.replace("intensity = [10.0, 10.0, 10.0]", "intensity = 1.0")
+        )
+    };
+    let object = |extra: &str| {
+        format!("{HEAD}[[object]]\nshape = \"sphere\"\nmaterial = \"white\"\n{extra}\n")
+    };
+    let cases: Vec<(String, &str, &str, &str)> = vec![
+        (
+            light("[[light]]\nkind = \"point\"\nposition = [0.0, 1.0, 0.0]\nintensity = 3e38"),
+            "light[1].intensity",
+            "intensity = 3e38",
+            "within ±1e10",
+        ),
+        (
+            light("[[light]]\nkind = \"directional\"\ndirection = [0.0, -1.0, 0.0]\nirradiance = [1.0, 2e10, 1.0]"),
+            "light[1].irradiance[1]",
+            "irradiance =",
+            "within ±1e10",
+        ),
+        (
+            light("[[light]]\nkind = \"point\"\nposition = [0.0, 3e6, 0.0]\nintensity = 1.0"),
+            "light[1].position[1]",
+            "3e6",
+            "within ±1e6",
+        ),
+        (object("radius = 1e30"), "object[0].radius", "radius", "within ±1e6"),
+        (object("radius = 1e-9"), "object[0].radius", "radius", "at least 1e-6"),
+        (
+            object("radius = 1.0\ntranslate = [3e38, 0.0, 0.0]"),
+            "object[0].translate[0]",
+            "translate",
+            "within ±1e6",
+        ),
+        (
+            object("radius = 1.0\nscale = [1.0, 1e-9, 1.0]"),
+            "object[0].scale",
+            "scale",
+            "at least 1e-6",
+        ),
+        (
+            object("radius = 1.0\nscale = 2e6"),
+            "object[0].scale",
+            "scale",
+            "within ±1e6",
+        ),
+        (
+            object("radius = 1.0\nanimate = { orbit_radius = 1.0, orbit_speed = 3e38 }"),
+            "object[0].animate.orbit_speed",
+            "orbit_speed",
+            "within ±1e6",
+        ),
+        (
+            object("radius = 1.0\nanimate = { spin = -5e6 }"),
+            "object[0].animate.spin",
+            "spin",
+            "within ±1e6",
+        ),
+        (
+            format!("{HEAD}{SPHERE}[medium]\nsigma_s = 1e7\nbounds = {{ min = [-1, -1, -1], max = [1, 1, 1] }}\n"),
+            "medium.sigma_s",
+            "sigma_s",
+            "within ±1e6",
+        ),
+        (
+            format!("{HEAD}[[object]]\nshape = \"plane\"\nsize = [1e-7, 1.0]\nmaterial = \"white\"\n"),
+            "object[0].size[0]",
+            "size",
+            "at least 1e-6",
+        ),
+        (
+            format!("{HEAD}{SPHERE}[output]\nexposure = 1e7\n"),
+            "output.exposure",
+            "exposure",
+            "within ±1e6",
+        ),
+    ];
+    for (text, field, needle, message) in &cases {
+        rejects(text, field, needle, message);
+    }
+}
+
+#[test]
+fn real_inputs_are_within_the_bounds() {
+    // A 1e6 W/sr searchlight, sunlight concentrated 1000x (1.4e6 W/m²), an
+    // ocean 100 km across, a 10 µm sphere, a fast spin.
+    let text = format!(
+        "{}[[light]]\nkind = \"directional\"\ndirection = [0.0, -1.0, 0.0]\nirradiance = 1.4e6\n\n\
+         [[object]]\nshape = \"plane\"\nsize = [1e5, 1e5]\nmaterial = \"white\"\n\n\
+         [[object]]\nshape = \"sphere\"\nradius = 1e-5\nmaterial = \"white\"\nanimate = {{ spin = 36000.0 }}\n",
+        HEAD.replace("intensity = [10.0, 10.0, 10.0]", "intensity = 1e6")
+    );
+    let s = Scene::from_str(&text, Path::new("real.toml")).expect("loads");
+    s.check_at(1e5).expect("within bounds at any time");
+}
+
+#[test]
+fn derived_positions_are_checked_at_the_requested_time() {
+    // OBJ coordinates are not TOML numbers: 1e30 loads, then fails the
+    // check before rendering, naming the object.
+    let obj = "v 0 0 0\nv 1e30 0 0\nv 0 1 0\nf 1 2 3\n";
+    let path = mesh_scene("far", &[("m.obj", obj)], "material = \"white\"");
+    let s = Scene::load(&path).expect("finite coordinates load");
+    let e = s.check_at(0.0).expect_err("beyond the world extent");
+    assert!(
+        e.contains("scene.toml: object[0]: `mesh0` reaches 1e30 m") && e.contains("Bounds"),
+        "{e}"
+    );
+    cli_rejects(&path, &["scene.toml: object[0]:", "beyond 1e7 m"]);
+    // Within bounds at time 0, carried far away by an animation: the field
+    // named is the animation.
+    let obj = "v 0 0 0\nv 9.5e6 0 0\nv 0 1 0\nf 1 2 3\n";
+    let path = mesh_scene(
+        "orbit",
+        &[("m.obj", obj)],
+        "material = \"white\"\nanimate = { orbit_radius = 9e5, orbit_speed = 90.0 }",
+    );
+    let s = Scene::load(&path).expect("loads");
+    s.check_at(1.0)
+        .expect("at 90 degrees the orbit points along -z");
+    let e = s.check_at(0.0).expect_err("at 0 it adds to +x");
+    assert!(e.contains("object[0].animate:"), "{e}");
+}
+
+#[test]
+fn time_beyond_the_bounds_is_refused() {
+    let path = mesh_scene(
+        "time",
+        &[("m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")],
+        "material = \"white\"",
+    );
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_caustics"));
+    let o = cmd
+        .args(["render", "--time", "1e30", "--scene"])
+        .arg(&path)
+        .arg("--out")
+        .arg(path.with_file_name("o.png"))
+        .env("VK_DRIVER_FILES", LAVAPIPE_ICD)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(stderr.starts_with("error: --time 1e30: must be a finite number of seconds within ±1e6"), "{stderr}");
+}

@@ -246,8 +246,12 @@ pub fn check_validation(ctx: Arc<Context>) -> anyhow::Result<()> {
     Ok(())
 }
 
-pub fn load_scene(path: &Path) -> anyhow::Result<Scene> {
-    Ok(Scene::load(path)?)
+/// Loads the scene and checks what it derives at `time` (transforms, light
+/// power: `Scene::check_at`) before any device work.
+pub fn load_scene(path: &Path, time: f32) -> anyhow::Result<Scene> {
+    let scene = Scene::load(path)?;
+    scene.check_at(time).map_err(anyhow::Error::msg)?;
+    Ok(scene)
 }
 
 pub fn check_size(args: &SceneArgs) -> anyhow::Result<()> {
@@ -256,8 +260,12 @@ pub fn check_size(args: &SceneArgs) -> anyhow::Result<()> {
             anyhow::bail!("{name} {v}: must be between 1 and 16384");
         }
     }
-    if !args.time.is_finite() {
-        anyhow::bail!("--time must be a finite number of seconds");
+    if !(args.time.is_finite() && args.time.abs() as f64 <= caustics::scene::MAX_MAGNITUDE) {
+        anyhow::bail!(
+            "--time {:e}: must be a finite number of seconds within ±{:e}",
+            args.time,
+            caustics::scene::MAX_MAGNITUDE
+        );
     }
     Ok(())
 }
@@ -272,7 +280,7 @@ pub fn checked_technique_run(run: &TechniqueArgs, frames: u32) -> anyhow::Result
     if frames == 0 {
         anyhow::bail!("--frames must be at least 1");
     }
-    Ok((load_scene(&scene.scene)?, params))
+    Ok((load_scene(&scene.scene, scene.time)?, params))
 }
 
 /// Writes both images, or neither: both are written to temporary names and

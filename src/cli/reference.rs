@@ -35,7 +35,7 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
             anyhow::bail!("--radius must be a positive length in metres, got {r}");
         }
     }
-    let loaded = load_scene(&scene.scene)?;
+    let loaded = load_scene(&scene.scene, scene.time)?;
     let outputs = output::prepare(&out)?;
     let ctx = context(&device)?;
     let settings = ReferenceSettings {
