@@ -63,7 +63,7 @@ impl Scene {
         let (_, radius) = self.bounding_sphere(time);
         for (i, l) in self.lights.iter().enumerate() {
             let largest = l.intensity.max_element();
-            if !(largest as f64 <= MAX_RADIOMETRIC) {
+            if largest.is_nan() || largest as f64 > MAX_RADIOMETRIC {
                 return Err(at(
                     format!("light[{i}]"),
                     format!("intensity {largest:e} is beyond {MAX_RADIOMETRIC:e}"),
