@@ -360,5 +360,8 @@ fn time_beyond_the_bounds_is_refused() {
         .unwrap();
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{stderr}");
-    assert!(stderr.starts_with("error: --time 1e30: must be a finite number of seconds within ±1e6"), "{stderr}");
+    assert!(
+        stderr.starts_with("error: --time 1e30: must be a finite number of seconds within ±1e6"),
+        "{stderr}"
+    );
 }

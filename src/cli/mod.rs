@@ -44,12 +44,12 @@ pub struct SceneArgs {
     /// Scene file: TOML, or a glTF 2.0 file (.gltf/.glb) as a whole scene (docs/SCENES.md).
     #[arg(long, default_value = DEFAULT_SCENE)]
     pub scene: PathBuf,
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 512)]
     pub width: u32,
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 512)]
     pub height: u32,
     /// Animation time in seconds.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.0)]
     pub time: f32,
 }
 
@@ -57,7 +57,7 @@ pub struct SceneArgs {
 pub struct FrameArgs {
     /// Frames the GPU may still be running while the host records the next
     /// (1 to 4); the host waits only for the frame that last used a slot.
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 2)]
     pub frames_in_flight: usize,
     /// Per-pass times on a CPU device (lavapipe), whose timestamps miss
     /// compute: one submission per pass, each waited for, so frames cannot
@@ -116,7 +116,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub run: TechniqueArgs,
     /// Frames to render (time advances 1/60 s per frame); timings are averaged over them.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1)]
     pub frames: u32,
     /// Path-type component to draw: one the technique renders (`--technique list`) or all.
     #[arg(long, default_value = "all")]
@@ -135,17 +135,22 @@ pub struct ReferenceArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
     /// Photons to trace (rounded up to whole passes of 262,144).
-    #[arg(long, default_value_t = 20_000_000, conflicts_with = "seconds")]
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        default_value_t = 20_000_000,
+        conflicts_with = "seconds"
+    )]
     pub photons: u64,
     /// Trace for this many seconds instead of a photon count (whole passes).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub seconds: Option<f64>,
     /// Seed of the random streams: different seeds give independent images.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0)]
     pub seed: u32,
     /// First pass's photon-mapping radius in metres (default: 1.5 pixel
     /// footprints at the camera target's distance); it shrinks every pass.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub radius: Option<f32>,
     /// The light tracer and the camera chains' direct light only: what is
     /// seen through glass, water or mirrors lacks its caustics (for
@@ -155,13 +160,13 @@ pub struct ReferenceArgs {
     /// Share of the photons aimed at the mirrors and dielectrics (their
     /// bounding sphere), in [0, 1); the rest follow the light's own
     /// distribution. Unbiased for any share; more caustic photons.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.5)]
     pub aim_share: f32,
     /// Path-type component to write: direct, surface_caustics, airlight, volume_caustics, other, all.
     #[arg(long, default_value = "all")]
     pub component: String,
     /// Diffuse bounces photons continue through (0: direct light and caustics only).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0)]
     pub diffuse_bounces: u32,
     /// Output image; .png or .exr (the other format is written beside it).
     #[arg(long, default_value = "out/reference.png")]
@@ -174,10 +179,10 @@ pub struct ReferenceArgs {
 pub struct BenchArgs {
     #[command(flatten)]
     pub run: TechniqueArgs,
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 20)]
     pub frames: u32,
     /// Frames rendered before timing starts (pipeline compilation, caches).
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 2)]
     pub warmup: u32,
     /// Also write the results as JSON.
     #[arg(long)]
@@ -198,16 +203,16 @@ pub struct DemoArgs {
     #[arg(long = "param")]
     pub params: Vec<String>,
     /// Initial window width.
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 512)]
     pub width: u32,
     /// Initial window height.
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 512)]
     pub height: u32,
     /// fifo (default, vsync), mailbox or immediate; falls back to fifo when not offered.
     #[arg(long, default_value = "fifo")]
     pub present_mode: String,
     /// With --exit: frames to present before exiting.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub frames: Option<u32>,
     /// Exit after --frames N frames (tests, screenshots).
     #[arg(long, requires = "frames")]
@@ -216,7 +221,7 @@ pub struct DemoArgs {
     #[arg(long)]
     pub resize_test: bool,
     /// Frames the GPU may still be running while the host records the next (1 to 4).
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 2)]
     pub frames_in_flight: usize,
     #[command(flatten)]
     pub device: DeviceArgs,
@@ -229,7 +234,8 @@ pub fn context(args: &DeviceArgs) -> anyhow::Result<Arc<Context>> {
         device: args.device.clone(),
     };
     let ctx = Context::new(&options)?;
-    eprintln!("device: {} ({})", ctx.info.name, ctx.info.driver.trim());
+    // On stdout with the results: stderr holds only the one line of an error.
+    println!("device: {} ({})", ctx.info.name, ctx.info.driver.trim());
     Ok(ctx)
 }
 
@@ -280,7 +286,9 @@ pub fn checked_technique_run(run: &TechniqueArgs, frames: u32) -> anyhow::Result
     if frames == 0 {
         anyhow::bail!("--frames must be at least 1");
     }
-    Ok((load_scene(&scene.scene, scene.time)?, params))
+    let loaded = load_scene(&scene.scene, scene.time)?;
+    (info.check_scene)(&loaded)?;
+    Ok((loaded, params))
 }
 
 /// Writes both images, or neither: both are written to temporary names and

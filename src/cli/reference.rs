@@ -46,6 +46,12 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
         aim_share,
         ..Default::default()
     };
+    // Whole passes: say so when --photons is not a multiple of one.
+    let batch = u64::from(settings.batch.div_ceil(64) * 64);
+    let rounded = photons.div_ceil(batch) * batch;
+    if seconds.is_none() && rounded != photons {
+        println!("--photons {photons}: rounded up to {rounded}, whole passes of {batch}");
+    }
     let mut reference = ReferenceRenderer::new(
         &ctx,
         loaded,
