@@ -13,12 +13,13 @@
 # volume_cone (Hu's Table 2 sweep), then the line and covered-pixel counts
 # (tests/volume_lines.rs, ignored test `coverage_statistics`);
 # water_photons: the per-pass split of Kougianos & Moustakas' Fig. 14 on
-# water_pool over ccm_0 and cascade counts. FRAMES (10) and PHOTONS (2e7)
-# set the effort.
+# water_pool over ccm_0 and cascade counts; loading: Scene::load per MB of
+# TOML (64,000 materials and 16,000 boxes) and for a 2,000,000-triangle OBJ
+# (examples/load_scene.rs). FRAMES (10) and PHOTONS (2e7) set the effort.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 sections=("$@")
-[ ${#sections[@]} -eq 0 ] && sections=(direct reference geometry image_space volume_lines water_photons)
+[ ${#sections[@]} -eq 0 ] && sections=(direct reference geometry image_space volume_lines water_photons loading)
 wants() { [[ " ${sections[*]} " == *" $1 "* ]]; }
 cargo build --release --quiet
 bin=target/release/caustics
@@ -170,4 +171,36 @@ PY
   echo
   echo "ocean_large:"
   wp_row ocean_large 512 2 0 1 1
+fi
+
+if wants loading; then
+  # Generated inputs, each in its own folder (load_scene counts the folder's
+  # bytes as the input size).
+  mkdir -p out/bench/loading/toml out/bench/loading/obj
+  python3 - out/bench/loading <<'PY'
+import sys
+root = sys.argv[1]
+head = ('[camera]\neye = [0.0, 2.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n\n'
+        '[[light]]\nkind = "point"\nposition = [0.0, 5.0, 0.0]\nintensity = 10.0\n\n')
+kinds = ['kind = "diffuse"\nalbedo = [0.5, 0.4, 0.3]', 'kind = "mirror"\nreflectance = 0.9',
+         'kind = "dielectric"\nior = 1.5\nabsorption = [0.1, 0.2, 0.3]']
+with open(f"{root}/toml/scene.toml", "w") as f:
+    f.write(head)
+    for i in range(64000):
+        f.write(f'[[material]]\nname = "m{i}"\n{kinds[i % 3]}\n')
+    for i in range(0, 64000, 4):
+        f.write(f'[[object]]\nshape = "box"\nmin = [{i}.0, 0.0, 0.0]\nmax = [{i}.5, 1.0, 1.0]\n'
+                f'material = "m{i}"\nrotate = [0.0, 30.0, 0.0]\n')
+n = 1000  # n x n quads: 2,000,000 triangles
+with open(f"{root}/obj/grid.obj", "w") as f:
+    f.write("".join(f"v {i / n:.6f} 0 {j / n:.6f}\n" for j in range(n + 1) for i in range(n + 1)))
+    for j in range(n):
+        f.write("".join(f"f {j * (n + 1) + i + 1} {(j + 1) * (n + 1) + i + 1} {(j + 1) * (n + 1) + i + 2} {j * (n + 1) + i + 2}\n"
+                        for i in range(n)))
+with open(f"{root}/obj/scene.toml", "w") as f:
+    f.write(head + '[[material]]\nname = "white"\nkind = "diffuse"\n\n'
+            '[[object]]\nshape = "mesh"\npath = "grid.obj"\nmaterial = "white"\n')
+PY
+  cargo build --release --quiet --example load_scene
+  target/release/examples/load_scene --repeat 3 out/bench/loading/toml/scene.toml out/bench/loading/obj/scene.toml
 fi

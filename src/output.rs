@@ -1,9 +1,15 @@
 //! Writing images: EXR holds linear radiance (32-bit float, the truth), PNG
-//! holds the tonemapped 8-bit sRGB display image. Files are written to a
-//! temporary name and renamed, so a failure never leaves a partial image.
+//! holds the tonemapped 8-bit sRGB display image. Outputs are written to
+//! temporary names in their folder and renamed together at the end
+//! ([`write_files`]), so a failure, or a process interrupted by a signal
+//! (whose handler calls [`abandon_temporaries`]), never leaves a partial
+//! file, nor one image of a pair without the other.
 
 use anyhow::Context as _;
+use std::fs::File;
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ImageFormat {
@@ -37,22 +43,16 @@ pub fn sibling(path: &Path, format: ImageFormat) -> PathBuf {
 }
 
 /// Checks, before any rendering, that `out` can be written: its format is
-/// known, its folder exists (created if needed) and neither `out` nor its
-/// sibling in the other format is a folder. Returns the (EXR, PNG) paths.
+/// known, neither `out` nor its sibling in the other format is a folder,
+/// and its folder exists or can be created (the nearest existing folder
+/// above it takes a new file). Creates nothing. Returns the (EXR, PNG)
+/// paths.
 pub fn prepare(out: &Path) -> anyhow::Result<(PathBuf, PathBuf)> {
     let (exr, png) = match format_of(out)? {
         ImageFormat::Exr => (out.to_path_buf(), sibling(out, ImageFormat::Png)),
         ImageFormat::Png => (sibling(out, ImageFormat::Exr), out.to_path_buf()),
     };
-    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| {
-            format!(
-                "--out {}: cannot create folder {}",
-                out.display(),
-                dir.display()
-            )
-        })?;
-    }
+    check_writable(out, "--out")?;
     for p in [&exr, &png] {
         if p.is_dir() {
             anyhow::bail!("--out {}: {} is a folder", out.display(), p.display());
@@ -61,48 +61,183 @@ pub fn prepare(out: &Path) -> anyhow::Result<(PathBuf, PathBuf)> {
     Ok((exr, png))
 }
 
-fn write_atomically(
-    path: &Path,
-    write: impl FnOnce(&Path) -> anyhow::Result<()>,
-) -> anyhow::Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("cannot create folder {}", dir.display()))?;
-    }
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("img");
-    let tmp = path.with_extension(format!("partial.{ext}"));
-    match write(&tmp) {
-        Ok(()) => std::fs::rename(&tmp, path).or_else(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            Err(e).with_context(|| format!("cannot write {}", path.display()))
-        }),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(e)
+/// Checks that the file `path` (named by the option `option`) could be
+/// written without creating anything: its nearest existing ancestor folder
+/// is a folder that takes a new file (probed by creating and removing one).
+pub fn check_writable(path: &Path, option: &str) -> anyhow::Result<()> {
+    let dir = folder_of(path);
+    let mut existing = dir.as_path();
+    while !existing.exists() {
+        match existing.parent() {
+            Some(p) => {
+                existing = if p.as_os_str().is_empty() {
+                    Path::new(".")
+                } else {
+                    p
+                }
+            }
+            None => break,
         }
+    }
+    if !existing.is_dir() {
+        anyhow::bail!(
+            "{option} {}: cannot create folder {}: {} is not a folder",
+            path.display(),
+            dir.display(),
+            existing.display()
+        );
+    }
+    let probe = existing.join(format!(".caustics-probe-{}", std::process::id()));
+    match File::create_new(&probe) {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) => Err(e).with_context(|| {
+            format!(
+                "{option} {}: cannot write in folder {}",
+                path.display(),
+                existing.display()
+            )
+        }),
+    }
+}
+
+fn folder_of(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// The temporaries being written, process-wide, so that a signal handler
+/// can remove them ([`abandon_temporaries`]). A temporary is created and a
+/// batch renamed only with this lock held.
+static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn temporaries() -> MutexGuard<'static, Vec<PathBuf>> {
+    TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Removes every temporary output being written and returns the lock that
+/// keeps new ones from being created or renamed into place: for a signal
+/// handler that then ends the process without releasing it, so that
+/// nothing appears at an output name after the signal.
+pub fn abandon_temporaries() -> MutexGuard<'static, Vec<PathBuf>> {
+    let mut list = temporaries();
+    for p in list.drain(..) {
+        let _ = std::fs::remove_file(p);
+    }
+    list
+}
+
+/// Writes an output file's bytes.
+pub type WriteBytes<'a> = Box<dyn FnOnce(&mut BufWriter<File>) -> anyhow::Result<()> + 'a>;
+
+/// One output file: where it goes and how its bytes are written.
+pub struct OutputFile<'a> {
+    pub path: &'a Path,
+    pub write: WriteBytes<'a>,
+}
+
+/// Writes every file of `files` to a temporary name beside it (a hidden
+/// `.NAME.PID.partial`) and, once all are written, renames them into place
+/// together: all of them or none appear (a failure removes what was already
+/// renamed and every temporary).
+pub fn write_files(files: Vec<OutputFile>) -> anyhow::Result<()> {
+    let mut written: Vec<(PathBuf, &Path)> = Vec::new();
+    let result = (|| {
+        for f in files {
+            let dir = folder_of(f.path);
+            std::fs::create_dir_all(&dir)
+                .with_context(|| format!("cannot create folder {}", dir.display()))?;
+            let name = f
+                .path
+                .file_name()
+                .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
+            let tmp = dir.join(format!(".{name}.{}.partial", std::process::id()));
+            // Created with the lock held: after a signal's handler took it,
+            // no temporary can appear.
+            let file = {
+                let mut list = temporaries();
+                let file = File::create(&tmp)
+                    .with_context(|| format!("cannot write {}", f.path.display()))?;
+                list.push(tmp.clone());
+                file
+            };
+            written.push((tmp, f.path));
+            let mut w = BufWriter::new(file);
+            (f.write)(&mut w)
+                .and_then(|()| Ok(w.flush()?))
+                .with_context(|| format!("cannot write {}", f.path.display()))?;
+            test_pause();
+        }
+        let mut list = temporaries();
+        for (i, (tmp, path)) in written.iter().enumerate() {
+            if let Err(e) = std::fs::rename(tmp, path) {
+                for (_, done) in &written[..i] {
+                    let _ = std::fs::remove_file(done);
+                }
+                return Err(e).with_context(|| format!("cannot write {}", path.display()));
+            }
+            list.retain(|p| p != tmp);
+        }
+        Ok(())
+    })();
+    if result.is_err() {
+        let mut list = temporaries();
+        for (tmp, _) in &written {
+            let _ = std::fs::remove_file(tmp);
+            list.retain(|p| p != tmp);
+        }
+    }
+    result
+}
+
+/// A test hook (tests/interrupt.rs): `CAUSTICS_TEST_WRITE_PAUSE_MS` pauses
+/// after each temporary is written, so that a test can aim a signal at the
+/// moment between writing and renaming.
+fn test_pause() {
+    if let Some(ms) = std::env::var("CAUSTICS_TEST_WRITE_PAUSE_MS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+    {
+        std::thread::sleep(std::time::Duration::from_millis(ms));
+    }
+}
+
+/// Linear RGBA f32 radiance as an OpenEXR file.
+pub fn exr_file<'a>(path: &'a Path, width: u32, height: u32, rgba: &'a [f32]) -> OutputFile<'a> {
+    OutputFile {
+        path,
+        write: Box::new(move |w| {
+            let image = image::Rgba32FImage::from_raw(width, height, rgba.to_vec())
+                .ok_or_else(|| anyhow::anyhow!("radiance buffer has the wrong size"))?;
+            Ok(image.write_to(w, image::ImageFormat::OpenExr)?)
+        }),
+    }
+}
+
+/// 8-bit sRGB RGBA as a PNG file.
+pub fn png_file<'a>(path: &'a Path, width: u32, height: u32, rgba8: &'a [u8]) -> OutputFile<'a> {
+    OutputFile {
+        path,
+        write: Box::new(move |w| {
+            let image = image::RgbaImage::from_raw(width, height, rgba8.to_vec())
+                .ok_or_else(|| anyhow::anyhow!("display buffer has the wrong size"))?;
+            Ok(image.write_to(w, image::ImageFormat::Png)?)
+        }),
     }
 }
 
 /// Writes linear RGBA f32 radiance as an OpenEXR file.
 pub fn write_exr(path: &Path, width: u32, height: u32, rgba: &[f32]) -> anyhow::Result<()> {
-    let image = image::Rgba32FImage::from_raw(width, height, rgba.to_vec())
-        .ok_or_else(|| anyhow::anyhow!("radiance buffer has the wrong size"))?;
-    write_atomically(path, |tmp| {
-        image
-            .save_with_format(tmp, image::ImageFormat::OpenExr)
-            .with_context(|| format!("cannot write {}", path.display()))
-    })
+    write_files(vec![exr_file(path, width, height, rgba)])
 }
 
 /// Writes 8-bit sRGB RGBA as a PNG file.
 pub fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> anyhow::Result<()> {
-    let image = image::RgbaImage::from_raw(width, height, rgba8.to_vec())
-        .ok_or_else(|| anyhow::anyhow!("display buffer has the wrong size"))?;
-    write_atomically(path, |tmp| {
-        image
-            .save_with_format(tmp, image::ImageFormat::Png)
-            .with_context(|| format!("cannot write {}", path.display()))
-    })
+    write_files(vec![png_file(path, width, height, rgba8)])
 }
 
 /// Reads an EXR back as RGBA f32 (tests and comparisons).
@@ -126,9 +261,29 @@ mod tests {
         std::fs::create_dir_all(&target).unwrap();
         let e = write_png(&target, 1, 1, &[0, 0, 0, 255]).expect_err("a folder is in the way");
         assert!(e.to_string().contains("cannot write"), "{e:#}");
-        assert!(!dir.join("x.partial.png").exists());
+        // A pair: the EXR renamed first is removed when the PNG fails.
+        let exr = dir.join("x.exr");
+        let e = write_files(vec![
+            exr_file(&exr, 1, 1, &[0.0; 4]),
+            png_file(&target, 1, 1, &[0, 0, 0, 255]),
+        ])
+        .expect_err("a folder is in the way");
+        assert!(e.to_string().contains("cannot write"), "{e:#}");
+        let left: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(
+            left,
+            vec![std::ffi::OsString::from("x.png")],
+            "only the folder in the way"
+        );
         assert!(prepare(&dir.join("x.exr")).is_err());
         assert!(prepare(&dir.join("sub/y.exr")).is_ok());
+        assert!(!dir.join("sub").exists(), "prepare creates nothing");
+        std::fs::write(dir.join("file"), "").unwrap();
+        let e = prepare(&dir.join("file/z.png")).expect_err("a file is in the way");
+        assert!(e.to_string().contains("is not a folder"), "{e:#}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

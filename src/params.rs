@@ -60,10 +60,16 @@ impl Params {
             .iter()
             .map(|s| (s.name.to_string(), s.default))
             .collect();
+        let mut given: BTreeMap<&str, &str> = BTreeMap::new();
         for o in overrides {
             let (name, value) = o
                 .split_once('=')
                 .ok_or_else(|| anyhow::anyhow!("--param {o:?}: expected NAME=VALUE"))?;
+            if let Some(first) = given.insert(name, value) {
+                anyhow::bail!(
+                    "--param {name}: given twice ({name}={first} and {name}={value}); give it once"
+                );
+            }
             let spec = by_name.get(name).ok_or_else(|| {
                 let known: Vec<_> = specs.iter().map(|s| s.name).collect();
                 anyhow::anyhow!(

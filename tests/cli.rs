@@ -491,7 +491,8 @@ fn unwritable_outputs_fail_before_rendering() {
     }
 }
 
-/// Values the argument parser itself rejects (clap's usage errors, exit code 2).
+/// Values the argument parser itself rejects: one line, exit code 1 like
+/// every other bad input (tests/cli_errors.rs checks the argument is named).
 #[test]
 fn unparsable_arguments_are_usage_errors() {
     for args in [
@@ -502,7 +503,8 @@ fn unparsable_arguments_are_usage_errors() {
         vec!["paint"],
     ] {
         let o = run_with(&args, true);
-        assert_clean_failure(&o, Some(2), &[]);
+        assert_clean_failure(&o, Some(1), &[]);
+        assert_eq!(o.stderr.lines().count(), 1, "{}", o.describe());
     }
 }
 

@@ -64,8 +64,10 @@ impl State {
             .unwrap_or(0);
         let base = PathBuf::from(format!("out/demo-{stamp}-{}", self.screenshots));
         let (exr, png) = output::prepare(&base.with_extension("png"))?;
-        output::write_exr(&exr, w, h, &radiance)?;
-        output::write_png(&png, w, h, &display)?;
+        output::write_files(vec![
+            output::exr_file(&exr, w, h, &radiance),
+            output::png_file(&png, w, h, &display),
+        ])?;
         println!("wrote {} and {}", png.display(), exr.display());
         Ok(())
     }

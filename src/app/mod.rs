@@ -87,7 +87,20 @@ fn pipeline_cache_file() -> Option<PathBuf> {
 /// any error, on validation errors and on leaked Vulkan objects.
 pub fn run(options: DemoOptions) -> anyhow::Result<()> {
     let scene = Scene::load(&options.scene)?;
-    let event_loop = EventLoop::new().context("cannot open a window (is DISPLAY set?)")?;
+    if std::env::var_os("DISPLAY").is_none() && std::env::var_os("WAYLAND_DISPLAY").is_none() {
+        anyhow::bail!(
+            "demo needs a display: neither DISPLAY nor WAYLAND_DISPLAY is set (run it in a desktop session, or under `xvfb-run`)"
+        );
+    }
+    // winit's message starts with its own source location: keep the reason.
+    let event_loop = EventLoop::new().map_err(|e| {
+        let m = e.to_string();
+        let reason = match m.split_once(": ") {
+            Some((at, reason)) if at.starts_with("os error at") => reason.to_owned(),
+            _ => m,
+        };
+        anyhow::anyhow!("demo cannot open a window: {reason}")
+    })?;
     let display = event_loop
         .display_handle()
         .context("no display handle")?

@@ -3,9 +3,10 @@
 //! half-runs, whose difference is its own noise), taken from the cache, or
 //! read from `--reference`; each technique renders its full frame and each
 //! of its components, timed over `--frames`; the metrics are the tests'
-//! (`caustics::compare::metrics`). Everything is written to a staging
-//! folder inside `--out` and moved into place at the end, report.json
-//! last, so a failed or interrupted run leaves no partial report.
+//! (`caustics::compare::metrics`). Every file is kept in memory until the
+//! end and then written by `output::write_files` (temporaries renamed
+//! together, removed on SIGINT/SIGTERM), report.json last, so a failed or
+//! interrupted run leaves none of its files.
 
 use super::reference::trace_reference;
 use super::{check_size, check_validation, context, load_scene, CompareArgs};
@@ -18,12 +19,14 @@ use caustics::compare::report::{
 use caustics::compare::sheet::{self, Tile};
 use caustics::compare::{cache_key, ReferenceKey};
 use caustics::output;
+use caustics::output::OutputFile;
 use caustics::params::Params;
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use caustics::renderer::Renderer;
 use caustics::scene::Scene;
 use caustics::techniques::{self, TECHNIQUES};
 use caustics::vk::{Context, FrameOptions};
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
@@ -78,9 +81,13 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
         }
         None => None,
     };
-    let scene = load_scene(&args.scene.scene)?;
+    let scene = load_scene(&args.scene.scene, time)?;
     let exposure = scene.output.exposure;
-    let staging = Staging::new(&args.out)?;
+    if args.out.exists() && !args.out.is_dir() {
+        anyhow::bail!("--out {}: not a folder", args.out.display());
+    }
+    output::check_writable(&args.out.join("report.json"), "--out")?;
+    let mut staging = Outputs::new(&args.out);
     let ctx = context(&args.device)?;
 
     let reference = match from_file {
@@ -145,7 +152,7 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
             name,
             &args,
             &reference,
-            &staging,
+            &mut staging,
             &mut timing_source,
         )? {
             Ok((result, image, map)) => {
@@ -271,17 +278,21 @@ fn reference_images(
         ReferenceRenderer::new(ctx, scene.clone(), width, height, args.scene.time, settings)?;
     // Two equal half-runs: whole passes, so the second stops at exactly
     // twice the first's photons.
-    match args.reference_time {
+    // A signal ends the comparison: a reference short of its budget would
+    // be cached under the full budget's key.
+    let interrupted = match args.reference_time {
         Some(s) => trace_reference(&mut r, 0, Some(s / 2.0))?,
         None => trace_reference(
             &mut r,
             (args.photons.unwrap_or(DEFAULT_PHOTONS) / 2).max(1),
             None,
         )?,
-    }
+    };
     let first_half = r.resolve(Component::All)?;
     let half_photons = r.reference.photons;
-    trace_reference(&mut r, 2 * half_photons, None)?;
+    if interrupted || trace_reference(&mut r, 2 * half_photons, None)? {
+        anyhow::bail!("interrupted while tracing the reference; nothing written");
+    }
     let all = r.resolve(Component::All)?;
     let mut components = Vec::new();
     for c in reference_components() {
@@ -378,7 +389,7 @@ fn run_technique(
     name: &str,
     args: &CompareArgs,
     reference: &ReferenceImages,
-    staging: &Staging,
+    staging: &mut Outputs,
     timing_source: &mut Option<String>,
 ) -> anyhow::Result<Result<(TechniqueResult, Vec<f32>, FlipMap), String>> {
     let (width, height, time) = (args.scene.width, args.scene.height, args.scene.time);
@@ -441,34 +452,36 @@ fn run_technique(
     Ok(Ok((result, image, map)))
 }
 
-/// The output folder's staging area: `<out>/.compare-partial-<pid>/`.
-/// Files go there; `commit` moves them into `<out>` (report.json last) and
-/// removes it; dropped uncommitted (an error), it is removed with
-/// everything in it.
-struct Staging {
-    out: PathBuf,
-    dir: PathBuf,
-    committed: std::cell::Cell<bool>,
+/// One file's content, held until `Outputs::commit`.
+enum Content {
+    Exr(u32, u32, Vec<f32>),
+    Png(u32, u32, Vec<u8>),
+    Rgb(u32, u32, Vec<u8>),
+    Text(String),
 }
 
-impl Staging {
-    fn new(out: &Path) -> anyhow::Result<Staging> {
-        if out.exists() && !out.is_dir() {
-            anyhow::bail!("--out {}: not a folder", out.display());
-        }
-        let dir = out.join(format!(".compare-partial-{}", std::process::id()));
-        std::fs::create_dir_all(&dir)
-            .with_context(|| format!("--out {}: cannot create it", out.display()))?;
-        Ok(Staging {
+/// Every file of the comparison, in memory until `commit` writes them all
+/// at once (`output::write_files`: all of them or none).
+struct Outputs {
+    out: PathBuf,
+    files: Vec<(PathBuf, Content)>,
+}
+
+impl Outputs {
+    fn new(out: &Path) -> Outputs {
+        Outputs {
             out: out.to_path_buf(),
-            dir,
-            committed: std::cell::Cell::new(false),
-        })
+            files: Vec::new(),
+        }
+    }
+
+    fn add(&mut self, name: String, content: Content) {
+        self.files.push((self.out.join(name), content));
     }
 
     /// `<stem>.exr` (linear radiance) and `<stem>.png` (display transform).
     fn write_pair(
-        &self,
+        &mut self,
         stem: &str,
         w: u32,
         h: u32,
@@ -476,56 +489,57 @@ impl Staging {
         exposure: f32,
     ) -> anyhow::Result<()> {
         if rgba.iter().any(|v| !v.is_finite()) {
-            anyhow::bail!("{stem}: the radiance contains NaN or Inf");
+            anyhow::bail!("{stem}: the radiance contains NaN or Inf; nothing written");
         }
-        output::write_exr(&self.dir.join(format!("{stem}.exr")), w, h, rgba)?;
-        output::write_png(
-            &self.dir.join(format!("{stem}.png")),
-            w,
-            h,
-            &metrics::tonemap(rgba, exposure),
-        )
+        self.add(format!("{stem}.exr"), Content::Exr(w, h, rgba.to_vec()));
+        self.add(
+            format!("{stem}.png"),
+            Content::Png(w, h, metrics::tonemap(rgba, exposure)),
+        );
+        Ok(())
     }
 
     /// A FLIP map through the magma colour map, `<stem>.png`.
-    fn write_map(&self, stem: &str, map: &FlipMap) -> anyhow::Result<()> {
+    fn write_map(&mut self, stem: &str, map: &FlipMap) -> anyhow::Result<()> {
         self.write_rgb(stem, map.width, map.height, &map.magma_rgb8())
     }
 
-    fn write_rgb(&self, stem: &str, w: u32, h: u32, rgb: &[u8]) -> anyhow::Result<()> {
-        let path = self.dir.join(format!("{stem}.png"));
-        image::save_buffer(&path, rgb, w, h, image::ExtendedColorType::Rgb8)
-            .with_context(|| format!("cannot write {}", path.display()))
+    fn write_rgb(&mut self, stem: &str, w: u32, h: u32, rgb: &[u8]) -> anyhow::Result<()> {
+        self.add(format!("{stem}.png"), Content::Rgb(w, h, rgb.to_vec()));
+        Ok(())
     }
 
-    fn write_text(&self, name: &str, text: &str) -> anyhow::Result<()> {
-        let path = self.dir.join(name);
-        std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))
+    fn write_text(&mut self, name: &str, text: &str) -> anyhow::Result<()> {
+        self.add(name.to_owned(), Content::Text(text.to_owned()));
+        Ok(())
     }
 
-    /// Moves every file into `--out` (report.json last); returns how many.
-    fn commit(&self) -> anyhow::Result<usize> {
-        let mut names: Vec<std::ffi::OsString> = std::fs::read_dir(&self.dir)?
-            .map(|e| e.map(|e| e.file_name()))
-            .collect::<Result<_, _>>()?;
-        names.sort_by_key(|n| n == "report.json");
-        for n in &names {
-            let to = self.out.join(n);
-            std::fs::rename(self.dir.join(n), &to)
-                .with_context(|| format!("cannot write {}", to.display()))?;
-        }
-        std::fs::remove_dir(&self.dir)?;
-        self.committed.set(true);
-        Ok(names.len())
-    }
-}
-
-impl Drop for Staging {
-    fn drop(&mut self) {
-        if !self.committed.get() {
-            let _ = std::fs::remove_dir_all(&self.dir);
-            // The folder itself, if this run created it and left it empty.
-            let _ = std::fs::remove_dir(&self.out);
-        }
+    /// Writes every file, report.json last; returns how many.
+    fn commit(mut self) -> anyhow::Result<usize> {
+        self.files
+            .sort_by_key(|(p, _)| p.file_name().is_some_and(|n| n == "report.json"));
+        let files: Vec<OutputFile> = self
+            .files
+            .iter()
+            .map(|(path, content)| match content {
+                Content::Exr(w, h, rgba) => output::exr_file(path, *w, *h, rgba),
+                Content::Png(w, h, rgba8) => output::png_file(path, *w, *h, rgba8),
+                Content::Rgb(w, h, rgb) => OutputFile {
+                    path,
+                    write: Box::new(move |out| {
+                        let image = image::RgbImage::from_raw(*w, *h, rgb.clone())
+                            .ok_or_else(|| anyhow::anyhow!("image buffer has the wrong size"))?;
+                        Ok(image.write_to(out, image::ImageFormat::Png)?)
+                    }),
+                },
+                Content::Text(text) => OutputFile {
+                    path,
+                    write: Box::new(move |out| Ok(out.write_all(text.as_bytes())?)),
+                },
+            })
+            .collect();
+        let n = files.len();
+        output::write_files(files)?;
+        Ok(n)
     }
 }

@@ -3,6 +3,7 @@
 
 pub mod compare;
 pub mod info;
+pub mod interrupt;
 pub mod reference;
 pub mod render;
 
@@ -44,12 +45,12 @@ pub struct SceneArgs {
     /// Scene file: TOML, or a glTF 2.0 file (.gltf/.glb) as a whole scene (docs/SCENES.md).
     #[arg(long, default_value = DEFAULT_SCENE)]
     pub scene: PathBuf,
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 512)]
     pub width: u32,
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 512)]
     pub height: u32,
     /// Animation time in seconds.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.0)]
     pub time: f32,
 }
 
@@ -57,7 +58,7 @@ pub struct SceneArgs {
 pub struct FrameArgs {
     /// Frames the GPU may still be running while the host records the next
     /// (1 to 4); the host waits only for the frame that last used a slot.
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 2)]
     pub frames_in_flight: usize,
     /// Per-pass times on a CPU device (lavapipe), whose timestamps miss
     /// compute: one submission per pass, each waited for, so frames cannot
@@ -118,7 +119,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub run: TechniqueArgs,
     /// Frames to render (time advances 1/60 s per frame); timings are averaged over them.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1)]
     pub frames: u32,
     /// Path-type component to draw: one the technique renders (`--technique list`) or all.
     #[arg(long, default_value = "all")]
@@ -137,17 +138,22 @@ pub struct ReferenceArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
     /// Photons to trace (rounded up to whole passes of 262,144).
-    #[arg(long, default_value_t = 20_000_000, conflicts_with = "seconds")]
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        default_value_t = 20_000_000,
+        conflicts_with = "seconds"
+    )]
     pub photons: u64,
     /// Trace for this many seconds instead of a photon count (whole passes).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub seconds: Option<f64>,
     /// Seed of the random streams: different seeds give independent images.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0)]
     pub seed: u32,
     /// First pass's photon-mapping radius in metres (default: 1.5 pixel
     /// footprints at the camera target's distance); it shrinks every pass.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub radius: Option<f32>,
     /// The light tracer and the camera chains' direct light only: what is
     /// seen through glass, water or mirrors lacks its caustics (for
@@ -157,13 +163,13 @@ pub struct ReferenceArgs {
     /// Share of the photons aimed at the mirrors and dielectrics (their
     /// bounding sphere), in [0, 1); the rest follow the light's own
     /// distribution. Unbiased for any share; more caustic photons.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.5)]
     pub aim_share: f32,
     /// Path-type component to write: direct, surface_caustics, airlight, volume_caustics, other, all.
     #[arg(long, default_value = "all")]
     pub component: String,
     /// Diffuse bounces photons continue through (0: direct light and caustics only).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0)]
     pub diffuse_bounces: u32,
     /// Output image; .png or .exr (the other format is written beside it).
     #[arg(long, default_value = "out/reference.png")]
@@ -176,10 +182,10 @@ pub struct ReferenceArgs {
 pub struct BenchArgs {
     #[command(flatten)]
     pub run: TechniqueArgs,
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 20)]
     pub frames: u32,
     /// Frames rendered before timing starts (pipeline compilation, caches).
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 2)]
     pub warmup: u32,
     /// Also write the results as JSON.
     #[arg(long)]
@@ -232,16 +238,16 @@ pub struct DemoArgs {
     #[arg(long = "param")]
     pub params: Vec<String>,
     /// Initial window width.
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 512)]
     pub width: u32,
     /// Initial window height.
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 512)]
     pub height: u32,
     /// fifo (default, vsync), mailbox or immediate; falls back to fifo when not offered.
     #[arg(long, default_value = "fifo")]
     pub present_mode: String,
     /// With --exit: frames to present before exiting.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub frames: Option<u32>,
     /// Exit after --frames N frames (tests, screenshots).
     #[arg(long, requires = "frames")]
@@ -250,7 +256,7 @@ pub struct DemoArgs {
     #[arg(long)]
     pub resize_test: bool,
     /// Frames the GPU may still be running while the host records the next (1 to 4).
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 2)]
     pub frames_in_flight: usize,
     #[command(flatten)]
     pub device: DeviceArgs,
@@ -263,7 +269,8 @@ pub fn context(args: &DeviceArgs) -> anyhow::Result<Arc<Context>> {
         device: args.device.clone(),
     };
     let ctx = Context::new(&options)?;
-    eprintln!("device: {} ({})", ctx.info.name, ctx.info.driver.trim());
+    // On stdout with the results: stderr holds only the one line of an error.
+    println!("device: {} ({})", ctx.info.name, ctx.info.driver.trim());
     Ok(ctx)
 }
 
@@ -280,8 +287,12 @@ pub fn check_validation(ctx: Arc<Context>) -> anyhow::Result<()> {
     Ok(())
 }
 
-pub fn load_scene(path: &Path) -> anyhow::Result<Scene> {
-    Ok(Scene::load(path)?)
+/// Loads the scene and checks what it derives at `time` (transforms, light
+/// power: `Scene::check_at`) before any device work.
+pub fn load_scene(path: &Path, time: f32) -> anyhow::Result<Scene> {
+    let scene = Scene::load(path)?;
+    scene.check_at(time).map_err(anyhow::Error::msg)?;
+    Ok(scene)
 }
 
 pub fn check_size(args: &SceneArgs) -> anyhow::Result<()> {
@@ -290,8 +301,12 @@ pub fn check_size(args: &SceneArgs) -> anyhow::Result<()> {
             anyhow::bail!("{name} {v}: must be between 1 and 16384");
         }
     }
-    if !args.time.is_finite() {
-        anyhow::bail!("--time must be a finite number of seconds");
+    if !(args.time.is_finite() && args.time.abs() as f64 <= caustics::scene::MAX_MAGNITUDE) {
+        anyhow::bail!(
+            "--time {:e}: must be a finite number of seconds within ±{:e}",
+            args.time,
+            caustics::scene::MAX_MAGNITUDE
+        );
     }
     Ok(())
 }
@@ -306,10 +321,13 @@ pub fn checked_technique_run(run: &TechniqueArgs, frames: u32) -> anyhow::Result
     if frames == 0 {
         anyhow::bail!("--frames must be at least 1");
     }
-    Ok((load_scene(&scene.scene)?, params))
+    let loaded = load_scene(&scene.scene, scene.time)?;
+    (info.check_scene)(&loaded)?;
+    Ok((loaded, params))
 }
 
-/// Writes both images, or neither: when the PNG fails the EXR just written is removed.
+/// Writes both images, or neither: both are written to temporary names and
+/// renamed together (an interrupt removes the temporaries).
 pub fn write_outputs(
     (exr, png): &(PathBuf, PathBuf),
     width: u32,
@@ -320,11 +338,10 @@ pub fn write_outputs(
     if radiance.iter().any(|v| !v.is_finite()) {
         anyhow::bail!("the rendered radiance contains NaN or Inf; no image written");
     }
-    output::write_exr(exr, width, height, radiance)?;
-    if let Err(e) = output::write_png(png, width, height, display) {
-        let _ = std::fs::remove_file(exr);
-        return Err(e);
-    }
+    output::write_files(vec![
+        output::exr_file(exr, width, height, radiance),
+        output::png_file(png, width, height, display),
+    ])?;
     println!(
         "wrote {} (linear radiance) and {} (tonemapped)",
         exr.display(),

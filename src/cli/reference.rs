@@ -35,7 +35,7 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
             anyhow::bail!("--radius must be a positive length in metres, got {r}");
         }
     }
-    let loaded = load_scene(&scene.scene)?;
+    let loaded = load_scene(&scene.scene, scene.time)?;
     let outputs = output::prepare(&out)?;
     let ctx = context(&device)?;
     let settings = ReferenceSettings {
@@ -46,6 +46,12 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
         aim_share,
         ..Default::default()
     };
+    // Whole passes: say so when --photons is not a multiple of one.
+    let batch = u64::from(settings.batch.div_ceil(64) * 64);
+    let rounded = photons.div_ceil(batch) * batch;
+    if seconds.is_none() && rounded != photons {
+        println!("--photons {photons}: rounded up to {rounded}, whole passes of {batch}");
+    }
     let mut reference = ReferenceRenderer::new(
         &ctx,
         loaded,
@@ -65,11 +71,12 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
 /// Runs reference passes until `photons` are traced or `seconds` have
 /// passed, with a progress bar that shows per pass the photons, the
 /// photon-mapping radius and the remaining noise; then prints the totals.
+/// Returns whether a signal cut it short (after the pass in flight).
 pub(super) fn trace_reference(
     reference: &mut ReferenceRenderer,
     photons: u64,
     seconds: Option<f64>,
-) -> anyhow::Result<()> {
+) -> anyhow::Result<bool> {
     let bar = match seconds {
         Some(s) => indicatif::ProgressBar::new((s * 1000.0) as u64).with_style(
             indicatif::ProgressStyle::with_template("{bar:40} {elapsed}/{msg}")
@@ -83,6 +90,9 @@ pub(super) fn trace_reference(
         ),
     };
     let start = std::time::Instant::now();
+    // SIGINT/SIGTERM while tracing: finish the pass in flight, then write.
+    let finish = super::interrupt::FinishOnSignal::new();
+    let mut interrupted = false;
     loop {
         let elapsed = start.elapsed().as_secs_f64();
         let done = match seconds {
@@ -115,8 +125,19 @@ pub(super) fn trace_reference(
         if bar.is_hidden() {
             eprintln!("{} photons, {message}", reference.reference.photons);
         }
+        if finish.requested() {
+            interrupted = true;
+            break;
+        }
     }
+    drop(finish);
     bar.finish_and_clear();
+    if interrupted {
+        println!(
+            "interrupted: writing the {} photons traced so far",
+            reference.reference.photons
+        );
+    }
     let noise = reference.noise()?;
     println!(
         "traced {} photons in {} passes, {:.2} s: {:.3} M photons/s; last radius {:.4} m; remaining noise {}",
@@ -141,5 +162,5 @@ pub(super) fn trace_reference(
             reference.reference.volume_capacity()
         );
     }
-    Ok(())
+    Ok(interrupted)
 }

@@ -5,7 +5,6 @@ use super::{
     check_validation, checked_technique_run, context, write_outputs, BenchArgs, DeviceArgs,
     RenderArgs, TechniqueArgs,
 };
-use anyhow::Context as _;
 use caustics::output;
 use caustics::params::Params;
 use caustics::renderer::Renderer;
@@ -13,6 +12,7 @@ use caustics::scene::Scene;
 use caustics::techniques;
 use caustics::vk::{Context, FrameOptions, FrameTiming, PassTiming};
 use std::collections::BTreeMap;
+use std::io::Write as _;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -149,6 +149,9 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
     } = args;
     let (loaded, params) = checked_technique_run(&run, frames)?;
     let options = frame.options()?;
+    if let Some(path) = &json {
+        output::check_writable(path, "--json")?;
+    }
     let (ctx, mut renderer) = start(&run, loaded, &params, options, &device)?;
     let (scene, technique) = (&run.scene, &run.technique);
     for i in 0..warmup {
@@ -236,12 +239,11 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
             "geometry": stats,
             "counters": counters,
         });
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("cannot create folder {}", dir.display()))?;
-        }
-        std::fs::write(&path, serde_json::to_string_pretty(&report)?)
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        let text = serde_json::to_string_pretty(&report)?;
+        output::write_files(vec![output::OutputFile {
+            path: &path,
+            write: Box::new(|w| Ok(w.write_all(text.as_bytes())?)),
+        }])?;
         println!("wrote {}", path.display());
     }
     Ok(())

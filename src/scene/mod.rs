@@ -8,6 +8,7 @@
 //! - `water.rs`: water surfaces (Gerstner waves), re-tessellated per time.
 //! - this file: loading, animation and world-space queries.
 
+mod bounds;
 mod error;
 mod file;
 pub mod gltf;
@@ -18,8 +19,10 @@ pub mod texture;
 mod types;
 pub mod water;
 
+pub use bounds::MAX_WORLD_EXTENT;
 pub use error::SceneError;
 pub use file::DEFAULT_FOV_Y_DEG;
+pub use node::{MAX_MAGNITUDE, MAX_RADIOMETRIC};
 pub use types::*;
 
 use glam::{Mat3, Mat4, Quat, Vec3};

@@ -335,23 +335,63 @@ impl<'a> Tbl<'a> {
     }
 }
 
-/// A finite number (integer or float) that fits an f32.
+/// The largest magnitude of a number in a scene file (docs/SCENES.md,
+/// "Bounds"): lengths and positions (m), angles (degrees), speeds, times,
+/// coefficients (1/m), scales, exposure. Beyond 10^6 m an f32 position
+/// resolves no better than 6 cm, and products of such values (an orbit at
+/// some time, a transform) head for overflow.
+pub const MAX_MAGNITUDE: f64 = 1e6;
+
+/// The largest radiometric value (`intensity` in W/sr, `irradiance` in
+/// W/m², `radiance` in W m⁻² sr⁻¹): wide enough for the sun's radiance
+/// (about 2e7) and a millimetre-sized lamp's (1e5-1e6) with room to spare,
+/// small enough that power and photon flux stay far from the f32 range.
+pub const MAX_RADIOMETRIC: f64 = 1e10;
+
+/// Fields (by their last key) that hold radiometric values.
+const RADIOMETRIC_KEYS: [&str; 3] = ["intensity", "irradiance", "radiance"];
+
+/// The bound on |value| for `field` (a dotted path such as
+/// `light[0].intensity[1]`): by its last key.
+fn magnitude_limit(field: &str) -> f64 {
+    let key = field.rsplit('.').next().unwrap_or(field);
+    let key = key.split('[').next().unwrap_or(key);
+    if RADIOMETRIC_KEYS.contains(&key) {
+        MAX_RADIOMETRIC
+    } else {
+        MAX_MAGNITUDE
+    }
+}
+
+/// A finite number (integer or float) within the field's bound
+/// ([`MAX_MAGNITUDE`], or [`MAX_RADIOMETRIC`] for light values).
 pub(crate) fn number(src: &Source, field: &str, n: &SNode) -> R<f32> {
-    match n.node {
-        Node::Int(i) => Ok(i as f32),
+    let v = match n.node {
+        Node::Int(i) => i as f64,
         Node::Float(f) if f.is_nan() => {
-            Err(src.err(&n.span, field, "must be a finite number, got nan"))
+            return Err(src.err(&n.span, field, "must be a finite number, got nan"))
         }
         Node::Float(f) if !f.is_finite() || f.abs() > f32::MAX as f64 => {
-            Err(src.err(&n.span, field, format!("must be a finite number, got {f}")))
+            return Err(src.err(&n.span, field, format!("must be a finite number, got {f}")))
         }
-        Node::Float(f) => Ok(f as f32),
-        ref other => Err(src.err(
+        Node::Float(f) => f,
+        ref other => {
+            return Err(src.err(
+                &n.span,
+                field,
+                format!("expected a number, got {}", other.type_name()),
+            ))
+        }
+    };
+    let limit = magnitude_limit(field);
+    if v.abs() > limit {
+        return Err(src.err(
             &n.span,
             field,
-            format!("expected a number, got {}", other.type_name()),
-        )),
+            format!("must be within ±{limit:e} (docs/SCENES.md, Bounds), got {v:e}"),
+        ));
     }
+    Ok(v as f32)
 }
 
 /// `[x, y, z]`, or (when `scalar_ok`) one number broadcast to all three.

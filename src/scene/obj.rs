@@ -39,26 +39,24 @@ pub struct ObjMesh {
 /// MTL to scene material: `illum` 4, 6 or 7, or `Ni` > 1 with `d` < 1, make a
 /// dielectric of ior `Ni` (1.5 when absent); `illum 3` a mirror of
 /// reflectance `Ks` (1 when absent); anything else a diffuse of albedo `Kd`
-/// (0.8 when absent). Colours are clamped to [0, 1].
+/// (0.8 when absent). Colours are clamped to [0, 1]. The values are assumed
+/// checked by [`check_mtl_values`].
 pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
     let rgb = |c: Option<[f32; 3]>, default: f32| {
         c.map_or(Vec3::splat(default), Vec3::from)
             .clamp(Vec3::ZERO, Vec3::ONE)
     };
-    let ni = m.optical_density.filter(|n| n.is_finite());
-    let illum = m.illumination_model.unwrap_or(2);
-    let transparent = ni.is_some_and(|n| n > 1.0) && m.dissolve.is_some_and(|d| d < 1.0);
     let name = format!("{prefix}:{}", m.name);
-    if matches!(illum, 4 | 6 | 7) || transparent {
+    if is_dielectric(m) {
         Material {
             name,
             kind: MaterialKind::Dielectric,
             color: Vec3::ONE,
-            ior: ni.filter(|&n| n >= 1.0).unwrap_or(1.5),
+            ior: m.optical_density.unwrap_or(1.5),
             absorption: Vec3::ZERO,
             texture: None,
         }
-    } else if illum == 3 {
+    } else if m.illumination_model == Some(3) {
         Material {
             name,
             kind: MaterialKind::Mirror,
@@ -79,6 +77,84 @@ pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
     }
 }
 
+/// `illum` 4, 6 or 7, or `Ni` > 1 with `d` < 1.
+fn is_dielectric(m: &tobj::Material) -> bool {
+    let transparent =
+        m.optical_density.is_some_and(|n| n > 1.0) && m.dissolve.is_some_and(|d| d < 1.0);
+    matches!(m.illumination_model, Some(4 | 6 | 7)) || transparent
+}
+
+/// The largest `Ni` a dielectric may have: the top of the MTL format's
+/// range (0.001 to 10); diamond is 2.42.
+pub const MAX_MTL_IOR: f32 = 10.0;
+
+/// Checks an MTL material's numbers (docs/SCENES.md): every number of
+/// `Ka`, `Kd`, `Ks`, `Ke`, `Tf`, `Ns`, `d` and `Ni` finite; `Kd`, `Ks`,
+/// `Ke` not negative (above 1, `Kd` and `Ks` are clamped to 1 on
+/// conversion); `d` and `Tf` within [0, 1]; the `Ni` of a material that
+/// becomes a dielectric within [1, 10]. The error names the material and
+/// the statement.
+pub fn check_mtl_values(m: &tobj::Material) -> Result<(), String> {
+    let bad = |key: &str, why: String| format!("material `{}`: {key}: {why}", m.name);
+    let finite = |key: &str, v: &[f32]| -> Result<(), String> {
+        match v.iter().find(|x| !x.is_finite()) {
+            Some(x) => Err(bad(key, format!("must be finite, got {x}"))),
+            None => Ok(()),
+        }
+    };
+    let in_range = |key: &str, v: &[f32], lo: f32, hi: f32, what: &str| -> Result<(), String> {
+        finite(key, v)?;
+        match v.iter().find(|&&x| !(lo..=hi).contains(&x)) {
+            Some(x) => Err(bad(key, format!("must be {what}, got {x}"))),
+            None => Ok(()),
+        }
+    };
+    for (key, c) in [
+        ("Ka", m.ambient),
+        ("Kd", m.diffuse),
+        ("Ks", m.specular),
+        ("Ke", m.emissive),
+    ] {
+        let Some(c) = c else { continue };
+        match key {
+            "Ka" => finite(key, &c)?,
+            _ => in_range(key, &c, 0.0, f32::INFINITY, "non-negative")?,
+        }
+    }
+    if let Some(ns) = m.shininess {
+        finite("Ns", &[ns])?;
+    }
+    if let Some(d) = m.dissolve {
+        in_range("d", &[d], 0.0, 1.0, "within [0, 1]")?;
+    }
+    if let Some(tf) = m.unknown_param.get("Tf") {
+        let mut words = tf.split_whitespace().peekable();
+        // `Tf spectral file.rfl [factor]` names a file; `Tf xyz x y z` is CIE XYZ.
+        if words.peek() != Some(&"spectral") {
+            if words.peek() == Some(&"xyz") {
+                words.next();
+            }
+            let values = words
+                .map(|w| w.parse::<f32>())
+                .collect::<Result<Vec<f32>, _>>()
+                .map_err(|_| bad("Tf", format!("expected numbers, got `{tf}`")))?;
+            in_range("Tf", &values, 0.0, 1.0, "within [0, 1]")?;
+        }
+    }
+    if let Some(ni) = m.optical_density {
+        finite("Ni", &[ni])?;
+        if is_dielectric(m) && !(1.0..=MAX_MTL_IOR).contains(&ni) {
+            return Err(bad(
+                "Ni",
+                format!(
+                    "the index of refraction of a dielectric must be within [1, {MAX_MTL_IOR}], got {ni}"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Reads an OBJ file (and the MTL files it names, relative to it).
 /// The error is a message that names the file.
 pub fn load(path: &Path) -> Result<ObjMesh, String> {
@@ -96,8 +172,15 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
     let (models, materials) = tobj::load_obj_buf(&mut reader, &options, |mtl: &Path| {
         let full = dir.join(mtl);
         let result = std::fs::File::open(&full)
-            .map_err(|e| e.to_string())
-            .and_then(|f| tobj::load_mtl_buf(&mut BufReader::new(f)).map_err(|e| e.to_string()));
+            .map_err(|e| format!("cannot read it: {e}"))
+            .and_then(|f| {
+                tobj::load_mtl_buf(&mut BufReader::new(f))
+                    .map_err(|e| format!("cannot read it: {e}"))
+            })
+            .and_then(|(materials, names)| {
+                materials.iter().try_for_each(check_mtl_values)?;
+                Ok((materials, names))
+            });
         if let Err(e) = &result {
             mtl_errors.borrow_mut().push((full, e.clone()));
         }
@@ -132,6 +215,8 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
 
     let mut mesh = Mesh::default();
     let mut all_normals = true;
+    // File normals that are zero or not finite (`vn 0 0 0`, `vn nan 0 0`).
+    let mut bad_normals = 0;
     for model in &models {
         let m = &model.mesh;
         if m.indices.len() % 3 != 0 || m.indices.is_empty() {
@@ -143,9 +228,12 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
             .map_or(NO_MATERIAL, |i| i as u32);
         let npos = m.positions.len() / 3;
         let positions: Vec<Vec3> = m.positions.chunks_exact(3).map(Vec3::from_slice).collect();
-        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+        if positions.iter().any(|p| !p.is_finite()) {
+            // tobj keeps no line numbers: find the statement in the file.
+            let at = first_non_finite(path, "v")
+                .map_or_else(String::new, |(line, text)| format!(":{line}: `{text}`"));
             return Err(format!(
-                "OBJ file {}: vertex position {i} of object `{}` is not finite",
+                "OBJ file {}{at}: a vertex position of object `{}` is not finite",
                 path.display(),
                 model.name
             ));
@@ -205,11 +293,13 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
                     Vec2::ZERO
                 };
                 mesh.positions.push(positions[pi as usize]);
-                mesh.normals.push(if n.is_finite() {
+                let n = if n.is_finite() {
                     n.normalize_or_zero()
                 } else {
                     Vec3::ZERO
-                });
+                };
+                bad_normals += usize::from(has_normals && n == Vec3::ZERO);
+                mesh.normals.push(n);
                 mesh.uvs.push(if uv.is_finite() { uv } else { Vec2::ZERO });
                 next
             });
@@ -223,6 +313,14 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
     if mesh.indices.is_empty() {
         return Err(format!("OBJ file {} has no faces", path.display()));
     }
+    if bad_normals > 0 {
+        log::warn!(
+            "OBJ file {}: {bad_normals} vertex normal(s) zero or not finite (first: {}); they take the normal of a face using them",
+            path.display(),
+            first_non_finite(path, "vn")
+                .map_or_else(|| "a zero `vn`".to_owned(), |(l, t)| format!("line {l}, `{t}`")),
+        );
+    }
     fix_zero_normals(&mut mesh);
     Ok(ObjMesh {
         mesh,
@@ -230,6 +328,19 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
         albedo_textures,
         mtl_errors: mtl_errors.into_inner(),
         had_normals: all_normals,
+    })
+}
+
+/// The first `keyword` statement (`v`, `vn`) of an OBJ file with a number
+/// that is not finite: its 1-based line and its text. Read again only when
+/// loading has found one, so loading stays one pass.
+fn first_non_finite(path: &Path, keyword: &str) -> Option<(usize, String)> {
+    let text = std::fs::read_to_string(path).ok()?;
+    text.lines().enumerate().find_map(|(i, line)| {
+        let mut words = line.split_whitespace();
+        let bad = words.next() == Some(keyword)
+            && words.any(|w| w.parse::<f32>().is_ok_and(|x| !x.is_finite()));
+        bad.then(|| (i + 1, line.trim().to_owned()))
     })
 }
 

@@ -77,6 +77,13 @@ pub trait TechniqueBuild: Technique + Sized + 'static {
         width: u32,
         height: u32,
     ) -> anyhow::Result<Self>;
+
+    /// What the technique needs of the scene (a water object, a sun),
+    /// checked before any device work so that the error comes first and
+    /// alone; `build` may assume it.
+    fn check_scene(_scene: &Scene) -> anyhow::Result<()> {
+        Ok(())
+    }
 }
 
 /// Builds a `T` from validated values (`TechniqueInfo::create`).
@@ -108,6 +115,9 @@ pub struct TechniqueInfo {
     /// Builds it for frames of `width` x `height` from values validated
     /// against `params()`.
     pub create: CreateFn,
+    /// What it needs of the scene, checked without a device
+    /// (`TechniqueBuild::check_scene`).
+    pub check_scene: fn(&Scene) -> anyhow::Result<()>,
 }
 
 impl TechniqueInfo {
@@ -118,6 +128,7 @@ impl TechniqueInfo {
             components: T::COMPONENTS,
             specs: <T::Params as ParamSet>::specs,
             create: create::<T>,
+            check_scene: T::check_scene,
         }
     }
 

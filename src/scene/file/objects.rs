@@ -210,7 +210,7 @@ fn mesh_object(
             return Err(t.err(
                 "path",
                 format!(
-                    "cannot read MTL file {} named by OBJ file {}: {why} (set `material` on the object to ignore the MTL)",
+                    "MTL file {} named by OBJ file {}: {why} (set `material` on the object to ignore the MTL)",
                     mtl.display(),
                     full.display()
                 ),
@@ -337,10 +337,13 @@ fn transform(t: &Tbl) -> R<Mat4> {
     let translate = t.vec3_or("translate", Vec3::ZERO)?;
     let rotate = t.vec3_or("rotate", Vec3::ZERO)?;
     let scale = t.opt_rgb("scale")?.unwrap_or(Vec3::ONE);
-    if scale.abs().min_element() < 1e-12 {
+    if scale.abs().min_element() < super::values::MIN_POSITIVE {
         return Err(t.err(
             "scale",
-            format!("must not be zero in any component, got {scale}"),
+            format!(
+                "must not be zero in any component (|scale| at least {:e}, docs/SCENES.md, Bounds), got {scale}",
+                super::values::MIN_POSITIVE
+            ),
         ));
     }
     let r = rotate * (std::f32::consts::PI / 180.0);

@@ -36,12 +36,25 @@ pub(super) fn unit_rgb(t: &Tbl, key: &str, default: Vec3) -> R<Vec3> {
     Ok(v)
 }
 
+/// The smallest positive length (radius, size, wavelength), scale or UV
+/// scale (docs/SCENES.md, Bounds): a micrometre; below it a triangle's
+/// edges vanish in f32 next to positions of metres.
+pub(crate) const MIN_POSITIVE: f32 = 1e-6;
+
+/// A positive number, at least [`MIN_POSITIVE`].
 pub(super) fn positive(t: &Tbl, key: &str) -> R<f32> {
     let v = t.f32(key)?;
     if v <= 0.0 {
         return Err(t.err(key, format!("must be positive, got {v}")));
     }
+    if v < MIN_POSITIVE {
+        return Err(t.err(key, too_small(v)));
+    }
     Ok(v)
+}
+
+fn too_small(v: f32) -> String {
+    format!("must be at least {MIN_POSITIVE:e} (docs/SCENES.md, Bounds), got {v:e}")
 }
 
 /// Two positive numbers `[a, b]`.
@@ -71,6 +84,11 @@ pub(super) fn numbers2(t: &Tbl, key: &str, positive: bool) -> R<[f32; 2]> {
                 &format!("{field}[{i}]"),
                 format!("must be positive, got {}", out[i]),
             ));
+        }
+        if positive && out[i] < MIN_POSITIVE {
+            return Err(t
+                .src
+                .err(&item.span, &format!("{field}[{i}]"), too_small(out[i])));
         }
     }
     Ok(out)

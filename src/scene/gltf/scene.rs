@@ -58,16 +58,14 @@ pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError
     let mut materials = asset.materials;
     // One texture per image, in the order materials first use them.
     let mut textures: Vec<Texture> = Vec::new();
+    let mut by_path = std::collections::HashMap::new();
     for (m, t) in materials.iter_mut().zip(asset.base_color_textures) {
         let Some(t) = t else { continue };
         let alpha_cutoff = t.alpha_cutoff;
-        let index = match textures.iter().position(|x| x.path == t.pixels.path) {
-            Some(i) => i,
-            None => {
-                textures.push(t.pixels);
-                textures.len() - 1
-            }
-        };
+        let index = *by_path.entry(t.pixels.path.clone()).or_insert_with(|| {
+            textures.push(t.pixels);
+            textures.len() - 1
+        });
         m.texture = Some(AlbedoTexture {
             index: index as u32,
             uv_scale: Vec2::ONE,

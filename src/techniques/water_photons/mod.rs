@@ -423,6 +423,23 @@ impl TechniqueBuild for WaterPhotons {
     ) -> anyhow::Result<Self> {
         Self::new(ctx, params, scene, scene_gpu, width, height)
     }
+
+    /// A `water` object and a directional light (the paper's sun), named
+    /// as the scene fields that lack them.
+    fn check_scene(scene: &Scene) -> anyhow::Result<()> {
+        let file = scene.source.display();
+        if !scene.objects.iter().any(|o| o.water.is_some()) {
+            anyhow::bail!(
+                "{file}: object: water_photons needs an object of shape = \"water\"; the scene has none"
+            );
+        }
+        if first_directional(&scene.lights).is_none() {
+            anyhow::bail!(
+                "{file}: light: water_photons needs a light of kind = \"directional\" (the paper's sun); the scene has none"
+            );
+        }
+        Ok(())
+    }
 }
 
 impl Technique for WaterPhotons {

@@ -1,0 +1,85 @@
+//! Derived quantities checked before rendering (issue 18; docs/SCENES.md,
+//! "Bounds"): a scene whose every field is within its bounds can still be
+//! placed out of reach by its transforms at the requested time (a glTF
+//! node's matrix, an OBJ's raw coordinates, an orbit), or carry lights from
+//! a glTF file beyond the radiometric bound. [`Scene::check_at`] names the
+//! object or light at fault.
+
+use super::node::MAX_RADIOMETRIC;
+use super::Scene;
+
+/// The farthest a world-space vertex may lie from the origin, in metres:
+/// ten times the largest coordinate a scene file may hold, leaving room
+/// for a translation plus an orbit plus a bob.
+pub const MAX_WORLD_EXTENT: f32 = 1e7;
+
+impl Scene {
+    /// Checks the scene at `time` (seconds): every object's transform
+    /// finite and its vertices within [`MAX_WORLD_EXTENT`] of the origin,
+    /// every light's intensity within the radiometric bound and its power
+    /// finite. The error is one line naming the scene file and the field.
+    pub fn check_at(&self, time: f32) -> Result<(), String> {
+        let at = |field: String, why: String| {
+            format!(
+                "{}: {field}: {why} (docs/SCENES.md, Bounds)",
+                self.source.display()
+            )
+        };
+        if !time.is_finite() {
+            return Err(at("--time".into(), format!("must be finite, got {time}")));
+        }
+        for (i, o) in self.objects.iter().enumerate() {
+            let field = if o.animation.is_some() {
+                format!("object[{i}].animate")
+            } else {
+                format!("object[{i}]")
+            };
+            let m = self.object_transform(i, time);
+            if !m.is_finite() {
+                return Err(at(
+                    field,
+                    format!("`{}`: its transform at time {time} s is not finite", o.name),
+                ));
+            }
+            let mesh = o.mesh_at(time);
+            let far = mesh
+                .positions
+                .iter()
+                .map(|&p| m.transform_point3(p).abs().max_element())
+                .fold(
+                    0.0f32,
+                    |a, b| if b.is_nan() { f32::INFINITY } else { a.max(b) },
+                );
+            if far > MAX_WORLD_EXTENT {
+                return Err(at(
+                    field,
+                    format!(
+                        "`{}` reaches {far:e} m from the origin at time {time} s, beyond {MAX_WORLD_EXTENT:e} m",
+                        o.name
+                    ),
+                ));
+            }
+        }
+        let (_, radius) = self.bounding_sphere(time);
+        for (i, l) in self.lights.iter().enumerate() {
+            let largest = l.intensity.max_element();
+            if largest.is_nan() || largest as f64 > MAX_RADIOMETRIC {
+                return Err(at(
+                    format!("light[{i}]"),
+                    format!("intensity {largest:e} is beyond {MAX_RADIOMETRIC:e}"),
+                ));
+            }
+            // Above every kind's power (radiometry::light_power: 4π I at
+            // most for point and spot lights, E π R² for a directional one).
+            let power =
+                largest * (4.0 * std::f32::consts::PI).max(std::f32::consts::PI * radius * radius);
+            if !power.is_finite() {
+                return Err(at(
+                    format!("light[{i}]"),
+                    format!("its power (up to {power} W) is not finite"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,178 @@
+//! Command-line errors (issue 18): every refusal is one line on stderr
+//! naming the argument or scene field, exit code 1, no device line before
+//! it and nothing created at `--out`; clap's own parse errors included.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const LAVAPIPE_ICD: &str = "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json";
+
+fn run(args: &[&str], env: &[(&str, Option<&str>)]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_caustics"));
+    if std::env::var_os("VK_DRIVER_FILES").is_none() {
+        c.env("VK_DRIVER_FILES", LAVAPIPE_ICD);
+    }
+    for (k, v) in env {
+        match v {
+            Some(v) => c.env(k, v),
+            None => c.env_remove(k),
+        };
+    }
+    c.args(args).output().expect("run caustics")
+}
+
+/// Exit code 1 and exactly one line on stderr, `error: ` first, containing
+/// every `needles`.
+fn one_line_error(o: &Output, needles: &[&str]) -> String {
+    let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "one line expected: {stderr}");
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    for n in needles {
+        assert!(stderr.contains(n), "expected `{n}` in {stderr}");
+    }
+    stderr
+}
+
+fn out_dir(name: &str) -> PathBuf {
+    let dir =
+        std::env::temp_dir().join(format!("caustics-cli-errors-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn manifest(rel: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join(rel)
+        .to_string_lossy()
+        .into_owned()
+}
+
+#[test]
+fn parse_errors_are_one_line_naming_the_argument() {
+    for (args, needle) in [
+        (vec!["render", "--height", "-1"], "'--height <HEIGHT>'"),
+        (vec!["render", "--width", "-3"], "'--width <WIDTH>'"),
+        (vec!["render", "--frames", "many"], "'--frames <FRAMES>'"),
+        (
+            vec!["reference", "--photons", "1e99"],
+            "'--photons <PHOTONS>'",
+        ),
+        (vec!["bench", "--warmup", "x"], "'--warmup <WARMUP>'"),
+        (vec!["render", "--no-such-flag"], "'--no-such-flag'"),
+        (vec!["paint"], "'paint'"),
+    ] {
+        one_line_error(&run(&args, &[]), &[needle, "--help"]);
+    }
+    // A negative time is a time, not an option.
+    let o = run(&["render", "--time", "-1", "--width", "0"], &[]);
+    one_line_error(&o, &["--width 0"]);
+    let o = run(&["render", "--help"], &[]);
+    assert_eq!(o.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("--technique"));
+}
+
+#[test]
+fn a_parameter_given_twice_is_refused() {
+    let o = run(
+        &[
+            "render",
+            "--technique",
+            "direct",
+            "--param",
+            "shadow_map_size=512",
+            "--param",
+            "shadow_map_size=1024",
+        ],
+        &[],
+    );
+    one_line_error(&o, &["--param shadow_map_size: given twice"]);
+}
+
+#[test]
+fn a_scene_the_technique_cannot_use_fails_before_the_device() {
+    let dir = out_dir("water");
+    let out = dir.join("deep/x.png");
+    let o = run(
+        &[
+            "render",
+            "--technique",
+            "water_photons",
+            "--scene",
+            &manifest("assets/scenes/ball_lens.toml"),
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    one_line_error(
+        &o,
+        &["ball_lens.toml: object: water_photons needs an object of shape = \"water\""],
+    );
+    assert!(o.stdout.is_empty(), "no device opened");
+    assert!(!dir.exists(), "nothing created at --out");
+    // No sun: the light is named.
+    let scene = dir.with_extension("toml");
+    let text = std::fs::read_to_string(manifest("assets/scenes/water_pool.toml")).unwrap();
+    let sun = "kind = \"directional\"\ndirection = [-0.35, -1.0, -0.45]\nirradiance = [1000.0, 980.0, 950.0]";
+    assert!(text.contains(sun), "water_pool's sun changed");
+    let point = "kind = \"point\"\nposition = [0.0, 10.0, 0.0]\nintensity = 100.0";
+    let text = text.replace(sun, point);
+    std::fs::write(&scene, text).unwrap();
+    let o = run(
+        &[
+            "bench",
+            "--technique",
+            "water_photons",
+            "--scene",
+            scene.to_str().unwrap(),
+        ],
+        &[],
+    );
+    let e = one_line_error(
+        &o,
+        &["light: water_photons needs a light of kind = \"directional\""],
+    );
+    assert!(!e.contains("device"), "{e}");
+}
+
+#[test]
+fn photons_rounded_to_whole_passes_say_so() {
+    let dir = out_dir("photons");
+    let o = run(
+        &[
+            "reference",
+            "--photons",
+            "1",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--out",
+            dir.join("r.png").to_str().unwrap(),
+        ],
+        &[],
+    );
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        stdout.contains("--photons 1: rounded up to 262144, whole passes of 262144"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("traced 262144 photons"), "{stdout}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn demo_without_a_display_says_so_in_one_line() {
+    let o = run(
+        &["demo", "--technique", "direct"],
+        &[("DISPLAY", None), ("WAYLAND_DISPLAY", None)],
+    );
+    let e = one_line_error(&o, &["demo needs a display", "DISPLAY"]);
+    assert!(!e.contains(".cargo") && !e.contains(".rs:"), "{e}");
+}
