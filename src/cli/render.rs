@@ -5,12 +5,15 @@ use super::{
     check_validation, checked_technique_run, context, write_outputs, BenchArgs, DeviceArgs,
     RenderArgs, TechniqueArgs,
 };
+use caustics::compare::report::{
+    median, pass_stats, per_pass, BenchReport, RunInfo, Timing, SCHEMA,
+};
 use caustics::output;
 use caustics::params::Params;
 use caustics::renderer::Renderer;
 use caustics::scene::Scene;
 use caustics::techniques;
-use caustics::vk::{Context, FrameOptions, FrameTiming, PassTiming};
+use caustics::vk::{Context, FrameOptions, PassTiming};
 use std::collections::BTreeMap;
 use std::io::Write as _;
 use std::sync::Arc;
@@ -100,44 +103,6 @@ fn start(
     Ok((ctx, renderer))
 }
 
-/// Each pass's times over frames, in the order of the first frame (passes
-/// matched by name; a repeated name collects all its occurrences).
-fn per_pass(frames: &[FrameTiming]) -> Vec<(String, Vec<f64>)> {
-    let mut out: Vec<(String, Vec<f64>)> = Vec::new();
-    for f in frames {
-        for (i, p) in f.passes.iter().enumerate() {
-            match out.iter_mut().find(|(n, _)| *n == p.name) {
-                Some((_, v)) if v.len() < frames.len() * (i + 1) => v.push(p.ms),
-                Some(_) => {}
-                None => out.push((p.name.clone(), vec![p.ms])),
-            }
-        }
-    }
-    out
-}
-
-fn median(values: &[f64]) -> f64 {
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    match v.len() {
-        0 => 0.0,
-        n if n % 2 == 1 => v[n / 2],
-        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-    }
-}
-
-fn min(values: &[f64]) -> f64 {
-    values.iter().copied().fold(f64::INFINITY, f64::min)
-}
-
-#[derive(serde::Serialize)]
-struct PassStats {
-    name: String,
-    /// Median over frames.
-    ms: f64,
-    min_ms: f64,
-}
-
 pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
     let BenchArgs {
         run,
@@ -177,14 +142,7 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
     let counters: BTreeMap<_, _> = renderer.technique_counters().into_iter().collect();
     drop(renderer);
     check_validation(ctx)?;
-    let passes: Vec<PassStats> = per_pass(&done)
-        .into_iter()
-        .map(|(name, ms)| PassStats {
-            name,
-            ms: median(&ms),
-            min_ms: min(&ms),
-        })
-        .collect();
+    let passes = pass_stats(&done);
     let submit_to_done: Vec<f64> = done.iter().map(|f| f.submit_to_done_ms).collect();
     println!(
         "bench {} on {} at {}x{}, {} frames after {} warm-up, {} in flight ({}):",
@@ -219,26 +177,35 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
         "host submit", submit_ms
     );
     if let Some(path) = json {
-        let report = serde_json::json!({
-            "device": device_name,
-            "driver": driver,
-            "timing_source": source.describe(),
-            "scene": scene.scene.display().to_string(),
-            "technique": technique,
-            "params": params.iter().map(|(k, v)| (k.clone(), *v)).collect::<BTreeMap<_, _>>(),
-            "width": scene.width,
-            "height": scene.height,
-            "frames": frames,
-            "warmup": warmup,
-            "frames_in_flight": in_flight,
-            "passes_ms": passes,
-            "frame_ms": interval_ms,
-            "submit_to_done_ms": median(&submit_to_done),
-            "host_wait_ms": wait_ms,
-            "host_submit_ms": submit_ms,
-            "geometry": stats,
-            "counters": counters,
-        });
+        let report = BenchReport {
+            run: RunInfo {
+                schema: SCHEMA.into(),
+                device: device_name,
+                driver,
+                timing_source: source.describe().into(),
+                scene: scene.scene.display().to_string(),
+                width: scene.width,
+                height: scene.height,
+                time: scene.time,
+            },
+            technique: technique.clone(),
+            params: params.iter().map(|(k, v)| (k.clone(), *v)).collect(),
+            warmup,
+            frames_in_flight: in_flight,
+            timing: Timing {
+                frames,
+                frame_ms: interval_ms,
+                passes_ms: passes,
+            },
+            submit_to_done_ms: median(&submit_to_done),
+            host_wait_ms: wait_ms,
+            host_submit_ms: submit_ms,
+            geometry: stats,
+            counters: counters
+                .into_iter()
+                .map(|(k, v)| (k.to_string(), v))
+                .collect(),
+        };
         let text = serde_json::to_string_pretty(&report)?;
         output::write_files(vec![output::OutputFile {
             path: &path,

@@ -170,9 +170,33 @@ impl CompareReport {
     }
 }
 
-/// Each pass's median and minimum over `frames`, in the order of the first
-/// frame (a repeated pass name collects all its occurrences).
-pub fn pass_stats(frames: &[crate::vk::FrameTiming]) -> Vec<PassStats> {
+/// `caustics bench --json`: the run, the technique's timing (the fields of
+/// [`Timing`] at the top level) and what only a benchmark measures.
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchReport {
+    #[serde(flatten)]
+    pub run: RunInfo,
+    pub technique: String,
+    pub params: BTreeMap<String, f32>,
+    pub warmup: u32,
+    pub frames_in_flight: usize,
+    #[serde(flatten)]
+    pub timing: Timing,
+    /// Median over frames of submission to fence (includes queueing with
+    /// more than one frame in flight).
+    pub submit_to_done_ms: f64,
+    /// Host time blocked on fences, per frame.
+    pub host_wait_ms: f64,
+    /// Host time inside vkQueueSubmit2, per frame.
+    pub host_submit_ms: f64,
+    pub geometry: crate::frame::GeometryStats,
+    /// The technique's named counts of its last frame (`Technique::counters`).
+    pub counters: BTreeMap<String, u64>,
+}
+
+/// Each pass's times over `frames`, in the order of the first frame (a
+/// repeated pass name collects all its occurrences).
+pub fn per_pass(frames: &[crate::vk::FrameTiming]) -> Vec<(String, Vec<f64>)> {
     let mut by_name: Vec<(String, Vec<f64>)> = Vec::new();
     for f in frames {
         for (i, p) in f.passes.iter().enumerate() {
@@ -184,6 +208,11 @@ pub fn pass_stats(frames: &[crate::vk::FrameTiming]) -> Vec<PassStats> {
         }
     }
     by_name
+}
+
+/// Each pass's median and minimum over `frames` ([`per_pass`]).
+pub fn pass_stats(frames: &[crate::vk::FrameTiming]) -> Vec<PassStats> {
+    per_pass(frames)
         .into_iter()
         .map(|(name, ms)| PassStats {
             name,
