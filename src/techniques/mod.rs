@@ -142,6 +142,7 @@ registry! {
     direct::Direct,
     image_space::ImageSpace,
     volume_lines::VolumeLines,
+    beams::Beams,
     water_photons::WaterPhotons,
 }
 
