@@ -118,7 +118,11 @@ void gauss_legendre(uint n, uint i, out float x, out float w) {
 // sigma_s at x (1/m): 0 outside the medium's bounds or without a medium.
 vec3 bm_sigma_s(vec3 x) {
     if (!medium_present()) return vec3(0.0);
+#ifdef MEDIUM_HOMOGENEOUS_ONLY
+    return inside_medium_bounds(x) ? medium.sigma_s.rgb * medium.bounds_min.w : vec3(0.0);
+#else
     return medium.sigma_s.rgb * medium_density(x);
+#endif
 }
 
 // Radiance beam b scatters toward the eye along the unit camera ray

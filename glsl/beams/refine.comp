@@ -170,8 +170,11 @@ vec3 incident_flux(ivec2 q0, ivec2 q1, ivec2 q2, out float measure) {
     return light.intensity.rgb * sum;
 }
 
-// Distance along (o, d) to the first diffuse surface (specular ones are
-// passed, as volume_lines' rays do), or to the scene's bounding sphere.
+// How far the edge ray (o, d) needs to be followed: to the first diffuse
+// surface (specular ones are passed, as volume_lines' rays do), else, where
+// it leaves the scene without meeting one, to where it leaves the medium's
+// bounds (beyond them it lights nothing; 0 without a medium). Sect. 4.3's
+// extrusion length from occlusion.
 float edge_length(vec3 o, vec3 d) {
     vec3 x = o;
     float travelled = 0.0;
@@ -185,11 +188,9 @@ float edge_length(vec3 o, vec3 d) {
         x = hx + d * eps;
         travelled += eps;
     }
-    vec3 oc = o - frame.scene_sphere.xyz;
-    float r = frame.scene_sphere.w;
-    float b = dot(oc, d);
-    float disc = b * b - (dot(oc, oc) - r * r);
-    return max(-b + sqrt(max(disc, 0.0)), travelled);
+    if (!medium_present()) return 0.0;
+    float t0 = 0.0, t1 = 1e30;
+    return clip_to_medium(o, d, t0, t1) ? t1 : 0.0;
 }
 
 // Builds the beam from the points p_k (where the light leaves the
@@ -211,8 +212,8 @@ bool make_beam(vec3 p[3], vec3 d[3], vec3 flux, vec3 incident, float measure, ui
         e[k] = d[k] / c;
         v[k] = p[k] + (h - dot(p[k], n)) * e[k];
         float eps = 1e-4 * max(1.0, bvh_max_abs(p[k]));
-        float s = edge_length(p[k] + d[k] * eps, d[k]) + eps;
-        y_max = max(y_max, dot(p[k] + s * d[k], n) - h);
+        float s = edge_length(p[k] + d[k] * eps, d[k]);
+        if (s > 0.0) y_max = max(y_max, dot(p[k] + (s + eps) * d[k], n) - h);
     }
     vec3 b1 = v[1] - v[0], b2 = v[2] - v[0];
     vec3 f1 = e[1] - e[0], f2 = e[2] - e[0];
@@ -315,17 +316,30 @@ void main() {
     }
     if (valid == 0) return; // outside the specular surfaces
 
-    // (a) Discontinuities.
+    // (a) Discontinuities. A depth difference splits; it is a silhouette
+    // (a jump between two surfaces, dropped at the last level) only where
+    // the vertices also leave each other's tangent planes (an edge more
+    // than 30 degrees off them): a surface seen at a grazing angle, as a
+    // sphere near its rim, has steep but continuous depth and is kept.
     bool silhouette = valid < 3 || !same_material;
+    bool split = silhouette;
     if (!silhouette) {
         float dmin = min(depth[0], min(depth[1], depth[2]));
         float dmax = max(depth[0], max(depth[1], depth[2]));
-        silhouette = dmax - dmin > pc.split.x * max(dmin, 1e-6);
-    }
-    bool split = silhouette;
-    if (!silhouette) {
+        if (dmax - dmin > pc.split.x * max(dmin, 1e-6)) {
+            split = true;
+            float off_plane = 0.0;
+            for (int i = 0; i < 3; ++i) {
+                for (int j = 0; j < 3; ++j) {
+                    vec3 chord = p[j] - p[i];
+                    float len = length(chord);
+                    if (i != j && len > 0.0) off_plane = max(off_plane, abs(dot(chord, nrm[i])) / len);
+                }
+            }
+            silhouette = off_plane > 0.5;
+        }
         float c = min(dot(nrm[0], nrm[1]), min(dot(nrm[1], nrm[2]), dot(nrm[2], nrm[0])));
-        split = c < pc.split.y;
+        split = split || c < pc.split.y;
     }
 
     // The beams of a triangle on one specular surface.

@@ -91,9 +91,9 @@ crate::declare_params! {
             "split (a): depths (distance from the light) of a triangle's vertices differing by more than this fraction (a silhouette: dropped at the last level)";
         split_normal: f32 [0.1, 180.0] = 15.0, rebuild,
             "split (a): normals of a triangle's vertices differing by more than this angle (degrees)";
-        split_focus: f32 [0.0, 1.0] = 0.25, rebuild,
+        split_focus: f32 [0.0, 1.0] = 0.1, rebuild,
             "split (b): the beam converges, its smallest cross-section |A(y)| below this fraction of its base's";
-        split_energy: f32 [0.0, 1.0] = 0.002, rebuild,
+        split_energy: f32 [0.0, 1.0] = 0.005, rebuild,
             "split (b): the beam carries more than this fraction of the flux of the light's whole view";
         split_camera: f32 [0.0, 10.0] = 0.05, rebuild,
             "split (c): the beam's cross-section at its central ray's point closest to the camera spans more than this angle (radians)";

@@ -11,7 +11,7 @@ use crate::frame::{FrameTargets, SceneGpu};
 use crate::passes::light_views::{LightView, LightViewConsumer};
 use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::passes::surface_frame::SurfaceFrame;
-use crate::scene::{LightKind, Scene};
+use crate::scene::{Density, LightKind, Scene};
 use crate::vk::{
     barrier, begin_rendering, end_rendering, Access, BindingKind, Buffer, BufferAccess,
     BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder,
@@ -333,7 +333,19 @@ impl BeamTracer {
         let receivers_pipeline = ComputePipeline::new(ctx, "beams/receivers.comp", &sets, 0)?;
         let apply_pipeline = ComputePipeline::new(ctx, "beams/apply.comp", &sets, 4)?;
         let composite_pipeline = ComputePipeline::new(ctx, "beams/composite.comp", &sets, 0)?;
-        let mut desc = GraphicsPipelineDesc::new("beams/volume.vert", "beams/volume.frag");
+        // A constant density (or none) gets fragments compiled without the
+        // density field's code (a CPU rasteriser pays for it in every
+        // fragment, as volume_lines measured).
+        let homogeneous = scene
+            .medium
+            .as_ref()
+            .is_none_or(|m| matches!(m.density, Density::Constant(_)));
+        let fragment = if homogeneous {
+            "beams/volume_homogeneous.frag"
+        } else {
+            "beams/volume.frag"
+        };
+        let mut desc = GraphicsPipelineDesc::new("beams/volume.vert", fragment);
         desc.geometry = Some("beams/volume.geom");
         desc.color_formats = vec![vk::Format::R32G32B32A32_SFLOAT; 2];
         desc.additive = true;
