@@ -131,13 +131,22 @@ fn beams_carry_the_flux_entering_their_base_triangles() {
             c.dropped_fraction()
         );
         assert_eq!(c.beam_overflow, 0);
-        assert!((ratio - 1.0).abs() < 0.01, "beams carry {ratio} of the entering flux");
+        assert!(
+            (ratio - 1.0).abs() < 0.01,
+            "beams carry {ratio} of the entering flux"
+        );
         assert!(((c.flux_in / (intensity * c.kept_measure)) - 1.0).abs() < 1e-3);
         // Kept triangles lie on the lens, dropped ones straddle its outline.
-        assert!(kept < 1.0 && tiled > 1.0, "kept {kept}, kept + dropped {tiled}");
+        assert!(
+            kept < 1.0 && tiled > 1.0,
+            "kept {kept}, kept + dropped {tiled}"
+        );
         dropped.push(c.dropped_fraction());
     }
-    assert!(dropped[1] < dropped[0], "refinement shrinks the dropped fraction: {dropped:?}");
+    assert!(
+        dropped[1] < dropped[0],
+        "refinement shrinks the dropped fraction: {dropped:?}"
+    );
     assert_validation_clean(&ctx);
 }
 
@@ -178,8 +187,8 @@ fn ball_lens_focuses_at_the_paraxial_focus() {
     let hit = o + dir * ((focus.y - o.y) / dir.y);
     // One pixel's footprint on the floor (along the slant).
     let view = focus - s.camera.eye;
-    let pixel = 2.0 * view.length() * 15f32.to_radians().tan() / size as f32
-        / (view.normalize().y.abs());
+    let pixel =
+        2.0 * view.length() * 15f32.to_radians().tan() / size as f32 / (view.normalize().y.abs());
     let miss = (hit - focus).length();
     println!(
         "brightest surface-caustic pixel at {hit:?}, paraxial focus {focus:?}: {miss:.4} m ({:.2} pixels)",
@@ -282,7 +291,14 @@ fn optically_thin_volume_caustic_is_linear_in_sigma_s() {
 ///   sum_px L_px = sum_beams int int ... V(x) / (t^2 Omega_px(x)),
 /// V = inside the frustum and not behind a surface (CPU BVH). Midpoint
 /// rule: `ny` heights, `m`^2 sub-triangles of the base. Homogeneous medium.
-fn beams_energy(scene: &Scene, beams: &[GpuBeam], g: f64, size: u32, ny: u32, m: u32) -> (f64, Vec<f64>) {
+fn beams_energy(
+    scene: &Scene,
+    beams: &[GpuBeam],
+    g: f64,
+    size: u32,
+    ny: u32,
+    m: u32,
+) -> (f64, Vec<f64>) {
     let mut bins = vec![0.0f64; (size * size) as usize];
     let medium = scene.medium.as_ref().unwrap();
     let caustics::scene::Density::Constant(density) = medium.density else {
@@ -314,8 +330,10 @@ fn beams_energy(scene: &Scene, beams: &[GpuBeam], g: f64, size: u32, ny: u32, m:
     }
     let mut sum = 0.0;
     for bm in beams {
-        let v = bm.v.map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
-        let e = bm.e.map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
+        let v =
+            bm.v.map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
+        let e =
+            bm.e.map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
         let y_max = bm.v[0][3] as f64;
         let dy = y_max / ny as f64;
         let phi = bm.flux[0] as f64;
@@ -323,7 +341,9 @@ fn beams_energy(scene: &Scene, beams: &[GpuBeam], g: f64, size: u32, ny: u32, m:
             let y = (k as f64 + 0.5) * dy;
             for l in &lams {
                 let lam = DVec3::new(l.x, l.y, 1.0 - l.x - l.y);
-                let x = lam.x * (v[0] + y * e[0]) + lam.y * (v[1] + y * e[1]) + lam.z * (v[2] + y * e[2]);
+                let x = lam.x * (v[0] + y * e[0])
+                    + lam.y * (v[1] + y * e[1])
+                    + lam.z * (v[2] + y * e[2]);
                 if !inside(x) {
                     continue;
                 }
@@ -345,10 +365,13 @@ fn beams_energy(scene: &Scene, beams: &[GpuBeam], g: f64, size: u32, ny: u32, m:
                 let len = el.length();
                 let d = el / len;
                 let s1 = y * len;
-                let tau = (-sigma_t * (length_in_box(x - s1 * d, x, lo, hi) + length_in_box(eye, x, lo, hi))).exp();
+                let tau = (-sigma_t
+                    * (length_in_box(x - s1 * d, x, lo, hi) + length_in_box(eye, x, lo, hi)))
+                .exp();
                 let cos_axis = w.dot(forward);
                 let omega_px = a_px * a_px * cos_axis.powi(3);
-                let c = sigma_s * hg_phase(d.dot(-w), g) * phi * tau * len * dy / lams.len() as f64
+                let c = sigma_s * hg_phase(d.dot(-w), g) * phi * tau * len * dy
+                    / lams.len() as f64
                     / (t * t * omega_px);
                 sum += c;
                 let px = (((ndc.x + 1.0) * 0.5 * size as f32) as u32).min(size - 1);
@@ -475,12 +498,19 @@ fn matches_reference(
     component: Component,
     size: u32,
     photons: u64,
+    overrides: &[&str],
     bound: Bound,
 ) {
     let mask = first_hit_mask(scene, size, true, |k| k == MaterialKind::Diffuse);
-    let mut reference =
-        ReferenceRenderer::new(ctx, scene.clone(), size, size, 0.0, ReferenceSettings::default())
-            .unwrap();
+    let mut reference = ReferenceRenderer::new(
+        ctx,
+        scene.clone(),
+        size,
+        size,
+        0.0,
+        ReferenceSettings::default(),
+    )
+    .unwrap();
     reference.trace(photons / 2, |_, _| {}).unwrap();
     let half_a = masked(&reference.resolve(component).unwrap(), &mask);
     reference.trace(photons / 2, |_, _| {}).unwrap();
@@ -490,7 +520,10 @@ fn matches_reference(
     let (noise_flip, _) = flip(&tonemap(&half_b), &tonemap(&half_a), size);
     let t = energy(&truth);
     let halves = (energy(&half_b) - energy(&half_a)) / t;
-    let beams = masked(&render(ctx, scene, &[], component.mask(), size).radiance(), &mask);
+    let beams = masked(
+        &render(ctx, scene, overrides, component.mask(), size).radiance(),
+        &mask,
+    );
     let rel = (energy(&beams) - t) / t;
     let (beams_ldr, truth_ldr) = (tonemap(&beams), tonemap(&truth));
     let (flip_mean, flip_map) = flip(&beams_ldr, &truth_ldr, size);
@@ -501,11 +534,30 @@ fn matches_reference(
         bound.flip
     );
     if rel.abs() >= bound.energy || flip_mean >= bound.flip {
-        let dir = write_comparison_pngs(&format!("beams_{label}"), size, &beams_ldr, &truth_ldr, &flip_map);
+        let dir = write_comparison_pngs(
+            &format!("beams_{label}"),
+            size,
+            &beams_ldr,
+            &truth_ldr,
+            &flip_map,
+        );
         panic!("{label}: relative energy {rel:+.4}, FLIP mean {flip_mean:.4} (images in {dir})");
     }
 }
 
+// Bounds: measured plus a margin (energy |measured| + 0.03 to 0.05, FLIP
+// mean 1.25 x measured); the reference's seeds are fixed.
+//
+// ball_lens, L S+ D, 96², 1 M photons (reference halves differ by +2.5%,
+// FLIP 0.023): beams +12.0% energy, FLIP 0.053 at the defaults (3 levels,
+// tir_remedy 1). The excess is the rim: Wyman's two-sided exit meets a
+// total internal reflection near the sphere's rim that the default remedy
+// sends out tangentially (the faint ring around the shadow; tir_remedy 0:
+// +17.7%, 2: -4.0%), and more levels keep more rim triangles (5 levels:
+// +42%). The gather evaluates each beam's irradiance at pixel centres,
+// so a coarse beam whose focus lies near the floor is point-sampled
+// where it is nearly singular (0 levels: +276%, one bright spot): the
+// refinement's focus criterion (b) is what keeps the beams fine there.
 #[test]
 fn ball_lens_surface_caustics_match_reference() {
     let ctx = validated_context();
@@ -516,11 +568,19 @@ fn ball_lens_surface_caustics_match_reference() {
         Component::SurfaceCaustics,
         96,
         1_000_000,
-        Bound { energy: 1.0, flip: 1.0 },
+        &[],
+        Bound {
+            energy: 0.17,
+            flip: 0.07,
+        },
     );
     assert_validation_clean(&ctx);
 }
 
+// volume_cone, L S+ V, 64², 1 M photons (halves -0.06%, FLIP 0.009):
+// beams -8.4% energy, FLIP 0.021. The deficit is the pixel-centre sampling
+// of the focus (the fragments against their own CPU volume integral
+// through this focus: 0.965 at 64², 0.981 at 128², 0.990 at 256²).
 #[test]
 fn volume_cone_volume_caustics_match_reference() {
     let ctx = validated_context();
@@ -531,7 +591,11 @@ fn volume_cone_volume_caustics_match_reference() {
         Component::VolumeCaustics,
         64,
         1_000_000,
-        Bound { energy: 1.0, flip: 1.0 },
+        &[],
+        Bound {
+            energy: 0.115,
+            flip: 0.027,
+        },
     );
     assert_validation_clean(&ctx);
 }
