@@ -163,7 +163,7 @@ fn ball_lens_focuses_at_the_paraxial_focus() {
     let alpha = 20f32.to_radians();
     let d = Vec3::new(alpha.sin(), -alpha.cos(), 0.0);
     let focus = centre + 1.5 * d;
-    let mut s = scene(
+    let s = scene(
         // From the side away from the lens, which must not hide the focus.
         camera(focus + Vec3::new(2.5, 3.0, 0.0), focus, 30.0),
         vec![directional_light(d, 1.0)],
@@ -598,4 +598,141 @@ fn volume_cone_volume_caustics_match_reference() {
         },
     );
     assert_validation_clean(&ctx);
+}
+
+/// One frame of `technique` (`beams` or `volume_lines`) drawing `component`,
+/// timed per pass (host clock per submission on lavapipe), on a context
+/// without validation: its image, the time of the passes whose names start
+/// with one of `caustic_passes`, and the beam counts.
+fn timed(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    technique: &str,
+    overrides: &[&str],
+    component: Component,
+    size: u32,
+    caustic_passes: &[&str],
+) -> (Vec<f32>, f64, Option<BeamCounts>) {
+    let info = caustics::techniques::find(technique).unwrap();
+    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let params = caustics::params::Params::resolve(technique, info.params(), &o).unwrap();
+    let mut scene_gpu = SceneGpu::new(ctx, scene, 0.0).unwrap();
+    scene_gpu.components = component.mask();
+    let targets = FrameTargets::new(ctx, size, size).unwrap();
+    let mut tech = (info.create)(ctx, &params, scene, &scene_gpu, size, size).unwrap();
+    scene_gpu.update_frame(scene, size, size, 0.0, 0).unwrap();
+    let profiler = caustics::vk::Profiler::for_timing(ctx, 64).unwrap();
+    // The first frame compiles the pipelines.
+    profiler
+        .frame(|rec| tech.record(rec, &scene_gpu, &targets))
+        .unwrap();
+    let passes = profiler
+        .frame(|rec| tech.record(rec, &scene_gpu, &targets))
+        .unwrap();
+    tech.after_frame(0).unwrap();
+    let ms = passes
+        .iter()
+        .filter(|p| caustic_passes.iter().any(|c| p.name.starts_with(c)))
+        .map(|p| p.ms)
+        .sum();
+    let counts = (technique == "beams").then(|| {
+        let c = tech.counters();
+        let get = |n: &str| c.iter().find(|(k, _)| *k == n).map_or(0, |(_, v)| *v) as u32;
+        BeamCounts {
+            beams: [0, 1, 2, 3, 4, 5].map(|l| get(&format!("beams_level{l}"))),
+            fragments: get("fragments"),
+            ..Default::default()
+        }
+    });
+    (targets.radiance.download_rgba32f().unwrap(), ms, counts)
+}
+
+/// For BENCHMARKS.md: Fig. 4 (adaptive against regular grids), Fig. 6
+/// (tight against prism volumes) and beams against volume_lines, on
+/// volume_cone's volume caustic (L S+ V) at `BEAMS_BENCH_SIZE` (default
+/// 128) against the reference (2 M photons), in one run.
+#[test]
+#[ignore]
+fn benchmark_statistics() {
+    let size: u32 = std::env::var("BEAMS_BENCH_SIZE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(128);
+    let ctx = Context::new(&caustics::vk::ContextOptions {
+        validation: false,
+        sync_validation: false,
+        device: None,
+    })
+    .unwrap();
+    let scene = load("volume_cone");
+    let mask = first_hit_mask(&scene, size, true, |k| k == MaterialKind::Diffuse);
+    let mut reference = ReferenceRenderer::new(
+        &ctx,
+        scene.clone(),
+        size,
+        size,
+        0.0,
+        ReferenceSettings::default(),
+    )
+    .unwrap();
+    reference.trace(2_000_000, |_, _| {}).unwrap();
+    let truth = masked(
+        &reference.resolve(Component::VolumeCaustics).unwrap(),
+        &mask,
+    );
+    drop(reference);
+    let truth_ldr = tonemap(&truth);
+    let t = energy(&truth);
+    let compare = |img: &[f32]| {
+        let img = masked(img, &mask);
+        let (f, _) = flip(&tonemap(&img), &truth_ldr, size);
+        (f, energy(&img) / t - 1.0)
+    };
+    println!("volume_cone, {size}², volume caustics against the reference (2 M photons)");
+    println!("| technique | settings | beams | fragments | caustics ms | FLIP | energy |");
+    println!("| --- | --- | ---: | ---: | ---: | ---: | ---: |");
+    let beam_passes = ["beam grid", "beam refine", "beam volumes"];
+    let configs: &[&[&str]] = &[
+        &["grid_size=16", "levels=0"],
+        &["grid_size=32", "levels=0"],
+        &["grid_size=64", "levels=0"],
+        &["grid_size=16", "levels=1"],
+        &["grid_size=16", "levels=2"],
+        &["grid_size=16", "levels=3"],
+        &["grid_size=16", "levels=3", "volume=0"],
+        &["grid_size=64", "levels=0", "volume=0"],
+    ];
+    for o in configs {
+        let (img, ms, c) = timed(
+            &ctx,
+            &scene,
+            "beams",
+            o,
+            Component::VolumeCaustics,
+            size,
+            &beam_passes,
+        );
+        let c = c.unwrap();
+        let (f, e) = compare(&img);
+        println!(
+            "| beams | {} | {} | {} | {ms:.0} | {f:.4} | {e:+.3} |",
+            o.join(" "),
+            c.total_beams(),
+            c.fragments
+        );
+    }
+    for n in [128u32, 256, 512] {
+        let o = format!("volume_buffer_size={n}");
+        let (img, ms, _) = timed(
+            &ctx,
+            &scene,
+            "volume_lines",
+            &[&o, "photon_buffer_size=64"],
+            Component::VolumeCaustics,
+            size,
+            &["volume segments", "volume lines"],
+        );
+        let (f, e) = compare(&img);
+        println!("| volume_lines | {o} | | | {ms:.0} | {f:.4} | {e:+.3} |");
+    }
 }
