@@ -491,6 +491,7 @@ struct Bound {
 /// `component` of `beams` on `scene` against the reference's, pixels whose
 /// camera ray meets a specular surface first zeroed in both (the reference
 /// also sees caustics through the glass, by its camera chains).
+#[allow(clippy::too_many_arguments)]
 fn matches_reference(
     ctx: &Arc<Context>,
     label: &str,
@@ -701,6 +702,29 @@ fn benchmark_statistics() {
         &["grid_size=16", "levels=3"],
         &["grid_size=16", "levels=3", "volume=0"],
         &["grid_size=64", "levels=0", "volume=0"],
+        // The oracle on discontinuities alone (Sect. 4.2 (a); the paper's
+        // water scene: smooth refractors, refined at the silhouettes).
+        &[
+            "grid_size=16",
+            "levels=1",
+            "split_focus=0",
+            "split_energy=1",
+            "split_camera=10",
+        ],
+        &[
+            "grid_size=16",
+            "levels=2",
+            "split_focus=0",
+            "split_energy=1",
+            "split_camera=10",
+        ],
+        &[
+            "grid_size=16",
+            "levels=3",
+            "split_focus=0",
+            "split_energy=1",
+            "split_camera=10",
+        ],
     ];
     for o in configs {
         let (img, ms, c) = timed(
@@ -735,4 +759,34 @@ fn benchmark_statistics() {
         let (f, e) = compare(&img);
         println!("| volume_lines | {o} | | | {ms:.0} | {f:.4} | {e:+.3} |");
     }
+}
+
+/// The components add up to the frame (Fig. 8): direct and surface
+/// caustics, airlight and volume caustics, each drawn alone, sum to
+/// everything drawn at once. Measured (32², 1 level): worst pixel 4.4e-7
+/// relative (bound 1e-4).
+#[test]
+fn components_add_up_to_the_frame() {
+    let ctx = validated_context();
+    let scene = load("volume_cone");
+    // Midpoint airlight samples: the same airlight in every render.
+    let opts = ["airlight_jitter=0", "airlight_steps=16", "levels=1"];
+    let draw = |mask: u32| render(&ctx, &scene, &opts, mask, 32).radiance();
+    let all = draw(Component::All.mask());
+    let parts = [
+        draw(Component::Direct.mask() | Component::SurfaceCaustics.mask()),
+        draw(Component::Airlight.mask()),
+        draw(Component::VolumeCaustics.mask()),
+    ];
+    assert!(parts.iter().all(|p| energy(p) > 0.0));
+    let mut worst = 0.0f32;
+    for (i, d) in all.chunks(4).enumerate() {
+        for k in 0..3 {
+            let sum: f32 = parts.iter().map(|p| p[4 * i + k]).sum();
+            worst = worst.max((d[k] - sum).abs() / d[k].abs().max(1e-3));
+        }
+    }
+    println!("all vs the three parts: worst relative difference {worst:.2e}");
+    assert!(worst < 1e-4, "{worst}");
+    assert_validation_clean(&ctx);
 }

@@ -238,7 +238,12 @@ impl Technique for Beams {
     }
 
     fn set_lights(&mut self, lights: &[Light]) -> bool {
-        self.surface.set_lights(lights) && self.light_views.set_lights(lights)
+        if !(self.surface.set_lights(lights) && self.light_views.set_lights(lights)) {
+            return false;
+        }
+        self.tracer
+            .set_lights(self.light_views.lights(), self.light_views.specular());
+        true
     }
 
     fn after_frame(&mut self, slot: usize) -> crate::vk::VkResult<()> {

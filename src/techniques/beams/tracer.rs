@@ -11,7 +11,8 @@ use crate::frame::{FrameTargets, SceneGpu};
 use crate::passes::light_views::{LightView, LightViewConsumer};
 use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::passes::surface_frame::SurfaceFrame;
-use crate::scene::{Density, LightKind, Scene};
+use crate::passes::light_views::photon_view;
+use crate::scene::{Density, Light, LightKind, Scene};
 use crate::vk::{
     barrier, begin_rendering, end_rendering, Access, BindingKind, Buffer, BufferAccess,
     BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder,
@@ -185,6 +186,7 @@ pub struct BeamTracer {
     /// criterion's reference.
     view_flux: Vec<f32>,
     split_energy: f32,
+    light_view_size: u32,
     refine_pipeline: ComputePipeline,
     args_pipeline: ComputePipeline,
     receivers_pipeline: ComputePipeline,
@@ -200,7 +202,35 @@ fn luminance(c: glam::Vec3) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
 }
 
+/// The energy criterion's reference per light: the flux of its whole view
+/// of the specular objects (luminance W: its intensity times the view's
+/// solid angle, or its irradiance times the view's area).
+fn view_fluxes(lights: &[Light], specular: Option<(glam::Vec3, f32)>, size: u32) -> Vec<f32> {
+    lights
+        .iter()
+        .take(crate::shader_bindings::MAX_LIGHTS as usize)
+        .enumerate()
+        .map(|(l, light)| {
+            let Some(v) = specular.and_then(|s| photon_view(light, l as u32, s, size)) else {
+                return 0.0;
+            };
+            let h = v.origin[3];
+            let measure = match light.kind {
+                LightKind::Directional => 4.0 * h * h,
+                // Solid angle of the square [-h, h]^2 of the tan plane.
+                _ => 4.0 * (h * h / (1.0 + 2.0 * h * h).sqrt()).asin(),
+            };
+            luminance(light.intensity) * measure
+        })
+        .collect()
+}
+
 impl BeamTracer {
+    /// The scene's lights moved: the energy criterion follows their views.
+    pub fn set_lights(&mut self, lights: &[Light], specular: Option<(glam::Vec3, f32)>) {
+        self.view_flux = view_fluxes(lights, specular, self.light_view_size);
+    }
+
     /// Frames of `width` x `height`; `light_view` is the light views'
     /// G-buffer, `surface` the frame the caustics add to.
     #[allow(clippy::too_many_arguments)]
@@ -353,30 +383,11 @@ impl BeamTracer {
         desc.push_size = size_of::<VolumePush>() as u32;
         let volume_pipeline = GraphicsPipeline::new(ctx, &desc, &sets)?;
 
-        // The energy criterion's reference: the flux of a light's whole
-        // view (its intensity times the view's solid angle, or its
-        // irradiance times the view's area).
-        let specular = crate::passes::light_views::specular_bounds(scene);
-        let view_flux = scene
-            .lights
-            .iter()
-            .take(crate::shader_bindings::MAX_LIGHTS as usize)
-            .enumerate()
-            .map(|(l, light)| {
-                let Some(v) = specular.and_then(|s| {
-                    crate::passes::light_views::photon_view(light, l as u32, s, light_view_size)
-                }) else {
-                    return 0.0;
-                };
-                let h = v.origin[3];
-                let measure = match light.kind {
-                    LightKind::Directional => 4.0 * h * h,
-                    // Solid angle of the square [-h, h]^2 of the tan plane.
-                    _ => 4.0 * (h * h / (1.0 + 2.0 * h * h).sqrt()).asin(),
-                };
-                luminance(light.intensity) * measure
-            })
-            .collect();
+        let view_flux = view_fluxes(
+            &scene.lights,
+            crate::passes::light_views::specular_bounds(scene),
+            light_view_size,
+        );
         let cos_normal = settings.split_normal_deg.to_radians().cos();
         Ok(Self {
             beams,
@@ -414,6 +425,7 @@ impl BeamTracer {
             },
             view_flux,
             split_energy: settings.split_energy,
+            light_view_size,
             refine_pipeline,
             args_pipeline,
             receivers_pipeline,
