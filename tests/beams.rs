@@ -551,7 +551,8 @@ fn matches_reference(
 //
 // ball_lens, L S+ D, 96², 1 M photons (reference halves differ by +2.5%,
 // FLIP 0.023): beams +12.0% energy, FLIP 0.053 at the defaults (3 levels,
-// tir_remedy 1). The excess is the rim: Wyman's two-sided exit meets a
+// tir_remedy 1); with the refraction traced through the BVH
+// (`refraction=1`) -4.5%, FLIP 0.027. The excess is the rim: Wyman's two-sided exit meets a
 // total internal reflection near the sphere's rim that the default remedy
 // sends out tangentially (the faint ring around the shadow; tir_remedy 0:
 // +17.7%, 2: -4.0%), and more levels keep more rim triangles (5 levels:
@@ -575,11 +576,28 @@ fn ball_lens_surface_caustics_match_reference() {
             flip: 0.07,
         },
     );
+    // Two-sided refraction traced exactly through the BVH.
+    matches_reference(
+        &ctx,
+        "ball_lens_surface_traced",
+        &load("ball_lens"),
+        Component::SurfaceCaustics,
+        96,
+        1_000_000,
+        &["refraction=1"],
+        Bound {
+            energy: 0.075,
+            flip: 0.035,
+        },
+    );
     assert_validation_clean(&ctx);
 }
 
 // volume_cone, L S+ V, 64², 1 M photons (halves -0.06%, FLIP 0.009):
-// beams -8.4% energy, FLIP 0.021. The deficit is the pixel-centre sampling
+// beams -8.4% energy, FLIP 0.021 (traced refraction: -17.2%, FLIP 0.014:
+// without the image-space exit's spurious total internal reflections,
+// which send rim light out sideways, the rim light dropped at the
+// silhouette is missing). The deficit is the pixel-centre sampling
 // of the focus (the fragments against their own CPU volume integral
 // through this focus: 0.965 at 64², 0.981 at 128², 0.990 at 256²).
 #[test]
@@ -596,6 +614,19 @@ fn volume_cone_volume_caustics_match_reference() {
         Bound {
             energy: 0.115,
             flip: 0.027,
+        },
+    );
+    matches_reference(
+        &ctx,
+        "volume_cone_volume_traced",
+        &load("volume_cone"),
+        Component::VolumeCaustics,
+        64,
+        1_000_000,
+        &["refraction=1"],
+        Bound {
+            energy: 0.20,
+            flip: 0.018,
         },
     );
     assert_validation_clean(&ctx);
@@ -788,5 +819,35 @@ fn components_add_up_to_the_frame() {
     }
     println!("all vs the three parts: worst relative difference {worst:.2e}");
     assert!(worst < 1e-4, "{worst}");
+    assert_validation_clean(&ctx);
+}
+
+/// The same bookkeeping under a directional light: flux E times the base
+/// triangle's area projected on the light direction, and the lens's
+/// projected disc pi r^2 between the kept and the kept plus dropped
+/// X
+#[test]
+fn directional_beams_carry_the_irradiance_times_the_projected_area() {
+    let ctx = validated_context();
+    let mut scene = load("ball_lens");
+    lens_ior(&mut scene, 1.0);
+    scene.lights = vec![directional_light(Vec3::new(0.3, -1.0, 0.2), 2.0)];
+    let f = render(&ctx, &scene, &[], Component::SurfaceCaustics.mask(), 32);
+    let c = f.counts();
+    let disc = std::f64::consts::PI; // r = 1 m
+    let kept = c.kept_measure as f64 / disc;
+    let tiled = (c.kept_measure + c.dropped_measure) as f64 / disc;
+    let ratio = c.flux_out as f64 / c.flux_in as f64;
+    println!(
+        "directional: flux_in {:.4} W = E x kept area {:.4} W; carried / entering {ratio:.5}; kept / disc {kept:.4}, (kept + dropped) / disc {tiled:.4}",
+        c.flux_in,
+        2.0 * c.kept_measure
+    );
+    assert!((c.flux_in / (2.0 * c.kept_measure) - 1.0).abs() < 1e-3);
+    assert!((ratio - 1.0).abs() < 0.01);
+    assert!(
+        kept < 1.0 && tiled > 1.0,
+        "kept {kept}, kept + dropped {tiled}"
+    );
     assert_validation_clean(&ctx);
 }

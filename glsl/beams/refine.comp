@@ -30,7 +30,7 @@
 // surface and no depth jump becomes one beam per specular event (mirror:
 // reflected; dielectric: reflected and refracted, Fresnel splitting the
 // flux, two-sided refraction through the back faces of the light-space
-// G-buffer, Sect. 6); a triangle still crossing a silhouette at the last
+// G-buffer, Sect. 6, or exactly through the BVH); a triangle still crossing a silhouette at the last
 // level is dropped, and its measure counted (`BEAMS_STAT_DROPPED_MEASURE`).
 #extension GL_EXT_shader_atomic_float : require
 #include "scene.glsl"
@@ -67,7 +67,7 @@ layout(push_constant) uniform Push {
     uvec4 grid;   // x: this level; y: levels; z: base grid side; w: triangle capacity per list
     uvec4 config; // x: beam capacity; y: TIR_* remedy; z: Eq. 6.3.2 on; w: medium steps
     vec4 split;   // x: relative depth; y: cos of the normal angle; z: focus ratio; w: energy (W)
-    vec4 split2;  // x: camera-space angular size (rad)
+    vec4 split2;  // x: camera-space angular size (rad); y: BEAMS_REFRACTION_* (uint bits)
 } pc;
 
 #define STAT_ADD(word, value) atomicAdd(counters[word], value)
@@ -232,6 +232,42 @@ bool make_beam(vec3 p[3], vec3 d[3], vec3 flux, vec3 incident, float measure, ui
     return true;
 }
 
+// Two-sided refraction exactly through the BVH (BEAMS_REFRACTION_TRACED,
+// the issue's alternative to the light view's back faces): Snell into the
+// glass at p, then the ray inside to the next surface, refracted out, or
+// reflected where it meets total internal reflection (up to 8 times, the
+// light staying in the beam); Beer-Lambert over the path inside. The
+// Fresnel reflections inside are not followed (their light is lost, as
+// with the image-space exit). False where the ray does not leave.
+bool traced_refraction(vec3 d, vec3 p, vec3 n, float ior, vec3 absorption,
+                       out vec3 exit_p, out vec3 exit_d, out vec3 factor) {
+    exit_p = p;
+    exit_d = d;
+    factor = vec3(1.0);
+    vec3 dir;
+    if (!refract_dir(d, n, 1.0 / ior, dir)) return false;
+    vec3 x = p;
+    for (int i = 0; i < 8; ++i) {
+        float eps = 1e-4 * max(1.0, bvh_max_abs(x));
+        vec3 o = x + dir * eps;
+        Hit h;
+        if (!trace_closest(o, dir, 0.0, 1e30, h)) return false;
+        x = hit_position(h, o, dir);
+        factor *= exp(-absorption * (h.t + eps));
+        vec3 nn = hit_normal(h);
+        if (dot(nn, dir) > 0.0) nn = -nn;
+        vec3 out_dir;
+        if (refract_dir(dir, nn, ior, out_dir)) {
+            factor *= 1.0 - fresnel_dielectric(-dot(dir, nn), ior);
+            exit_p = x;
+            exit_d = out_dir;
+            return true;
+        }
+        dir = reflect(dir, nn);
+    }
+    return false;
+}
+
 // Criterion (b): the smallest |A(y)| over [0, y_max] against |A(0)|.
 float focus_ratio(Beam b) {
     float y_max = b.v0.w;
@@ -376,7 +412,14 @@ void main() {
                 float f0 = fresnel_dielectric(-dot(dir[k], nrm[k]), 1.0 / ior);
                 f_refl += f0 / 3.0;
                 vec4 bp = imageLoad(back_position, q[k]);
-                if (bp.w < 0.0) {
+                if (floatBitsToUint(pc.split2.y) == BEAMS_REFRACTION_TRACED) {
+                    vec3 factor;
+                    if (!traced_refraction(dir[k], p[k], nrm[k], ior, absorption, exit_p[k], exit_d[k], factor)) {
+                        refracts = false;
+                        continue;
+                    }
+                    f_refr += (1.0 - f0) * factor / 3.0;
+                } else if (bp.w < 0.0) {
                     // No back face: an open sheet (d_N = 0) refracts once
                     // and its beam starts at the interface; a closed
                     // refractor's texel without one is its silhouette.

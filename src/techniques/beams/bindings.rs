@@ -66,3 +66,9 @@ pub const BEAM_REFRACTED: u32 = 1;
 /// six-side-triangle hull with the prism as its fallback.
 pub const BEAMS_VOLUME_PRISM: u32 = 0;
 pub const BEAMS_VOLUME_TIGHT: u32 = 1;
+
+/// Two-sided refraction (Sect. 6): Wyman's image-space exit through the
+/// light view's back faces (the paper uses a distance impostor), or the
+/// exact path through the BVH.
+pub const BEAMS_REFRACTION_IMAGE_SPACE: u32 = 0;
+pub const BEAMS_REFRACTION_TRACED: u32 = 1;

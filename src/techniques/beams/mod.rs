@@ -24,7 +24,7 @@
 //!    Final triangles become beams (Sects. 4.3, 6): the base at the first
 //!    specular interaction, edges by reflection and by two-sided
 //!    refraction (Wyman's, through the back faces of the light's
-//!    G-buffer), Fresnel splitting the flux; flux from the light's
+//!    G-buffer, or exactly through the BVH: `refraction`), Fresnel splitting the flux; flux from the light's
 //!    radiometry (point: I times the exact solid angle of the base
 //!    triangle; spot: the integral of I over it; directional: E times the
 //!    projected area), times Fresnel and Beer-Lambert absorption and the
@@ -48,7 +48,7 @@
 //!
 //! Not implemented (documented limits): multiple bounces through further
 //! specular surfaces (Sect. 6; an edge ray passes through them), the
-//! exact BVH variant of two-sided refraction, the energy cut-off of the
+//! energy cut-off of the
 //! extrusion length for divergent beams, the low-pass filter of the
 //! surface caustics; the flux is uniform across a beam (one area function
 //! per beam, as in the paper; Fresnel and absorption factors averaged over
@@ -101,6 +101,8 @@ crate::declare_params! {
             "bounding volumes (Sect. 4.3): 0 Ernst's prism, 1 the tight six-triangle hull (prism where it is not convex)";
         quadrature: u32 [1, 4] = 3, rebuild,
             "Gauss-Legendre points per interval of a camera ray inside a beam (Sect. 5)";
+        refraction: u32 [0, 1] = 0, rebuild,
+            "two-sided refraction (Sect. 6): 0 Wyman's image-space exit through the light view's back faces (the paper's approximate ray tracing), 1 exactly through the BVH (internal total reflections followed)";
         tir_remedy: u32 [0, 2] = 1, rebuild,
             "total internal reflection at the approximated exit of two-sided refraction (as image_space's): 0 single refraction, 1 clamp to the critical angle, 2 reflect";
         eq_6_3_2: u32 [0, 1] = 1, rebuild,
@@ -181,6 +183,7 @@ impl TechniqueBuild for Beams {
                 beam_capacity: params.beam_capacity,
                 tir_remedy: params.tir_remedy,
                 eq_6_3_2: params.eq_6_3_2,
+                refraction: params.refraction,
                 medium_steps: params.direct.medium_steps,
             },
             scene,

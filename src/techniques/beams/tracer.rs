@@ -126,7 +126,7 @@ struct RefinePush {
     config: [u32; 4],
     /// relative depth, cos(normal angle), focus ratio, energy (W).
     split: [f32; 4],
-    /// camera angular size (rad).
+    /// camera angular size (rad); refraction (u32 bits).
     split2: [f32; 4],
 }
 const _: () = assert!(size_of::<RefinePush>() == 128);
@@ -164,6 +164,8 @@ pub struct TracerSettings {
     pub beam_capacity: u32,
     pub tir_remedy: u32,
     pub eq_6_3_2: u32,
+    /// `BEAMS_REFRACTION_*`.
+    pub refraction: u32,
     pub medium_steps: u32,
 }
 
@@ -411,7 +413,12 @@ impl BeamTracer {
                     settings.medium_steps,
                 ],
                 split: [settings.split_depth, cos_normal, settings.split_focus, 0.0],
-                split2: [settings.split_camera, 0.0, 0.0, 0.0],
+                split2: [
+                    settings.split_camera,
+                    f32::from_bits(settings.refraction),
+                    0.0,
+                    0.0,
+                ],
             },
             args: ArgsPush {
                 triangle_capacity,
