@@ -851,3 +851,41 @@ fn directional_beams_carry_the_irradiance_times_the_projected_area() {
     );
     assert_validation_clean(&ctx);
 }
+
+/// The extrusion's energy cut-off (Sect. 4.3) on volume_cone: divergent
+/// beams (the front-face reflections fanning out through the medium) end
+/// where their flux density falls below the cut-off times their base's,
+/// trading their thin far ends for fragments. Measured (32²): 0.01 keeps
+/// 0.9964 of the energy with 0.975x the fragments, 0.05 keeps 0.9148 with
+/// 0.627x.
+#[test]
+fn energy_cutoff_trades_thin_light_for_fragments() {
+    let ctx = validated_context();
+    let scene = load("volume_cone");
+    let run = |cutoff: &str| {
+        let f = render(
+            &ctx,
+            &scene,
+            &[cutoff],
+            Component::VolumeCaustics.mask(),
+            32,
+        );
+        (energy(&f.radiance()), f.counts().fragments as f64)
+    };
+    let (full, full_frags) = run("extrusion_cutoff=0");
+    let (light, light_frags) = run("extrusion_cutoff=0.01");
+    let (heavy, heavy_frags) = run("extrusion_cutoff=0.05");
+    println!(
+        "cut-off 0.01: energy {:.4} x, fragments {:.3} x; 0.05: energy {:.4} x, fragments {:.3} x",
+        light / full,
+        light_frags / full_frags,
+        heavy / full,
+        heavy_frags / full_frags
+    );
+    assert!(light <= full * (1.0 + 1e-6) && light > 0.99 * full);
+    assert!(heavy < light && heavy > 0.88 * full);
+    assert!(
+        heavy_frags < light_frags && light_frags <= full_frags && heavy_frags < 0.7 * full_frags
+    );
+    assert_validation_clean(&ctx);
+}

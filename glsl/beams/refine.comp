@@ -67,7 +67,7 @@ layout(push_constant) uniform Push {
     uvec4 grid;   // x: this level; y: levels; z: base grid side; w: triangle capacity per list
     uvec4 config; // x: beam capacity; y: TIR_* remedy; z: Eq. 6.3.2 on; w: medium steps
     vec4 split;   // x: relative depth; y: cos of the normal angle; z: focus ratio; w: energy (W)
-    vec4 split2;  // x: camera-space angular size (rad); y: BEAMS_REFRACTION_* (uint bits)
+    vec4 split2;  // x: camera-space angular size (rad); y: BEAMS_REFRACTION_* (uint bits); z: extrusion cut-off
 } pc;
 
 #define STAT_ADD(word, value) atomicAdd(counters[word], value)
@@ -219,6 +219,31 @@ bool make_beam(vec3 p[3], vec3 d[3], vec3 flux, vec3 incident, float measure, ui
     vec3 f1 = e[1] - e[0], f2 = e[2] - e[0];
     vec3 area = 0.5 * vec3(dot(n, cross(b1, b2)), dot(n, cross(b1, f2) + cross(f1, b2)), dot(n, cross(f1, f2)));
     if (!(abs(area.x) > 0.0) || !(y_max > 0.0)) return false;
+    // The energy cut-off (Sect. 4.3): a divergent beam (|A(y)| growing
+    // from its base for all y > 0) is extruded only while its flux density
+    // Phi / |A(y)| stays above `cutoff` times that at its base, i.e. up to
+    // the height where |A(y)| = |A(0)| / cutoff: its far part, whose light
+    // is spread too thin to matter. Converging beams (a lens's, which
+    // spread again past their focus into the visible cone) are kept whole.
+    float cutoff = pc.split2.z;
+    bool divergent = area.x * area.y >= 0.0 && area.x * area.z >= 0.0;
+    if (cutoff > 0.0 && divergent) {
+        float target = area.x / cutoff; // same sign as A(0): A grows past it before any sign change
+        float c0 = area.x - target, c1 = area.y, c2 = area.z;
+        float y_cut = 1e30;
+        if (abs(c2) > 1e-12 * max(abs(c1), abs(c0))) {
+            float disc = c1 * c1 - 4.0 * c2 * c0;
+            if (disc >= 0.0) {
+                float r = sqrt(disc);
+                float ya = (-c1 - r) / (2.0 * c2), yb = (-c1 + r) / (2.0 * c2);
+                if (ya > 0.0) y_cut = ya;
+                if (yb > 0.0) y_cut = min(y_cut, yb);
+            }
+        } else if (c1 != 0.0 && -c0 / c1 > 0.0) {
+            y_cut = -c0 / c1;
+        }
+        y_max = min(y_max, y_cut);
+    }
     beam.v0 = vec4(v[0], y_max * 1.001);
     beam.v1 = vec4(v[1], uintBitsToFloat(pc.grid.x));
     beam.v2 = vec4(v[2], uintBitsToFloat(kind));

@@ -48,9 +48,7 @@
 //!
 //! Not implemented (documented limits): multiple bounces through further
 //! specular surfaces (Sect. 6; an edge ray passes through them), the
-//! energy cut-off of the
-//! extrusion length for divergent beams, the low-pass filter of the
-//! surface caustics; the flux is uniform across a beam (one area function
+//! low-pass filter of the surface caustics; the flux is uniform across a beam (one area function
 //! per beam, as in the paper; Fresnel and absorption factors averaged over
 //! its three vertices); the beam's base plane is normal to the mean edge
 //! direction rather than the surface triangle (an equivalent beam space
@@ -97,6 +95,8 @@ crate::declare_params! {
             "split (b): the beam carries more than this fraction of the flux of the light's whole view";
         split_camera: f32 [0.0, 10.0] = 0.05, rebuild,
             "split (c): the beam's cross-section at its central ray's point closest to the camera spans more than this angle (radians)";
+        extrusion_cutoff: f32 [0.0, 1.0] = 0.0, rebuild,
+            "energy cut-off of the extrusion (Sect. 4.3): a divergent beam ends where its flux density falls below this fraction of its base's (0: beams end at the first diffuse surface or the medium's bounds only)";
         volume: u32 [0, 1] = 1, rebuild,
             "bounding volumes (Sect. 4.3): 0 Ernst's prism, 1 the tight six-triangle hull (prism where it is not convex)";
         quadrature: u32 [1, 4] = 3, rebuild,
@@ -184,6 +184,7 @@ impl TechniqueBuild for Beams {
                 tir_remedy: params.tir_remedy,
                 eq_6_3_2: params.eq_6_3_2,
                 refraction: params.refraction,
+                extrusion_cutoff: params.extrusion_cutoff,
                 medium_steps: params.direct.medium_steps,
             },
             scene,

@@ -126,7 +126,7 @@ struct RefinePush {
     config: [u32; 4],
     /// relative depth, cos(normal angle), focus ratio, energy (W).
     split: [f32; 4],
-    /// camera angular size (rad); refraction (u32 bits).
+    /// camera angular size (rad); refraction (u32 bits); extrusion cut-off.
     split2: [f32; 4],
 }
 const _: () = assert!(size_of::<RefinePush>() == 128);
@@ -166,6 +166,8 @@ pub struct TracerSettings {
     pub eq_6_3_2: u32,
     /// `BEAMS_REFRACTION_*`.
     pub refraction: u32,
+    /// Extrusion cut-off (fraction of the base's flux density; 0: none).
+    pub extrusion_cutoff: f32,
     pub medium_steps: u32,
 }
 
@@ -416,7 +418,7 @@ impl BeamTracer {
                 split2: [
                     settings.split_camera,
                     f32::from_bits(settings.refraction),
-                    0.0,
+                    settings.extrusion_cutoff,
                     0.0,
                 ],
             },
