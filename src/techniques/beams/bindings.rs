@@ -22,6 +22,7 @@ pub const BEAMS_BINDING_VOLUME: u32 = 14;
 pub const BEAMS_BINDING_SURFACE: u32 = 15;
 pub const BEAMS_BINDING_OPAQUE_RADIANCE: u32 = 16;
 pub const BEAMS_BINDING_RADIANCE: u32 = 17;
+pub const BEAMS_BINDING_SURFACE_FILTERED: u32 = 18;
 
 /// Refinement levels at most (Sect. 4.2; the grid coordinates are stored
 /// at the finest level's resolution, base x 2^BEAMS_MAX_LEVELS).

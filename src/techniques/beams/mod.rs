@@ -41,14 +41,14 @@
 //!    receiver to the base) into the surface target.
 //!
 //! Per frame: "beam receivers" and "beam clear" before the lights, "beam
-//! apply" (surface caustics into the opaque frame) before the camera
+//! filter" (the paper's optional low-pass filter of the surface caustics,
+//! `surface_filter`), "beam apply" (surface caustics into the opaque frame) before the camera
 //! refraction, "beam composite" (volume caustics) after it, "airlight"
 //! last. Counters (beams and triangles per level, the dropped fraction,
 //! fragments) go to `bench --json` through `counters`.
 //!
 //! Not implemented (documented limits): multiple bounces through further
-//! specular surfaces (Sect. 6; an edge ray passes through them), the
-//! low-pass filter of the surface caustics; the flux is uniform across a beam (one area function
+//! specular surfaces (Sect. 6; an edge ray passes through them); the flux is uniform across a beam (one area function
 //! per beam, as in the paper; Fresnel and absorption factors averaged over
 //! its three vertices); the beam's base plane is normal to the mean edge
 //! direction rather than the surface triangle (an equivalent beam space
@@ -97,6 +97,8 @@ crate::declare_params! {
             "split (c): the beam's cross-section at its central ray's point closest to the camera spans more than this angle (radians)";
         extrusion_cutoff: f32 [0.0, 1.0] = 0.0, rebuild,
             "energy cut-off of the extrusion (Sect. 4.3): a divergent beam ends where its flux density falls below this fraction of its base's (0: beams end at the first diffuse surface or the medium's bounds only)";
+        surface_filter: u32 [0, 8] = 0, rebuild,
+            "low-pass filter of the surface caustics (Sect. 7): Gaussian radius in pixels over receivers of one surface (0: off)";
         volume: u32 [0, 1] = 1, rebuild,
             "bounding volumes (Sect. 4.3): 0 Ernst's prism, 1 the tight six-triangle hull (prism where it is not convex)";
         quadrature: u32 [1, 4] = 3, rebuild,
@@ -185,6 +187,7 @@ impl TechniqueBuild for Beams {
                 eq_6_3_2: params.eq_6_3_2,
                 refraction: params.refraction,
                 extrusion_cutoff: params.extrusion_cutoff,
+                surface_filter: params.surface_filter,
                 medium_steps: params.direct.medium_steps,
             },
             scene,

@@ -168,6 +168,8 @@ pub struct TracerSettings {
     pub refraction: u32,
     /// Extrusion cut-off (fraction of the base's flux density; 0: none).
     pub extrusion_cutoff: f32,
+    /// Low-pass filter radius of the surface caustics in pixels (0: none).
+    pub surface_filter: u32,
     pub medium_steps: u32,
 }
 
@@ -178,6 +180,9 @@ pub struct BeamTracer {
     pub volume: Image,
     /// Irradiance the beams deliver to the receiver each pixel sees (rgb).
     pub surface: Image,
+    /// The filter's intermediate (after the x pass).
+    surface_filtered: Image,
+    surface_filter: u32,
     triangles: [Buffer; 2],
     counters: Buffer,
     indirect: Buffer,
@@ -196,6 +201,7 @@ pub struct BeamTracer {
     receivers_pipeline: ComputePipeline,
     apply_pipeline: ComputePipeline,
     composite_pipeline: ComputePipeline,
+    filter_pipeline: ComputePipeline,
     volume_pipeline: GraphicsPipeline,
     set: DescriptorSet,
     bound_radiance: TargetBinding,
@@ -309,6 +315,7 @@ impl BeamTracer {
         };
         let volume = target("beam volume caustics")?;
         let surface_target = target("beam surface irradiance")?;
+        let surface_filtered = target("beam surface irradiance, filtered in x")?;
         use BindingKind::{Storage, StorageImage};
         let layout = DescriptorSetLayout::new(
             ctx,
@@ -331,6 +338,7 @@ impl BeamTracer {
                 (bb::BEAMS_BINDING_SURFACE, StorageImage),
                 (bb::BEAMS_BINDING_OPAQUE_RADIANCE, StorageImage),
                 (bb::BEAMS_BINDING_RADIANCE, StorageImage),
+                (bb::BEAMS_BINDING_SURFACE_FILTERED, StorageImage),
             ],
         )?;
         let set = DescriptorSet::new(ctx, &layout)?;
@@ -354,6 +362,7 @@ impl BeamTracer {
             .write_buffer(bb::BEAMS_BINDING_RECEIVERS, &receivers)
             .write_storage_image(bb::BEAMS_BINDING_VOLUME, &volume)
             .write_storage_image(bb::BEAMS_BINDING_SURFACE, &surface_target)
+            .write_storage_image(bb::BEAMS_BINDING_SURFACE_FILTERED, &surface_filtered)
             .write_storage_image(bb::BEAMS_BINDING_OPAQUE_RADIANCE, surface.opaque());
         let sets = [&scene_gpu.layout, &layout];
         let refine_pipeline = ComputePipeline::new(
@@ -367,6 +376,7 @@ impl BeamTracer {
         let receivers_pipeline = ComputePipeline::new(ctx, "beams/receivers.comp", &sets, 0)?;
         let apply_pipeline = ComputePipeline::new(ctx, "beams/apply.comp", &sets, 4)?;
         let composite_pipeline = ComputePipeline::new(ctx, "beams/composite.comp", &sets, 0)?;
+        let filter_pipeline = ComputePipeline::new(ctx, "beams/filter.comp", &sets, 8)?;
         // A constant density (or none) gets fragments compiled without the
         // density field's code (a CPU rasteriser pays for it in every
         // fragment, as volume_lines measured).
@@ -397,6 +407,8 @@ impl BeamTracer {
             beams,
             volume,
             surface: surface_target,
+            surface_filtered,
+            surface_filter: settings.surface_filter,
             triangles,
             counters,
             indirect,
@@ -440,6 +452,7 @@ impl BeamTracer {
             receivers_pipeline,
             apply_pipeline,
             composite_pipeline,
+            filter_pipeline,
             volume_pipeline,
             set,
             bound_radiance: TargetBinding::new(bb::BEAMS_BINDING_RADIANCE),
@@ -515,6 +528,50 @@ impl BeamTracer {
     /// (before the surface frame's refraction reads it).
     pub fn apply(&self, rec: &mut FrameRecorder, scene: &SceneGpu, surface: &SurfaceFrame) {
         let ctx = rec.ctx().clone();
+        if self.surface_filter > 0 {
+            let e = self.surface.extent();
+            let groups = [e.width.div_ceil(8), e.height.div_ceil(8), 1];
+            rec.pass("beam filter", |cmd| {
+                // x: the volumes' blended irradiance -> the intermediate
+                // (overwritten after last frame's y pass read it). Both
+                // images are bound writable in both passes (one shader
+                // picks the direction), so both are declared written.
+                barrier(
+                    &ctx,
+                    cmd,
+                    &[
+                        ImageAccess::new(&self.surface, Access::ComputeWrite),
+                        ImageAccess::discard(&self.surface_filtered, Access::ComputeWrite),
+                    ],
+                    &[BufferAccess::new(&self.receivers, Access::ComputeRead)],
+                );
+                let push = [self.surface_filter, 0];
+                self.filter_pipeline.dispatch(
+                    cmd,
+                    &[&scene.set, &self.set],
+                    bytemuck::cast_slice(&push),
+                    groups,
+                );
+                // y: the intermediate -> the surface target (read-after-
+                // write one way, write-after-read the other).
+                barrier(
+                    &ctx,
+                    cmd,
+                    &[
+                        ImageAccess::new(&self.surface_filtered, Access::ComputeWrite),
+                        ImageAccess::new(&self.surface, Access::ComputeWrite),
+                    ],
+                    &[],
+                );
+                let push = [self.surface_filter, 1];
+                self.filter_pipeline.dispatch(
+                    cmd,
+                    &[&scene.set, &self.set],
+                    bytemuck::cast_slice(&push),
+                    groups,
+                );
+            });
+        }
         rec.pass("beam apply", |cmd| {
             // The volumes' blended writes are read; the opaque frame was
             // written by direct lighting.
