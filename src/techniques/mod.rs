@@ -142,8 +142,8 @@ registry! {
     direct::Direct,
     image_space::ImageSpace,
     volume_lines::VolumeLines,
-    beams::Beams,
     water_photons::WaterPhotons,
+    beams::Beams,
 }
 
 pub fn find(name: &str) -> anyhow::Result<&'static TechniqueInfo> {
