@@ -154,6 +154,7 @@ registry! {
     image_space::ImageSpace,
     volume_lines::VolumeLines,
     water_photons::WaterPhotons,
+    beams::Beams,
 }
 
 pub fn find(name: &str) -> anyhow::Result<&'static TechniqueInfo> {

@@ -357,6 +357,27 @@ impl ComputePipeline {
                 .cmd_dispatch(cmd, groups[0], groups[1], groups[2])
         };
     }
+
+    /// Binds the pipeline and sets, pushes constants and dispatches the
+    /// `VkDispatchIndirectCommand` at byte `offset` of `args` (a
+    /// `StorageIndirect` buffer the caller has barriered to `IndirectRead`).
+    pub fn dispatch_indirect(
+        &self,
+        cmd: vk::CommandBuffer,
+        sets: &[&DescriptorSet],
+        push_data: &[u8],
+        args: &Buffer,
+        offset: u64,
+    ) {
+        let ctx = &self.ctx;
+        unsafe {
+            ctx.device
+                .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.raw)
+        };
+        bind_sets(ctx, cmd, vk::PipelineBindPoint::COMPUTE, self.layout, sets);
+        push(ctx, cmd, self.layout, push_data);
+        unsafe { ctx.device.cmd_dispatch_indirect(cmd, args.raw, offset) };
+    }
 }
 
 /// How a graphics pipeline is built. Geometry comes from storage buffers

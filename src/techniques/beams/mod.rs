@@ -1,0 +1,303 @@
+//! `beams`: adaptive caustic beams, surface and volume caustics in
+//! single-scattering media (Liktor & Dachsbacher 2011, "Real-Time Volume
+//! Caustics with Adaptive Beam Tracing"), over the shared surface frame.
+//!
+//! The frame is the paper's Fig. 8 sum, composed as `volume_lines` composes
+//! Hu's: the surface radiance (direct light from `passes::surface_frame`
+//! plus the beams' surface caustics, attenuated by the medium toward the
+//! eye), + airlight with volumetric shadows (`passes::airlight`), + the
+//! beams' volume caustics. Components `direct`, `surface_caustics`,
+//! `airlight`, `volume_caustics`, each writable alone.
+//!
+//! Per light (`passes::light_views`, the one per-light loop):
+//! 1. "light view": the light's front/back G-buffer of the specular objects
+//!    (Sect. 4.1's "caustic geometry buffers"; perspective from a point or
+//!    spot light, orthographic along a directional one).
+//! 2. "beam grid" + "beam refine" x (levels + 1) (glsl/beams/refine.comp):
+//!    the hierarchical projected grid (Sect. 4.1, `grid_size`^2 cells of two
+//!    triangles) refined adaptively (Sect. 4.2: discontinuity, focus or
+//!    energy, camera proximity) by one compute dispatch per level. The
+//!    paper's geometry shader with stream-out becomes its modern
+//!    equivalent: compute passes appending children and beams through
+//!    atomic counters, each next level and the draw sized by indirect
+//!    arguments a one-thread pass (args.comp) writes from the counters.
+//!    Final triangles become beams (Sects. 4.3, 6): the base at the first
+//!    specular interaction, edges by reflection and by two-sided
+//!    refraction (Wyman's, through the back faces of the light's
+//!    G-buffer, or exactly through the BVH: `refraction`), Fresnel splitting the flux; flux from the light's
+//!    radiometry (point: I times the exact solid angle of the base
+//!    triangle; spot: the integral of I over it; directional: E times the
+//!    projected area), times Fresnel and Beer-Lambert absorption and the
+//!    medium's transmittance from the light; the area function A(y).
+//! 3. "beam volumes" (volume.vert/geom/frag): one point per beam, drawn
+//!    indirect; the geometry shader extrudes the beam's bounding volume
+//!    (Ernst's prism, or the tight six-triangle hull with the prism as
+//!    fallback, `volume`), emitting only back faces so each covered pixel
+//!    gets one fragment; the fragment integrates the in-scattering over the
+//!    camera ray's exact interval inside the beam (Sect. 5, Gauss-Legendre,
+//!    `quadrature` points) into the volume target, and gathers the beam's
+//!    irradiance on the diffuse receiver the pixel sees (Sect. 5.3, a
+//!    point-in-beam test on the camera G-buffer, with a shadow ray from the
+//!    receiver to the base) into the surface target.
+//!
+//! Per frame: "beam receivers" and "beam clear" before the lights, "beam
+//! filter" (the paper's optional low-pass filter of the surface caustics,
+//! `surface_filter`), "beam apply" (surface caustics into the opaque frame) before the camera
+//! refraction, "beam composite" (volume caustics) after it, "airlight"
+//! last. Counters (beams and triangles per level, the dropped fraction,
+//! fragments) go to `bench --json` through `counters`.
+//!
+//! Not implemented (documented limits): multiple bounces through further
+//! specular surfaces (Sect. 6; an edge ray passes through them); the flux is uniform across a beam (one area function
+//! per beam, as in the paper; Fresnel and absorption factors averaged over
+//! its three vertices); the beam's base plane is normal to the mean edge
+//! direction rather than the surface triangle (an equivalent beam space
+//! that stays valid after two refractions); area lights give no caustics.
+
+pub mod bindings;
+mod tracer;
+
+pub use tracer::{BeamCounts, BeamTracer, GpuBeam};
+
+use super::{Technique, TechniqueBuild};
+use crate::frame::{FrameTargets, SceneGpu};
+use crate::params::{ParamSet, Params};
+use crate::passes::airlight::{Airlight, AirlightParams};
+use crate::passes::camera_refraction::RefractionPush;
+use crate::passes::direct_light::DirectParams;
+use crate::passes::light_views::LightViews;
+use crate::passes::surface_frame::SurfaceFrame;
+use crate::radiometry::Component;
+use crate::scene::{Light, Scene};
+use crate::vk::{Context, FrameRecorder};
+use std::sync::Arc;
+use tracer::TracerSettings;
+
+crate::declare_params! {
+    /// `beams`' parameters: the surface frame's and the airlight's, then
+    /// the beams' own (Sects. 4-5).
+    pub struct BeamsParams {
+        @group direct: DirectParams;
+        @group airlight: AirlightParams;
+        light_view_size: u32 [64, 2048] = 512, rebuild,
+            "light-space G-buffer resolution (texels per side) the projected grid's vertices sample";
+        grid_size: u32 [2, 64] = 16, rebuild,
+            "base projected grid: cells per side of the light's view (Sect. 4.1; two triangles per cell)";
+        levels: u32 [0, 5] = 3, rebuild,
+            "adaptive refinement levels (Sect. 4.2; 0: the regular grid alone)";
+        split_depth: f32 [0.001, 10.0] = 0.05, rebuild,
+            "split (a): depths (distance from the light) of a triangle's vertices differing by more than this fraction (a silhouette: dropped at the last level)";
+        split_normal: f32 [0.1, 180.0] = 15.0, rebuild,
+            "split (a): normals of a triangle's vertices differing by more than this angle (degrees)";
+        split_focus: f32 [0.0, 1.0] = 0.1, rebuild,
+            "split (b): the beam converges, its smallest cross-section |A(y)| below this fraction of its base's";
+        split_energy: f32 [0.0, 1.0] = 0.005, rebuild,
+            "split (b): the beam carries more than this fraction of the flux of the light's whole view";
+        split_camera: f32 [0.0, 10.0] = 0.05, rebuild,
+            "split (c): the beam's cross-section at its central ray's point closest to the camera spans more than this angle (radians)";
+        extrusion_cutoff: f32 [0.0, 1.0] = 0.0, rebuild,
+            "energy cut-off of the extrusion (Sect. 4.3): a divergent beam ends where its flux density falls below this fraction of its base's (0: beams end at the first diffuse surface or the medium's bounds only)";
+        surface_filter: u32 [0, 8] = 0, rebuild,
+            "low-pass filter of the surface caustics (Sect. 7): Gaussian radius in pixels over receivers of one surface (0: off)";
+        volume: u32 [0, 1] = 1, rebuild,
+            "bounding volumes (Sect. 4.3): 0 Ernst's prism, 1 the tight six-triangle hull (prism where it is not convex)";
+        quadrature: u32 [1, 4] = 3, rebuild,
+            "Gauss-Legendre points per interval of a camera ray inside a beam (Sect. 5)";
+        refraction: u32 [0, 1] = 0, rebuild,
+            "two-sided refraction (Sect. 6): 0 Wyman's image-space exit through the light view's back faces (the paper's approximate ray tracing), 1 exactly through the BVH (internal total reflections followed)";
+        tir_remedy: u32 [0, 2] = 1, rebuild,
+            "total internal reflection at the approximated exit of two-sided refraction (as image_space's): 0 single refraction, 1 clamp to the critical angle, 2 reflect";
+        eq_6_3_2: u32 [0, 1] = 1, rebuild,
+            "1: a missing back-face normal at the exit is replaced by Wyman's Eq. 6.3.2";
+        search_steps: u32 [4, 256] = 32, rebuild,
+            "linear steps of the camera refraction's image-space search (what the camera sees through glass)";
+        beam_capacity: u32 [1024, 4194304] = 262144, rebuild,
+            "beams per light at most (more are counted as overflow and not drawn)";
+    }
+}
+
+pub struct Beams {
+    /// The surface frame: shadows, G-buffers, direct light, camera refraction.
+    pub surface: SurfaceFrame,
+    /// Each light's view of the specular objects.
+    pub light_views: LightViews,
+    /// The beams, their volumes and the two caustic targets.
+    pub tracer: BeamTracer,
+    /// Airlight with volumetric shadows from the surface frame's shadow maps.
+    pub airlight: Airlight,
+    last_counts: Option<BeamCounts>,
+}
+
+impl TechniqueBuild for Beams {
+    const NAME: &'static str = "beams";
+    const DESCRIPTION: &'static str = "Liktor & Dachsbacher 2011: adaptive caustic beams from a hierarchical projected grid on the light's G-buffer, bounding volumes extruded by a geometry shader, in-scattering and surface caustics per fragment, plus ray-marched airlight";
+    const COMPONENTS: &'static [Component] = &[
+        Component::Direct,
+        Component::SurfaceCaustics,
+        Component::Airlight,
+        Component::VolumeCaustics,
+    ];
+    type Params = BeamsParams;
+
+    fn build(
+        ctx: &Arc<Context>,
+        params: &BeamsParams,
+        scene: &Scene,
+        scene_gpu: &SceneGpu,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<Self> {
+        let surface = SurfaceFrame::new(
+            ctx,
+            &params.direct,
+            scene,
+            scene_gpu,
+            width,
+            height,
+            RefractionPush {
+                tir_remedy: params.tir_remedy,
+                use_eq632: params.eq_6_3_2,
+                search_steps: params.search_steps,
+                pad: 0,
+            },
+        )?;
+        let light_views = LightViews::new(ctx, scene, scene_gpu, params.light_view_size)?;
+        let airlight = Airlight::new(
+            ctx,
+            &params.airlight,
+            params.direct.medium_steps,
+            scene,
+            scene_gpu,
+            surface.shadows(),
+        )?;
+        let tracer = BeamTracer::new(
+            ctx,
+            &TracerSettings {
+                grid_size: params.grid_size,
+                levels: params.levels,
+                split_depth: params.split_depth,
+                split_normal_deg: params.split_normal,
+                split_focus: params.split_focus,
+                split_energy: params.split_energy,
+                split_camera: params.split_camera,
+                volume: params.volume,
+                quadrature: params.quadrature,
+                beam_capacity: params.beam_capacity,
+                tir_remedy: params.tir_remedy,
+                eq_6_3_2: params.eq_6_3_2,
+                refraction: params.refraction,
+                extrusion_cutoff: params.extrusion_cutoff,
+                surface_filter: params.surface_filter,
+                medium_steps: params.direct.medium_steps,
+            },
+            scene,
+            scene_gpu,
+            &light_views.gbuffer,
+            params.light_view_size,
+            &surface,
+            width,
+            height,
+        )?;
+        Ok(Self {
+            surface,
+            light_views,
+            tracer,
+            airlight,
+            last_counts: None,
+        })
+    }
+}
+
+impl Beams {
+    /// The counters of the last completed frame.
+    pub fn counts(&self) -> Option<BeamCounts> {
+        self.last_counts
+    }
+}
+
+impl Technique for Beams {
+    fn name(&self) -> &'static str {
+        Self::NAME
+    }
+
+    fn update_live(&mut self, params: &Params) -> anyhow::Result<bool> {
+        let params = BeamsParams::from_params(params)?;
+        self.surface.set_live(&params.direct, params.search_steps);
+        self.airlight.set_live(&params.airlight);
+        Ok(true)
+    }
+
+    fn record(
+        &mut self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        targets: &FrameTargets,
+    ) -> crate::vk::VkResult<()> {
+        self.surface.record_opaque(rec, scene)?;
+        self.tracer.begin(rec, scene, &self.surface, targets);
+        self.light_views.record(rec, scene, &mut [&mut self.tracer]);
+        self.tracer.apply(rec, scene, &self.surface);
+        self.surface.record_refraction(rec, scene, targets);
+        self.tracer.composite(rec, scene, targets);
+        self.airlight
+            .record(rec, scene, self.surface.shadows(), &targets.radiance);
+        Ok(())
+    }
+
+    fn set_lights(&mut self, lights: &[Light]) -> bool {
+        if !(self.surface.set_lights(lights) && self.light_views.set_lights(lights)) {
+            return false;
+        }
+        self.tracer
+            .set_lights(self.light_views.lights(), self.light_views.specular());
+        true
+    }
+
+    fn after_frame(&mut self, slot: usize) -> crate::vk::VkResult<()> {
+        let counts = self.tracer.counts(slot)?;
+        if counts.beam_overflow > 0 || counts.triangle_overflow > 0 {
+            log::warn!(
+                "beams: {} beams and {} split triangles did not fit (raise beam_capacity)",
+                counts.beam_overflow,
+                counts.triangle_overflow
+            );
+        }
+        self.last_counts = Some(counts);
+        Ok(())
+    }
+
+    fn counters(&self) -> Vec<(&'static str, u64)> {
+        const BEAMS: [&str; 6] = [
+            "beams_level0",
+            "beams_level1",
+            "beams_level2",
+            "beams_level3",
+            "beams_level4",
+            "beams_level5",
+        ];
+        const TRIS: [&str; 6] = [
+            "triangles_level0",
+            "triangles_level1",
+            "triangles_level2",
+            "triangles_level3",
+            "triangles_level4",
+            "triangles_level5",
+        ];
+        let Some(c) = self.last_counts else {
+            return Vec::new();
+        };
+        let mut out = vec![("beams", c.total_beams() as u64)];
+        for l in 0..6 {
+            out.push((BEAMS[l], c.beams[l] as u64));
+            out.push((TRIS[l], c.triangles[l] as u64));
+        }
+        out.push((
+            "dropped_per_million",
+            (c.dropped_fraction() as f64 * 1e6).round() as u64,
+        ));
+        out.push(("fragments", c.fragments as u64));
+        out.push(("beam_overflow", c.beam_overflow as u64));
+        out.push(("triangle_overflow", c.triangle_overflow as u64));
+        out
+    }
+}

@@ -1,0 +1,782 @@
+//! The beams themselves: per light, the adaptive projected grid ("beam
+//! refine", one compute level at a time, driven by indirect arguments) and
+//! the beams' bounding volumes ("beam volumes", one indirect draw); per
+//! frame, "beam receivers" and "beam clear" before the lights, "beam apply"
+//! (surface caustics into the opaque frame) and "beam composite" (volume
+//! caustics into the frame) after them, and the counters' copy to the host.
+//! The module doc of `beams` has the method.
+
+use super::bindings as bb;
+use crate::frame::{FrameTargets, SceneGpu};
+use crate::passes::light_views::{LightView, LightViewConsumer};
+use crate::passes::specular_gbuffer::SpecularGBuffer;
+use crate::passes::surface_frame::SurfaceFrame;
+use crate::passes::light_views::photon_view;
+use crate::scene::{Density, Light, LightKind, Scene};
+use crate::vk::{
+    barrier, begin_rendering, end_rendering, Access, BindingKind, Buffer, BufferAccess,
+    BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder,
+    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageAccess, ImageDesc, TargetBinding,
+    VkResult, MAX_FRAMES_IN_FLIGHT,
+};
+use ash::vk;
+use bytemuck::{Pod, Zeroable};
+use std::mem::size_of;
+use std::sync::Arc;
+
+/// One beam, mirrored by `Beam` in glsl/beams/beam.glsl (which documents
+/// the fields).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuBeam {
+    /// Base vertices; w: y_max, level (u32 bits), kind (u32 bits).
+    pub v: [[f32; 4]; 3],
+    /// Edge directions scaled to dot(e, n) = 1.
+    pub e: [[f32; 4]; 3],
+    /// Base plane normal; w: its offset.
+    pub n: [f32; 4],
+    /// A(y) coefficients; w: measure of the incident triangle (sr or m^2).
+    pub area: [f32; 4],
+    /// rgb flux (W).
+    pub flux: [f32; 4],
+    /// rgb flux entering the base triangle (W).
+    pub incident: [f32; 4],
+}
+const _: () = assert!(size_of::<GpuBeam>() == 160);
+
+impl GpuBeam {
+    pub fn level(&self) -> u32 {
+        self.v[1][3].to_bits()
+    }
+    pub fn kind(&self) -> u32 {
+        self.v[2][3].to_bits()
+    }
+    /// A(y), the cross-section parallel to the base at height y (m^2, signed).
+    pub fn area_at(&self, y: f32) -> f32 {
+        self.area[0] + self.area[1] * y + self.area[2] * y * y
+    }
+}
+
+/// The counters of one frame, summed over its lights (`bench --json`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BeamCounts {
+    /// Triangles the oracle looked at, per level.
+    pub triangles: [u32; 6],
+    /// Beams emitted, per level.
+    pub beams: [u32; 6],
+    pub beam_overflow: u32,
+    pub triangle_overflow: u32,
+    /// Measure (sr, or m^2 for directional light) of the kept base
+    /// triangles and of those dropped at silhouettes.
+    pub kept_measure: f32,
+    pub dropped_measure: f32,
+    /// Luminance flux (W) entering the kept triangles and carried by the beams.
+    pub flux_in: f32,
+    pub flux_out: f32,
+    /// Fragments of the bounding volumes.
+    pub fragments: u32,
+}
+
+impl BeamCounts {
+    fn from_words(w: &[u32]) -> Self {
+        let word = |i: u32| w[i as usize];
+        let float = |i: u32| f32::from_bits(w[i as usize]);
+        let mut c = BeamCounts::default();
+        for l in 0..6 {
+            c.triangles[l] = word(bb::BEAMS_STAT_TRIS + l as u32);
+            c.beams[l] = word(bb::BEAMS_STAT_BEAMS + l as u32);
+        }
+        c.beam_overflow = word(bb::BEAMS_STAT_BEAM_OVERFLOW);
+        c.triangle_overflow = word(bb::BEAMS_STAT_TRI_OVERFLOW);
+        c.kept_measure = float(bb::BEAMS_STAT_KEPT_MEASURE);
+        c.dropped_measure = float(bb::BEAMS_STAT_DROPPED_MEASURE);
+        c.flux_in = float(bb::BEAMS_STAT_FLUX_IN);
+        c.flux_out = float(bb::BEAMS_STAT_FLUX_OUT);
+        c.fragments = word(bb::BEAMS_STAT_FRAGMENTS);
+        c
+    }
+
+    pub fn total_beams(&self) -> u32 {
+        self.beams.iter().sum()
+    }
+
+    /// The fraction of the grid's measure on the specular surfaces that
+    /// was dropped at silhouettes.
+    pub fn dropped_fraction(&self) -> f32 {
+        let all = self.kept_measure + self.dropped_measure;
+        if all > 0.0 {
+            self.dropped_measure / all
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Push constants of refine.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct RefinePush {
+    origin: [f32; 4],
+    right: [f32; 4],
+    up: [f32; 4],
+    forward: [f32; 4],
+    /// level, levels, base grid side, triangle capacity.
+    grid: [u32; 4],
+    /// beam capacity, TIR remedy, Eq. 6.3.2, medium steps.
+    config: [u32; 4],
+    /// relative depth, cos(normal angle), focus ratio, energy (W).
+    split: [f32; 4],
+    /// camera angular size (rad); refraction (u32 bits); extrusion cut-off.
+    split2: [f32; 4],
+}
+const _: () = assert!(size_of::<RefinePush>() == 128);
+
+/// Push constants of args.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct ArgsPush {
+    triangle_capacity: u32,
+    beam_capacity: u32,
+}
+
+/// Push constants of the volume pass (glsl/beams/volume_push.glsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct VolumePush {
+    volume_kind: u32,
+    quadrature: u32,
+    medium_steps: u32,
+    pad: u32,
+}
+
+/// What `BeamTracer` takes from the technique's parameters.
+pub struct TracerSettings {
+    pub grid_size: u32,
+    pub levels: u32,
+    pub split_depth: f32,
+    pub split_normal_deg: f32,
+    pub split_focus: f32,
+    /// Fraction of the light view's flux above which a beam is split.
+    pub split_energy: f32,
+    pub split_camera: f32,
+    pub volume: u32,
+    pub quadrature: u32,
+    pub beam_capacity: u32,
+    pub tir_remedy: u32,
+    pub eq_6_3_2: u32,
+    /// `BEAMS_REFRACTION_*`.
+    pub refraction: u32,
+    /// Extrusion cut-off (fraction of the base's flux density; 0: none).
+    pub extrusion_cutoff: f32,
+    /// Low-pass filter radius of the surface caustics in pixels (0: none).
+    pub surface_filter: u32,
+    pub medium_steps: u32,
+}
+
+pub struct BeamTracer {
+    /// The beams of the last light recorded.
+    pub beams: Buffer,
+    /// The volume caustics alone (rgb, component-weighted; a: fragments).
+    pub volume: Image,
+    /// Irradiance the beams deliver to the receiver each pixel sees (rgb).
+    pub surface: Image,
+    /// The filter's intermediate (after the x pass).
+    surface_filtered: Image,
+    surface_filter: u32,
+    triangles: [Buffer; 2],
+    counters: Buffer,
+    indirect: Buffer,
+    receivers: Buffer,
+    readbacks: Vec<Buffer>,
+    refine: RefinePush,
+    args: ArgsPush,
+    volume_push: VolumePush,
+    /// Light flux of a whole view (luminance W, per light): the energy
+    /// criterion's reference.
+    view_flux: Vec<f32>,
+    split_energy: f32,
+    light_view_size: u32,
+    refine_pipeline: ComputePipeline,
+    args_pipeline: ComputePipeline,
+    receivers_pipeline: ComputePipeline,
+    apply_pipeline: ComputePipeline,
+    composite_pipeline: ComputePipeline,
+    filter_pipeline: ComputePipeline,
+    volume_pipeline: GraphicsPipeline,
+    set: DescriptorSet,
+    bound_radiance: TargetBinding,
+    _layout: DescriptorSetLayout,
+}
+
+fn luminance(c: glam::Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+/// The energy criterion's reference per light: the flux of its whole view
+/// of the specular objects (luminance W: its intensity times the view's
+/// solid angle, or its irradiance times the view's area).
+fn view_fluxes(lights: &[Light], specular: Option<(glam::Vec3, f32)>, size: u32) -> Vec<f32> {
+    lights
+        .iter()
+        .take(crate::shader_bindings::MAX_LIGHTS as usize)
+        .enumerate()
+        .map(|(l, light)| {
+            let Some(v) = specular.and_then(|s| photon_view(light, l as u32, s, size)) else {
+                return 0.0;
+            };
+            let h = v.origin[3];
+            let measure = match light.kind {
+                LightKind::Directional => 4.0 * h * h,
+                // Solid angle of the square [-h, h]^2 of the tan plane.
+                _ => 4.0 * (h * h / (1.0 + 2.0 * h * h).sqrt()).asin(),
+            };
+            luminance(light.intensity) * measure
+        })
+        .collect()
+}
+
+impl BeamTracer {
+    /// The scene's lights moved: the energy criterion follows their views.
+    pub fn set_lights(&mut self, lights: &[Light], specular: Option<(glam::Vec3, f32)>) {
+        self.view_flux = view_fluxes(lights, specular, self.light_view_size);
+    }
+
+    /// Frames of `width` x `height`; `light_view` is the light views'
+    /// G-buffer, `surface` the frame the caustics add to.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        ctx: &Arc<Context>,
+        settings: &TracerSettings,
+        scene: &Scene,
+        scene_gpu: &SceneGpu,
+        light_view: &SpecularGBuffer,
+        light_view_size: u32,
+        surface: &SurfaceFrame,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<Self> {
+        let base = settings.grid_size;
+        // Each level holds at most 4x the previous one's; the lists are
+        // sized for the deepest level (bounded by the beam capacity: a
+        // level with more triangles than beams fits cannot be drawn anyway).
+        let full = 2 * (base as u64).pow(2) * 4u64.pow(settings.levels);
+        let triangle_capacity = full.min(settings.beam_capacity as u64).max(2 * (base as u64).pow(2)) as u32;
+        let triangles = [
+            Buffer::new(ctx, "beam triangles A", triangle_capacity as u64 * 16, BufferUsage::Storage)?,
+            Buffer::new(ctx, "beam triangles B", triangle_capacity as u64 * 16, BufferUsage::Storage)?,
+        ];
+        let beams = Buffer::new(
+            ctx,
+            "beams",
+            settings.beam_capacity as u64 * size_of::<GpuBeam>() as u64,
+            BufferUsage::Storage,
+        )?;
+        let counters = Buffer::new(
+            ctx,
+            "beam counters",
+            bb::BEAMS_COUNTER_WORDS as u64 * 4,
+            BufferUsage::Storage,
+        )?;
+        let indirect = Buffer::new(
+            ctx,
+            "beam indirect arguments",
+            bb::BEAMS_INDIRECT_WORDS as u64 * 4,
+            BufferUsage::StorageIndirect,
+        )?;
+        let receivers = Buffer::new(
+            ctx,
+            "beam receivers",
+            width as u64 * height as u64 * 32,
+            BufferUsage::Storage,
+        )?;
+        let readbacks = (0..MAX_FRAMES_IN_FLIGHT)
+            .map(|_| {
+                Buffer::with_data(
+                    ctx,
+                    "beam counters readback",
+                    &[0u32; bb::BEAMS_COUNTER_WORDS as usize],
+                    BufferUsage::Readback,
+                )
+            })
+            .collect::<VkResult<Vec<_>>>()?;
+        let target = |name: &str| {
+            Image::new(
+                ctx,
+                name,
+                ImageDesc::new_2d(
+                    width,
+                    height,
+                    vk::Format::R32G32B32A32_SFLOAT,
+                    vk::ImageUsageFlags::COLOR_ATTACHMENT
+                        | vk::ImageUsageFlags::STORAGE
+                        | vk::ImageUsageFlags::TRANSFER_SRC,
+                ),
+            )
+        };
+        let volume = target("beam volume caustics")?;
+        let surface_target = target("beam surface irradiance")?;
+        let surface_filtered = target("beam surface irradiance, filtered in x")?;
+        use BindingKind::{Storage, StorageImage};
+        let layout = DescriptorSetLayout::new(
+            ctx,
+            &[
+                (bb::BEAMS_BINDING_TRIANGLES_A, Storage),
+                (bb::BEAMS_BINDING_TRIANGLES_B, Storage),
+                (bb::BEAMS_BINDING_BEAMS, Storage),
+                (bb::BEAMS_BINDING_COUNTERS, Storage),
+                (bb::BEAMS_BINDING_INDIRECT, Storage),
+                (bb::BEAMS_BINDING_FRONT_POSITION, StorageImage),
+                (bb::BEAMS_BINDING_FRONT_NORMAL, StorageImage),
+                (bb::BEAMS_BINDING_BACK_POSITION, StorageImage),
+                (bb::BEAMS_BINDING_BACK_NORMAL, StorageImage),
+                (bb::BEAMS_BINDING_OPAQUE_POSITION, StorageImage),
+                (bb::BEAMS_BINDING_OPAQUE_NORMAL, StorageImage),
+                (bb::BEAMS_BINDING_OPAQUE_ALBEDO, StorageImage),
+                (bb::BEAMS_BINDING_SPECULAR_POSITION, StorageImage),
+                (bb::BEAMS_BINDING_RECEIVERS, Storage),
+                (bb::BEAMS_BINDING_VOLUME, StorageImage),
+                (bb::BEAMS_BINDING_SURFACE, StorageImage),
+                (bb::BEAMS_BINDING_OPAQUE_RADIANCE, StorageImage),
+                (bb::BEAMS_BINDING_RADIANCE, StorageImage),
+                (bb::BEAMS_BINDING_SURFACE_FILTERED, StorageImage),
+            ],
+        )?;
+        let set = DescriptorSet::new(ctx, &layout)?;
+        let g = surface.gbuffer();
+        set.write_buffer(bb::BEAMS_BINDING_TRIANGLES_A, &triangles[0])
+            .write_buffer(bb::BEAMS_BINDING_TRIANGLES_B, &triangles[1])
+            .write_buffer(bb::BEAMS_BINDING_BEAMS, &beams)
+            .write_buffer(bb::BEAMS_BINDING_COUNTERS, &counters)
+            .write_buffer(bb::BEAMS_BINDING_INDIRECT, &indirect)
+            .write_storage_image(bb::BEAMS_BINDING_FRONT_POSITION, &light_view.front_position)
+            .write_storage_image(bb::BEAMS_BINDING_FRONT_NORMAL, &light_view.front_normal)
+            .write_storage_image(bb::BEAMS_BINDING_BACK_POSITION, &light_view.back_position)
+            .write_storage_image(bb::BEAMS_BINDING_BACK_NORMAL, &light_view.back_normal)
+            .write_storage_image(bb::BEAMS_BINDING_OPAQUE_POSITION, &g.position)
+            .write_storage_image(bb::BEAMS_BINDING_OPAQUE_NORMAL, &g.normal)
+            .write_storage_image(bb::BEAMS_BINDING_OPAQUE_ALBEDO, &g.albedo)
+            .write_storage_image(
+                bb::BEAMS_BINDING_SPECULAR_POSITION,
+                &surface.specular().front_position,
+            )
+            .write_buffer(bb::BEAMS_BINDING_RECEIVERS, &receivers)
+            .write_storage_image(bb::BEAMS_BINDING_VOLUME, &volume)
+            .write_storage_image(bb::BEAMS_BINDING_SURFACE, &surface_target)
+            .write_storage_image(bb::BEAMS_BINDING_SURFACE_FILTERED, &surface_filtered)
+            .write_storage_image(bb::BEAMS_BINDING_OPAQUE_RADIANCE, surface.opaque());
+        let sets = [&scene_gpu.layout, &layout];
+        let refine_pipeline = ComputePipeline::new(
+            ctx,
+            "beams/refine.comp",
+            &sets,
+            size_of::<RefinePush>() as u32,
+        )?;
+        let args_pipeline =
+            ComputePipeline::new(ctx, "beams/args.comp", &sets, size_of::<ArgsPush>() as u32)?;
+        let receivers_pipeline = ComputePipeline::new(ctx, "beams/receivers.comp", &sets, 0)?;
+        let apply_pipeline = ComputePipeline::new(ctx, "beams/apply.comp", &sets, 4)?;
+        let composite_pipeline = ComputePipeline::new(ctx, "beams/composite.comp", &sets, 0)?;
+        let filter_pipeline = ComputePipeline::new(ctx, "beams/filter.comp", &sets, 8)?;
+        // A constant density (or none) gets fragments compiled without the
+        // density field's code (a CPU rasteriser pays for it in every
+        // fragment, as volume_lines measured).
+        let homogeneous = scene
+            .medium
+            .as_ref()
+            .is_none_or(|m| matches!(m.density, Density::Constant(_)));
+        let fragment = if homogeneous {
+            "beams/volume_homogeneous.frag"
+        } else {
+            "beams/volume.frag"
+        };
+        let mut desc = GraphicsPipelineDesc::new("beams/volume.vert", fragment);
+        desc.geometry = Some("beams/volume.geom");
+        desc.color_formats = vec![vk::Format::R32G32B32A32_SFLOAT; 2];
+        desc.additive = true;
+        desc.topology = vk::PrimitiveTopology::POINT_LIST;
+        desc.push_size = size_of::<VolumePush>() as u32;
+        let volume_pipeline = GraphicsPipeline::new(ctx, &desc, &sets)?;
+
+        let view_flux = view_fluxes(
+            &scene.lights,
+            crate::passes::light_views::specular_bounds(scene),
+            light_view_size,
+        );
+        let cos_normal = settings.split_normal_deg.to_radians().cos();
+        Ok(Self {
+            beams,
+            volume,
+            surface: surface_target,
+            surface_filtered,
+            surface_filter: settings.surface_filter,
+            triangles,
+            counters,
+            indirect,
+            receivers,
+            readbacks,
+            refine: RefinePush {
+                origin: [0.0; 4],
+                right: [0.0; 4],
+                up: [0.0; 4],
+                forward: [0.0; 4],
+                grid: [0, settings.levels, base, triangle_capacity],
+                config: [
+                    settings.beam_capacity,
+                    settings.tir_remedy,
+                    settings.eq_6_3_2,
+                    settings.medium_steps,
+                ],
+                split: [settings.split_depth, cos_normal, settings.split_focus, 0.0],
+                split2: [
+                    settings.split_camera,
+                    f32::from_bits(settings.refraction),
+                    settings.extrusion_cutoff,
+                    0.0,
+                ],
+            },
+            args: ArgsPush {
+                triangle_capacity,
+                beam_capacity: settings.beam_capacity,
+            },
+            volume_push: VolumePush {
+                volume_kind: settings.volume,
+                quadrature: settings.quadrature,
+                medium_steps: settings.medium_steps,
+                pad: 0,
+            },
+            view_flux,
+            split_energy: settings.split_energy,
+            light_view_size,
+            refine_pipeline,
+            args_pipeline,
+            receivers_pipeline,
+            apply_pipeline,
+            composite_pipeline,
+            filter_pipeline,
+            volume_pipeline,
+            set,
+            bound_radiance: TargetBinding::new(bb::BEAMS_BINDING_RADIANCE),
+            _layout: layout,
+        })
+    }
+
+    /// The counters of the frame that ran in `slot`, once its fence has signalled.
+    pub fn counts(&self, slot: usize) -> VkResult<BeamCounts> {
+        let words: Vec<u32> = self.readbacks[slot].download_pod()?;
+        Ok(BeamCounts::from_words(&words))
+    }
+
+    /// Records "beam receivers" and "beam clear", before the lights' passes
+    /// (after `surface.record_opaque`).
+    pub fn begin(
+        &mut self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        surface: &SurfaceFrame,
+        targets: &FrameTargets,
+    ) {
+        self.bound_radiance.bind(rec, &self.set, &targets.radiance);
+        let ctx = rec.ctx().clone();
+        rec.pass("beam receivers", |cmd| {
+            // The camera G-buffers were written by rasterisation; the
+            // receivers are overwritten after last frame's fragments.
+            barrier(
+                &ctx,
+                cmd,
+                &[
+                    ImageAccess::new(&surface.gbuffer().position, Access::ComputeRead),
+                    ImageAccess::new(&surface.gbuffer().normal, Access::ComputeRead),
+                    ImageAccess::new(&surface.specular().front_position, Access::ComputeRead),
+                ],
+                &[BufferAccess::new(&self.receivers, Access::ComputeWrite)],
+            );
+            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
+            self.receivers_pipeline
+                .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
+        });
+        rec.pass("beam clear", |cmd| {
+            // The frame's statistics start from zero (after last frame's
+            // copy to the host); both targets are cleared.
+            barrier(
+                &ctx,
+                cmd,
+                &[
+                    ImageAccess::discard(&self.volume, Access::ColorAttachment),
+                    ImageAccess::discard(&self.surface, Access::ColorAttachment),
+                ],
+                &[BufferAccess::new(&self.counters, Access::TransferWrite)],
+            );
+            unsafe {
+                ctx.device
+                    .cmd_fill_buffer(cmd, self.counters.raw, 0, vk::WHOLE_SIZE, 0)
+            };
+            begin_rendering(
+                &ctx,
+                cmd,
+                self.volume.extent(),
+                &[
+                    (self.volume.view, Some([0.0; 4])),
+                    (self.surface.view, Some([0.0; 4])),
+                ],
+                None,
+            );
+            end_rendering(&ctx, cmd);
+        });
+    }
+
+    /// Records "beam apply": the surface caustics into the opaque frame
+    /// (before the surface frame's refraction reads it).
+    pub fn apply(&self, rec: &mut FrameRecorder, scene: &SceneGpu, surface: &SurfaceFrame) {
+        let ctx = rec.ctx().clone();
+        if self.surface_filter > 0 {
+            let e = self.surface.extent();
+            let groups = [e.width.div_ceil(8), e.height.div_ceil(8), 1];
+            rec.pass("beam filter", |cmd| {
+                // x: the volumes' blended irradiance -> the intermediate
+                // (overwritten after last frame's y pass read it). Both
+                // images are bound writable in both passes (one shader
+                // picks the direction), so both are declared written.
+                barrier(
+                    &ctx,
+                    cmd,
+                    &[
+                        ImageAccess::new(&self.surface, Access::ComputeWrite),
+                        ImageAccess::discard(&self.surface_filtered, Access::ComputeWrite),
+                    ],
+                    &[BufferAccess::new(&self.receivers, Access::ComputeRead)],
+                );
+                let push = [self.surface_filter, 0];
+                self.filter_pipeline.dispatch(
+                    cmd,
+                    &[&scene.set, &self.set],
+                    bytemuck::cast_slice(&push),
+                    groups,
+                );
+                // y: the intermediate -> the surface target (read-after-
+                // write one way, write-after-read the other).
+                barrier(
+                    &ctx,
+                    cmd,
+                    &[
+                        ImageAccess::new(&self.surface_filtered, Access::ComputeWrite),
+                        ImageAccess::new(&self.surface, Access::ComputeWrite),
+                    ],
+                    &[],
+                );
+                let push = [self.surface_filter, 1];
+                self.filter_pipeline.dispatch(
+                    cmd,
+                    &[&scene.set, &self.set],
+                    bytemuck::cast_slice(&push),
+                    groups,
+                );
+            });
+        }
+        rec.pass("beam apply", |cmd| {
+            // The volumes' blended writes are read; the opaque frame was
+            // written by direct lighting.
+            barrier(
+                &ctx,
+                cmd,
+                &[
+                    ImageAccess::new(&self.surface, Access::ComputeRead),
+                    ImageAccess::new(&surface.gbuffer().position, Access::ComputeRead),
+                    ImageAccess::new(&surface.gbuffer().albedo, Access::ComputeRead),
+                    ImageAccess::new(surface.opaque(), Access::ComputeWrite),
+                ],
+                &[],
+            );
+            let e = surface.opaque().extent();
+            let groups = [e.width.div_ceil(8), e.height.div_ceil(8), 1];
+            self.apply_pipeline.dispatch(
+                cmd,
+                &[&scene.set, &self.set],
+                bytemuck::bytes_of(&self.volume_push.medium_steps),
+                groups,
+            );
+        });
+    }
+
+    /// Records "beam composite" (the volume caustics added to the frame's
+    /// radiance, after the refraction wrote it) and the counters' copy to
+    /// this frame's read-back buffer.
+    pub fn composite(&self, rec: &mut FrameRecorder, scene: &SceneGpu, targets: &FrameTargets) {
+        let ctx = rec.ctx().clone();
+        let readback = &self.readbacks[rec.slot()];
+        rec.pass("beam composite", |cmd| {
+            barrier(
+                &ctx,
+                cmd,
+                &[
+                    ImageAccess::new(&self.volume, Access::ComputeRead),
+                    ImageAccess::new(&targets.radiance, Access::ComputeWrite),
+                ],
+                &[
+                    BufferAccess::new(&self.counters, Access::TransferRead),
+                    BufferAccess::new(readback, Access::TransferWrite),
+                ],
+            );
+            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
+            self.composite_pipeline
+                .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
+            let region = vk::BufferCopy::default().size(self.counters.size);
+            unsafe {
+                ctx.device
+                    .cmd_copy_buffer(cmd, self.counters.raw, readback.raw, &[region])
+            };
+            barrier(
+                &ctx,
+                cmd,
+                &[],
+                &[BufferAccess::new(readback, Access::HostRead)],
+            );
+        });
+    }
+}
+
+impl LightViewConsumer for BeamTracer {
+    fn reads_gbuffer(&self) -> bool {
+        true
+    }
+
+    /// Records "beam refine" (levels 0..=levels, each followed by its
+    /// indirect arguments) and "beam volumes" for one light.
+    fn record_light(
+        &mut self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        light: usize,
+        view: &LightView,
+        light_view: &SpecularGBuffer,
+    ) {
+        let ctx = rec.ctx().clone();
+        let base = self.refine.grid[2];
+        let first = 2 * base * base;
+        let mut push = self.refine;
+        push.origin = view.origin;
+        push.right = view.right;
+        push.up = view.up;
+        push.forward = view.forward;
+        push.split[3] = self.split_energy * self.view_flux.get(light).copied().unwrap_or(0.0);
+        rec.pass("beam grid", |cmd| {
+            // This light's counts and level-0 arguments start anew, after
+            // the previous light's draw read them (write-after-read).
+            barrier(
+                &ctx,
+                cmd,
+                &[],
+                &[
+                    BufferAccess::new(&self.counters, Access::TransferWrite),
+                    BufferAccess::new(&self.indirect, Access::TransferWrite),
+                ],
+            );
+            let mut light_words = [0u32; bb::BEAMS_COUNTER_LIGHT_WORDS as usize];
+            light_words[bb::BEAMS_COUNTER_TRIS as usize] = first;
+            let mut args = [0u32; bb::BEAMS_INDIRECT_WORDS as usize];
+            args[0] = first.div_ceil(bb::BEAMS_REFINE_GROUP);
+            args[1] = 1;
+            args[2] = 1;
+            unsafe {
+                ctx.device.cmd_update_buffer(
+                    cmd,
+                    self.counters.raw,
+                    0,
+                    bytemuck::cast_slice(&light_words),
+                );
+                ctx.device
+                    .cmd_update_buffer(cmd, self.indirect.raw, 0, bytemuck::cast_slice(&args));
+            }
+        });
+        for level in 0..=self.refine.grid[1] {
+            push.grid[0] = level;
+            rec.pass("beam refine", |cmd| {
+                // The level's arguments as indirect dispatch; the counters,
+                // lists and beams by atomics; the light view's attachments
+                // as storage reads; the BVH after any refit.
+                barrier(
+                    &ctx,
+                    cmd,
+                    &light_view.compute_reads(),
+                    &[
+                        BufferAccess::new(&self.indirect, Access::IndirectRead),
+                        BufferAccess::new(&self.counters, Access::ComputeWrite),
+                        BufferAccess::new(&self.triangles[0], Access::ComputeWrite),
+                        BufferAccess::new(&self.triangles[1], Access::ComputeWrite),
+                        BufferAccess::new(&self.beams, Access::ComputeWrite),
+                        BufferAccess::new(&scene.triangles, Access::ComputeRead),
+                    ],
+                );
+                self.refine_pipeline.dispatch_indirect(
+                    cmd,
+                    &[&scene.set, &self.set],
+                    bytemuck::bytes_of(&push),
+                    &self.indirect,
+                    12 * level as u64,
+                );
+                // The next level's arguments (and the draw's) from the
+                // counts this level appended (read-after-write), written
+                // after this level's indirect read (write-after-read).
+                barrier(
+                    &ctx,
+                    cmd,
+                    &[],
+                    &[
+                        BufferAccess::new(&self.counters, Access::ComputeRead),
+                        BufferAccess::new(&self.indirect, Access::ComputeWrite),
+                    ],
+                );
+                self.args_pipeline.dispatch(
+                    cmd,
+                    &[&scene.set, &self.set],
+                    bytemuck::bytes_of(&self.args),
+                    [1, 1, 1],
+                );
+            });
+        }
+        rec.pass("beam volumes", |cmd| {
+            // Beams pulled by the geometry shader and read again by the
+            // fragments; the draw's count as indirect arguments; the
+            // fragment counter by fragment atomics.
+            barrier(
+                &ctx,
+                cmd,
+                &[
+                    ImageAccess::new(&self.volume, Access::ColorAttachment),
+                    ImageAccess::new(&self.surface, Access::ColorAttachment),
+                ],
+                &[
+                    BufferAccess::new(&self.beams, Access::GraphicsRead),
+                    BufferAccess::new(&self.indirect, Access::IndirectRead),
+                    BufferAccess::new(&self.counters, Access::FragmentWrite),
+                    BufferAccess::new(&self.receivers, Access::FragmentRead),
+                    // The receivers' shadow rays traverse the scene.
+                    BufferAccess::new(&scene.triangles, Access::FragmentRead),
+                ],
+            );
+            let extent = self.volume.extent();
+            begin_rendering(
+                &ctx,
+                cmd,
+                extent,
+                &[(self.volume.view, None), (self.surface.view, None)],
+                None,
+            );
+            self.volume_pipeline.bind(
+                cmd,
+                &[&scene.set, &self.set],
+                bytemuck::bytes_of(&self.volume_push),
+                extent,
+            );
+            unsafe {
+                ctx.device.cmd_draw_indirect(
+                    cmd,
+                    self.indirect.raw,
+                    4 * bb::BEAMS_INDIRECT_DRAW as u64,
+                    1,
+                    0,
+                )
+            };
+            end_rendering(&ctx, cmd);
+        });
+    }
+}
