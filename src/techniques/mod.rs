@@ -143,6 +143,7 @@ registry! {
     image_space::ImageSpace,
     volume_lines::VolumeLines,
     water_photons::WaterPhotons,
+    pinhole::Pinhole,
 }
 
 pub fn find(name: &str) -> anyhow::Result<&'static TechniqueInfo> {
