@@ -359,3 +359,67 @@ fn components_add_up_to_the_frame() {
     );
     assert_validation_clean(&ctx);
 }
+
+/// BENCHMARKS.md's accuracy tables (not part of the suite:
+/// `cargo test --release --test pinhole ring_accuracy_table -- --ignored --nocapture`):
+/// the ring at 64² against the reference's single-bounce L S+ D (4M
+/// photons), FLIP mean and relative energy per sampling strategy at 2,000
+/// points (the paper's Fig. 5, with and without filtering) and per cluster
+/// count at 1,000 points (Sect. 5's clusters, the light 4 m away).
+#[test]
+#[ignore]
+fn ring_accuracy_table() {
+    use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
+    let ctx = validated_context();
+    let size = 64u32;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/ring.toml");
+    let scene = Scene::load(&path).unwrap();
+    let mask = first_hit_mask(&scene, size, false, |k| k == MaterialKind::Diffuse);
+    let settings = ReferenceSettings {
+        max_depth: 2,
+        ..ReferenceSettings::default()
+    };
+    let mut reference =
+        ReferenceRenderer::new(&ctx, scene.clone(), size, size, 0.0, settings).unwrap();
+    reference.trace(4_000_000, |_, _| {}).unwrap();
+    let truth = masked(
+        &reference.resolve(Component::SurfaceCaustics).unwrap(),
+        &mask,
+    );
+    drop(reference);
+    let t = energy(&truth);
+    let truth_ldr = tonemap(&truth);
+    let mut configs: Vec<String> = Vec::new();
+    for filter in [0, 1] {
+        for strategy in 0..4 {
+            configs.push(format!("samples=2000,strategy={strategy},filter={filter}"));
+        }
+    }
+    for clusters in [1, 2, 4, 8, 16] {
+        configs.push(format!("samples=1000,clusters={clusters}"));
+    }
+    println!("| parameters | relative energy | FLIP mean |\n| --- | ---: | ---: |");
+    for config in &configs {
+        let overrides: Vec<&str> = config.split(',').collect();
+        let f = render(
+            &ctx,
+            &scene,
+            &overrides,
+            size,
+            Some(1 << caustics::shader_bindings::COMPONENT_SURFACE_CAUSTICS),
+        );
+        let img = masked(&f.targets.radiance.download_rgba32f().unwrap(), &mask);
+        let rel = (energy(&img) - t) / t;
+        let ldr = tonemap(&img);
+        let (fl, map) = flip(&ldr, &truth_ldr, size);
+        println!("| {} | {rel:+.3} | {fl:.4} |", config.replace(',', ", "));
+        write_comparison_pngs(
+            &format!("pinhole_ring_{}", config.replace(['=', ','], "_")),
+            size,
+            &ldr,
+            &truth_ldr,
+            &map,
+        );
+    }
+    assert_validation_clean(&ctx);
+}

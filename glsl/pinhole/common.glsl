@@ -52,7 +52,7 @@ layout(push_constant) uniform Push {
     float sun_cos;      // cos of the sun disc's angular radius
     float epsilon;      // the paper's epsilon, in units of the sample diameter squared
     uint medium_steps;  // midpoint steps of inhomogeneous transmittance
-    uint pad0;
+    uint first_candidate; // select: the first candidate of this dispatch
     uint pad1;
     uint pad2;
 } pc;

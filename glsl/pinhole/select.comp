@@ -22,6 +22,11 @@
 //     is also removed by an earlier candidate of the round that passed the
 //     test (greedy order kept, conservatively).
 // The candidates' `normal.w` marks the kept ones (neighbourhood test).
+// One dispatch handles PINHOLE_SELECT_CHUNK candidates from
+// pc.first_candidate on, carrying the kept count in state.count (the host
+// records ceil(M / chunk) dispatches): long single dispatches of this
+// barrier loop stopped early on lavapipe (at N >= 3800 on `ring`, no
+// validation message), chunks of this size never did.
 #include "common.glsl"
 
 layout(local_size_x = PINHOLE_GROUP) in;
@@ -70,12 +75,13 @@ bool covered_in_round(uint i, vec3 p, float delta, uint round_base) {
 
 void main() {
     uint tid = gl_LocalInvocationID.x;
-    if (tid == 0u) base_count = 0u;
+    if (tid == 0u) base_count = state.count;
     barrier();
     if (state.total_area <= 0.0) return; // uniform: no reflector
     float delta = 0.75 * sqrt(state.total_area / float(pc.target));
     uint rounds = 0u;
-    for (uint round_base = 0u; round_base < pc.candidates; round_base += PINHOLE_GROUP) {
+    uint end = min(pc.candidates, pc.first_candidate + PINHOLE_SELECT_CHUNK);
+    for (uint round_base = pc.first_candidate; round_base < end; round_base += PINHOLE_GROUP) {
         if (base_count >= pc.target) break; // uniform: read after a barrier
         rounds += 1u;
         uint i = round_base + tid;
@@ -120,6 +126,6 @@ void main() {
     }
     if (tid == 0u) {
         state.count = base_count;
-        state.kept_rounds = rounds;
+        state.kept_rounds += rounds;
     }
 }

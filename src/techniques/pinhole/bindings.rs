@@ -32,3 +32,5 @@ pub const PINHOLE_FLAG_LIGHT_VISIBILITY: u32 = 4;
 pub const PINHOLE_FLAG_DIELECTRICS: u32 = 8;
 /// Threads of the single-workgroup passes (scan, stratification, clusters).
 pub const PINHOLE_GROUP: u32 = 256;
+/// Candidates one dispatch of the selection (select.comp) visits.
+pub const PINHOLE_SELECT_CHUNK: u32 = 4096;

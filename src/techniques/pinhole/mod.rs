@@ -249,7 +249,8 @@ impl Pinhole {
             sun_cos: 1.0,
             epsilon: 0.0,
             medium_steps: params.direct.medium_steps,
-            pad: [0; 4],
+            first_candidate: 0,
+            pad: [0; 3],
         };
         params.apply_live(&mut push);
         Ok(Self {
@@ -321,19 +322,27 @@ impl Pinhole {
             self.candidates_pass.dispatch(cmd, &sets, push, groups);
         });
         rec.pass("pinhole samples", |cmd| {
-            barrier(
-                &ctx,
-                cmd,
-                &[],
-                &[
-                    w(&self.candidates),
-                    r(&self.heads),
-                    r(&self.next),
-                    w(&self.samples),
-                    w(&self.state),
-                ],
-            );
-            self.select.dispatch(cmd, &sets, push, one);
+            // One dispatch per chunk of candidates; each continues the
+            // previous one's kept count and flags.
+            for first in (0..self.push.candidates).step_by(b::PINHOLE_SELECT_CHUNK as usize) {
+                barrier(
+                    &ctx,
+                    cmd,
+                    &[],
+                    &[
+                        w(&self.candidates),
+                        r(&self.heads),
+                        r(&self.next),
+                        w(&self.samples),
+                        w(&self.state),
+                    ],
+                );
+                let chunk = PinholePush {
+                    first_candidate: first,
+                    ..self.push
+                };
+                self.select.dispatch(cmd, &sets, bytemuck::bytes_of(&chunk), one);
+            }
         });
         rec.pass("pinhole gradients", |cmd| {
             barrier(

@@ -56,7 +56,9 @@ pub struct PinholePush {
     pub sun_cos: f32,
     pub epsilon: f32,
     pub medium_steps: u32,
-    pub pad: [u32; 4],
+    /// select.comp: the first candidate of this dispatch.
+    pub first_candidate: u32,
+    pub pad: [u32; 3],
 }
 const _: () = assert!(size_of::<PinholePush>() == 64);
 
