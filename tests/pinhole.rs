@@ -423,3 +423,29 @@ fn ring_accuracy_table() {
     }
     assert_validation_clean(&ctx);
 }
+
+/// Light maps too large for the device (layers) or for the 1 GiB budget are
+/// refused with a message naming the parameters, not a failed allocation.
+#[test]
+fn oversized_light_maps_are_refused() {
+    use caustics::techniques::TechniqueBuild;
+    let ctx = validated_context();
+    let mut scene = flat_mirror_scene();
+    for x in [-1.0, 1.0] {
+        scene.lights.push(point_light(Vec3::new(x, 3.0, 0.0), 10.0));
+    }
+    let scene_gpu = SceneGpu::new(&ctx, &scene, 0.0).unwrap();
+    let overrides = ["clusters=16".to_string(), "cube_size=512".to_string()];
+    let params = PinholeParams::parse("pinhole", &overrides).unwrap();
+    let err = match Pinhole::build(&ctx, &params, &scene, &scene_gpu, 16, 16) {
+        Ok(_) => panic!("16 clusters x 3 lights of 512² faces (1.6 GiB) were accepted"),
+        Err(e) => e.to_string(),
+    };
+    println!("{err}");
+    assert!(
+        err.contains("clusters") && err.contains("cube_size"),
+        "{err}"
+    );
+    drop(scene_gpu);
+    assert_validation_clean(&ctx);
+}

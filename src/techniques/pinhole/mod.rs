@@ -83,6 +83,8 @@ const CANDIDATE_BYTES: u64 = 32;
 /// Bytes of the state block before its per-map normalisations.
 pub const STATE_HEADER_BYTES: u64 = 16 + 16 * b::PINHOLE_MAX_CLUSTERS as u64;
 const LIGHT_MAP_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+/// Largest light-map image `build` accepts (its mips included).
+const MAX_LIGHT_MAP_BYTES: u64 = 1 << 30;
 
 pub struct Pinhole {
     /// Shadows, G-buffers, direct light on the opaque scene, camera refraction.
@@ -419,6 +421,20 @@ impl TechniqueBuild for Pinhole {
         width: u32,
         height: u32,
     ) -> anyhow::Result<Self> {
+        // The light maps: clusters x lights x 6 faces, RGBA32F with mips.
+        let slots = scene.lights.len().max(1) as u64;
+        let layers = params.clusters as u64 * slots * 6;
+        let size = params.cube_size as u64;
+        let bytes = layers * size * size * 16 * 4 / 3;
+        if layers > ctx.limits.max_image_array_layers as u64 || bytes > MAX_LIGHT_MAP_BYTES {
+            anyhow::bail!(
+                "pinhole: {} clusters x {slots} lights x 6 faces of {size}² texels ({layers} layers, {} MiB) exceed the device's {} layers or {} MiB: lower `clusters` or `cube_size`",
+                params.clusters,
+                bytes >> 20,
+                ctx.limits.max_image_array_layers,
+                MAX_LIGHT_MAP_BYTES >> 20
+            );
+        }
         Ok(Self::new(ctx, params, scene, scene_gpu, width, height)?)
     }
 }
