@@ -5,9 +5,11 @@
 //! the selection):
 //! - flat_mirror_reflects_r_times_the_sun (32², 4000 samples, 256² cube
 //!   faces, one cluster, sun radius 3°, epsilon 0, filtering on): mean
-//!   mirrored irradiance over the patch's centre 8.934 W/m² vs R E = 9
-//!   (-0.73%), bound 2%; flux on the wall 6.342 W vs R E A cos 45° = 6.364 W
-//!   (-0.34%), bound 5%.
+//!   mirrored irradiance over the patch's centre 8.951 W/m² vs R E = 9
+//!   (-0.55%), bound 2%; flux on the wall 6.369 W vs R E A cos 45° = 6.364 W
+//!   (+0.08%), bound 5%.
+//! - flat_dielectric_reflects_fresnel_times_the_sun (the same plate as
+//!   glass, n = 1.5): 0.50118 W/m² vs F(45°) E = 0.50240 (-0.24%), bound 2%.
 //! - ring_caustics_match_reference (64², default parameters: 1000 samples,
 //!   neighbourhood removal, 8 clusters, filtering and visibility on;
 //!   reference 4M photons with max_depth 2, i.e. the single specular bounce
@@ -106,18 +108,16 @@ fn flat_mirror_scene() -> Scene {
     )
 }
 
-/// The flat mirror (ε = 0 so the equation is the plain area integral):
-/// inside the mirrored patch the wall faces the reflected sun, whose disc
-/// (L = E / (π sin² α)) it sees whole in the mirror, so E = R E_sun exactly;
-/// over the wall the reflected flux is R times the flux the mirror
-/// intercepts, E A cos 45°.
-#[test]
-fn flat_mirror_reflects_r_times_the_sun() {
-    let ctx = validated_context();
+/// The mirrored irradiance at the centre of the reflected patch and the
+/// flux over the wall (pixels' radiance x pi / albedo x pixel area) of the
+/// flat reflector scene with `reflector` as material 0.
+fn flat_reflector(ctx: &Arc<Context>, reflector: Material) -> (f64, f64, u32) {
     let size = 32u32;
+    let mut scene = flat_mirror_scene();
+    scene.materials[0] = reflector;
     let f = render(
-        &ctx,
-        &flat_mirror_scene(),
+        ctx,
+        &scene,
         &[
             "samples=4000",
             "epsilon=0",
@@ -131,8 +131,7 @@ fn flat_mirror_reflects_r_times_the_sun() {
     let img = f.targets.radiance.download_rgba32f().unwrap();
     assert_finite(&img);
     let (area, count, _) = state(&f);
-    assert!((area - 1.0).abs() < 1e-4, "mirror area {area}");
-    assert!(count > 3500 && count <= 4000, "{count} sample points");
+    assert!((area - 1.0).abs() < 1e-4, "reflector area {area}");
     // The camera at distance 1 with a 90° field: every pixel covers
     // (2 / size)^2 m^2 of the wall; pixel (x, y) sees the wall at
     // (y, z) = (1 - (y + 1/2) 2 / size, (x + 1/2) 2 / size - 1).
@@ -151,7 +150,19 @@ fn flat_mirror_reflects_r_times_the_sun() {
             }
         }
     }
-    let centre = centre / n as f64;
+    (centre / n as f64, flux, count)
+}
+
+/// The flat mirror (ε = 0 so the equation is the plain area integral):
+/// inside the mirrored patch the wall faces the reflected sun, whose disc
+/// (L = E / (π sin² α)) it sees whole in the mirror, so E = R E_sun exactly;
+/// over the wall the reflected flux is R times the flux the mirror
+/// intercepts, E A cos 45°.
+#[test]
+fn flat_mirror_reflects_r_times_the_sun() {
+    let ctx = validated_context();
+    let (centre, flux, count) = flat_reflector(&ctx, mirror("mirror", R));
+    assert!(count > 3500 && count <= 4000, "{count} sample points");
     let expected_e = (R * SUN_E) as f64;
     let expected_flux = expected_e * std::f64::consts::FRAC_1_SQRT_2;
     let rel_e = centre / expected_e - 1.0;
@@ -162,6 +173,24 @@ fn flat_mirror_reflects_r_times_the_sun() {
         rel_flux.abs() < 0.05,
         "reflected flux off by {rel_flux:+.4}"
     );
+    assert_validation_clean(&ctx);
+}
+
+/// The same plate as glass (n = 1.5, one interface facing the light): the
+/// reflected irradiance is the Fresnel reflectance at 45° (0.0503) times
+/// E (Sect. 5's Fresnel modulation).
+#[test]
+fn flat_dielectric_reflects_fresnel_times_the_sun() {
+    let ctx = validated_context();
+    let f45 =
+        caustics::radiometry::fresnel_dielectric(std::f32::consts::FRAC_1_SQRT_2, 1.0 / 1.5) as f64;
+    let (centre, _, _) = flat_reflector(&ctx, dielectric("glass", 1.5));
+    let expected = f45 * SUN_E as f64;
+    let rel = centre / expected - 1.0;
+    println!(
+        "glass: reflected irradiance {centre:.5} W/m² vs F(45°) E = {expected:.5} ({rel:+.4})"
+    );
+    assert!(rel.abs() < 0.02, "glass reflection off by {rel:+.4}");
     assert_validation_clean(&ctx);
 }
 
