@@ -25,7 +25,7 @@ use caustics::frame::{FrameTargets, SceneGpu};
 use caustics::params::ParamSet;
 use caustics::scene::Scene;
 use caustics::scene::{Material, MaterialKind};
-use caustics::techniques::pinhole::{Pinhole, PinholeParams};
+use caustics::techniques::pinhole::{GpuSample, Pinhole, PinholeParams};
 use caustics::techniques::Technique;
 use caustics::vk::Context;
 use common::*;
@@ -214,10 +214,10 @@ fn sample_points_follow_each_strategy() {
             None,
         );
         let (area, count, _) = state(&f);
-        let s: Vec<f32> = f.tech.samples.download_pod().unwrap();
+        let s: Vec<GpuSample> = f.tech.samples.download_pod().unwrap();
         let cell = (1.5 * area / n as f32).sqrt();
         let points: Vec<Vec3> = (0..count as usize)
-            .map(|i| Vec3::new(s[20 * i], s[20 * i + 1], s[20 * i + 2]))
+            .map(|i| Vec3::from_slice(&s[i].position[..3]))
             .collect();
         let mut min_d = f32::MAX;
         for (i, a) in points.iter().enumerate() {
@@ -237,9 +237,8 @@ fn sample_points_follow_each_strategy() {
             for b in &points[i + 1..] {
                 min_d = min_d.min(a.distance(*b));
             }
-            let g = 20 * i;
-            let grad = Vec3::new(s[g + 12], s[g + 13], s[g + 14]).length()
-                + Vec3::new(s[g + 16], s[g + 17], s[g + 18]).length();
+            let grad = Vec3::from_slice(&s[i].dn_du[..3]).length()
+                + Vec3::from_slice(&s[i].dn_dv[..3]).length();
             assert!(
                 grad < 1e-3,
                 "strategy {strategy}: a plane's normal gradient {grad}"
@@ -280,12 +279,11 @@ fn sample_points_follow_each_strategy() {
         None,
     );
     let (_, count, _) = state(&f);
-    let s: Vec<f32> = f.tech.samples.download_pod().unwrap();
+    let s: Vec<GpuSample> = f.tech.samples.download_pod().unwrap();
     let (mut k_max, mut k_min) = (Vec::new(), Vec::new());
-    for i in 0..count as usize {
-        let g = 20 * i;
-        let du = Vec3::new(s[g + 12], s[g + 13], s[g + 14]).length();
-        let dv = Vec3::new(s[g + 16], s[g + 17], s[g + 18]).length();
+    for p in &s[..count as usize] {
+        let du = Vec3::from_slice(&p.dn_du[..3]).length();
+        let dv = Vec3::from_slice(&p.dn_dv[..3]).length();
         k_max.push(du.max(dv));
         k_min.push(du.min(dv));
     }

@@ -1,6 +1,6 @@
 // pinhole (Wand & Strasser 2003): what its passes share: the sample points,
 // the frame's state, the hash grid of candidate points, the cube-map layout.
-// Mirrors src/techniques/pinhole/mod.rs (GpuSample, GpuState, PinholePush).
+// Mirrors src/techniques/pinhole/ (GpuSample, the state's size, PinholePush).
 #ifndef PINHOLE_COMMON_GLSL
 #define PINHOLE_COMMON_GLSL
 

@@ -72,16 +72,34 @@ use crate::vk::{
 };
 use ash::vk;
 use bindings as b;
+use bytemuck::{Pod, Zeroable};
 pub use params::{PinholeParams, PinholePush};
 use std::mem::size_of;
 use std::sync::Arc;
 
-/// Bytes of one sample point (`Sample` in glsl/pinhole/common.glsl).
-pub const SAMPLE_BYTES: u64 = 80;
+/// One reflector sample point, mirrored by `Sample` in
+/// glsl/pinhole/common.glsl (written by the GPU only; tests read it back).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuSample {
+    /// xyz position; w: material index (u32 bits).
+    pub position: [f32; 4],
+    /// xyz unit normal; w: cluster index (u32 bits).
+    pub normal: [f32; 4],
+    /// xyz principal direction u of the normal gradient; w: light
+    /// visibility mask (u32 bits).
+    pub tangent: [f32; 4],
+    /// xyz dn/du.
+    pub dn_du: [f32; 4],
+    /// xyz dn/dv along v = normal x u.
+    pub dn_dv: [f32; 4],
+}
+const _: () = assert!(size_of::<GpuSample>() == 80);
+const SAMPLE_BYTES: u64 = size_of::<GpuSample>() as u64;
 /// Bytes of one dense candidate (`Candidate`).
 const CANDIDATE_BYTES: u64 = 32;
 /// Bytes of the state block before its per-map normalisations.
-pub const STATE_HEADER_BYTES: u64 = 16 + 16 * b::PINHOLE_MAX_CLUSTERS as u64;
+const STATE_HEADER_BYTES: u64 = 16 + 16 * b::PINHOLE_MAX_CLUSTERS as u64;
 const LIGHT_MAP_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 /// Largest light-map image `build` accepts (its mips included).
 const MAX_LIGHT_MAP_BYTES: u64 = 1 << 30;
