@@ -37,6 +37,8 @@ void main() {
             ? vec4(samples[(tid * count) / k_count].position.xyz, 1.0)
             : vec4(0.0);
     }
+    // Every invocation reads the centres (buffer memory) next.
+    memoryBarrierBuffer();
     barrier();
     if (k_count == 0u) return; // uniform
     for (int it = 0; it <= PINHOLE_KMEANS_ITERATIONS; ++it) {
@@ -57,6 +59,7 @@ void main() {
                 barrier();
             }
             if (tid == 0u && red[0].w > 0.0) state.centres[k] = vec4(red[0].xyz / red[0].w, 1.0);
+            memoryBarrierBuffer();
             barrier();
         }
     }

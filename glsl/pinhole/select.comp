@@ -24,9 +24,11 @@
 // The candidates' `normal.w` marks the kept ones (neighbourhood test).
 // One dispatch handles PINHOLE_SELECT_CHUNK candidates from
 // pc.first_candidate on, carrying the kept count in state.count (the host
-// records ceil(M / chunk) dispatches): long single dispatches of this
-// barrier loop stopped early on lavapipe (at N >= 3800 on `ring`, no
-// validation message), chunks of this size never did.
+// records ceil(M / chunk) dispatches): one dispatch over all candidates
+// stopped early on lavapipe (on `ring`: no point at all at N = 3800 or
+// 10,000, 1986 of 2,000 at N = 2,000 with 32,000 candidates; no validation
+// message, buffer memory barriers made no difference; the cause is not
+// known), while chunks of this size gave every point in every case tried.
 #include "common.glsl"
 
 layout(local_size_x = PINHOLE_GROUP) in;
@@ -120,6 +122,8 @@ void main() {
             keep = false;
         }
         if (i < pc.candidates) candidates[i].normal.w = keep ? 1.0 : 0.0;
+        // The next round reads these flags from other invocations.
+        memoryBarrierBuffer();
         barrier();
         if (tid == 0u) base_count = min(base_count + scan[PINHOLE_GROUP - 1u], pc.target);
         barrier();
