@@ -3,7 +3,8 @@
 # device (set VK_DRIVER_FILES to pick lavapipe). JSON goes to out/bench/.
 #   scripts/bench.sh               every section below
 #   scripts/bench.sh SECTION...    only those: direct, reference, geometry,
-#                                  image_space, volume_lines, water_photons
+#                                  image_space, volume_lines, water_photons,
+#                                  pinhole
 # direct: the base frame per pass at 512^2 and 1024^2; reference: photons per
 # second; geometry: BVH build time and size per canonical scene; image_space:
 # caustic-map passes over photon buffers 64^2/256^2/1024^2, caustic maps
@@ -16,10 +17,14 @@
 # water_pool over ccm_0 and cascade counts; loading: Scene::load per MB of
 # TOML (64,000 materials and 16,000 boxes) and for a 2,000,000-triangle OBJ
 # (examples/load_scene.rs). FRAMES (10) and PHOTONS (2e7) set the effort.
+# pinhole: Wand & Strasser's Fig. 4 (time against sample count, filtering
+# on and off) and the cost of the visibility rays on ring; SIZE (128) the
+# screen; then the accuracy table (Fig. 5's strategies, the cluster count)
+# from tests/pinhole.rs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 sections=("$@")
-[ ${#sections[@]} -eq 0 ] && sections=(direct reference geometry image_space volume_lines water_photons loading)
+[ ${#sections[@]} -eq 0 ] && sections=(direct reference geometry image_space volume_lines water_photons pinhole loading)
 wants() { [[ " ${sections[*]} " == *" $1 "* ]]; }
 cargo build --release --quiet
 bin=target/release/caustics
@@ -203,4 +208,21 @@ with open(f"{root}/obj/scene.toml", "w") as f:
 PY
   cargo build --release --quiet --example load_scene
   target/release/examples/load_scene --repeat 3 out/bench/loading/toml/scene.toml out/bench/loading/obj/scene.toml
+fi
+
+if wants pinhole; then
+  size=${SIZE:-128}
+  for n in 100 1000 10000; do
+    for filter in 1 0; do
+      echo "samples=$n filter=$filter:"
+      $bin bench --pass-timing --scene assets/scenes/ring.toml --technique pinhole --param samples=$n \
+        --param filter=$filter --width $size --height $size --frames ${FRAMES:-10} --warmup 1 \
+        --json out/bench/pinhole_ring_${n}_filter$filter.json | grep -E "pinhole receivers|frame interval"
+    done
+  done
+  echo "samples=1000 visibility=0:"
+  $bin bench --pass-timing --scene assets/scenes/ring.toml --technique pinhole --param samples=1000 \
+    --param visibility=0 --width $size --height $size --frames ${FRAMES:-10} --warmup 1 \
+    --json out/bench/pinhole_ring_1000_vis0.json | grep -E "pinhole receivers|frame interval"
+  cargo test --release --test pinhole ring_accuracy_table -- --ignored --nocapture | grep "^|"
 fi

@@ -155,6 +155,7 @@ registry! {
     volume_lines::VolumeLines,
     water_photons::WaterPhotons,
     beams::Beams,
+    pinhole::Pinhole,
 }
 
 pub fn find(name: &str) -> anyhow::Result<&'static TechniqueInfo> {

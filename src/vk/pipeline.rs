@@ -175,6 +175,21 @@ impl DescriptorSet {
         self
     }
 
+    /// A storage image through one of its views (e.g. one mip level,
+    /// `Image::level_views`), in GENERAL layout.
+    pub fn write_storage_view(&self, binding: u32, view: vk::ImageView) -> &Self {
+        let info = [vk::DescriptorImageInfo::default()
+            .image_view(view)
+            .image_layout(vk::ImageLayout::GENERAL)];
+        let write = vk::WriteDescriptorSet::default()
+            .dst_set(self.raw)
+            .dst_binding(binding)
+            .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+            .image_info(&info);
+        unsafe { self.ctx.device.update_descriptor_sets(&[write], &[]) };
+        self
+    }
+
     /// A sampled image (all layers) read in the layout `Access::FragmentRead`/`ComputeRead` gives it.
     pub fn write_sampled_image(
         &self,
@@ -235,6 +250,25 @@ impl Sampler {
             .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
             .address_mode_u(vk::SamplerAddressMode::REPEAT)
             .address_mode_v(vk::SamplerAddressMode::REPEAT)
+            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .max_lod(vk::LOD_CLAMP_NONE);
+        Ok(Self {
+            ctx: ctx.clone(),
+            raw: unsafe { ctx.device.create_sampler(&info, None) }?,
+        })
+    }
+}
+
+impl Sampler {
+    /// Trilinear filtering, clamped to the edge, over every mip level: for
+    /// `textureGrad` lookups with explicit footprints.
+    pub fn trilinear_clamp(ctx: &Arc<Context>) -> VkResult<Self> {
+        let info = vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::LINEAR)
+            .min_filter(vk::Filter::LINEAR)
+            .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
+            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
             .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
             .max_lod(vk::LOD_CLAMP_NONE);
         Ok(Self {

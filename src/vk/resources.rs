@@ -272,6 +272,9 @@ pub struct Image {
     pub view: vk::ImageView,
     /// One 2D view per layer.
     pub layer_views: Vec<vk::ImageView>,
+    /// One 2D-array view (all layers) per mip level, for compute writes of
+    /// single levels (`Image::mipmapped`); empty otherwise.
+    pub level_views: Vec<vk::ImageView>,
     pub desc: ImageDesc,
     /// Mip levels (1 but for `Image::sampled_with_levels`).
     pub mip_levels: u32,
@@ -288,6 +291,34 @@ impl Image {
     /// shaders that declare `image2DArray` whatever the layer count).
     pub fn new_array(ctx: &Arc<Context>, name: &str, desc: ImageDesc) -> VkResult<Image> {
         Self::create(ctx, name, desc, true, 1)
+    }
+
+    /// A 2D array image with `levels` mip levels that shaders write level
+    /// by level (`level_views`) and sample through `view` (all levels).
+    pub fn mipmapped(
+        ctx: &Arc<Context>,
+        name: &str,
+        desc: ImageDesc,
+        levels: u32,
+    ) -> VkResult<Image> {
+        let mut image = Self::create(ctx, name, desc, true, levels)?;
+        for level in 0..levels {
+            let info = vk::ImageViewCreateInfo::default()
+                .image(image.raw)
+                .view_type(vk::ImageViewType::TYPE_2D_ARRAY)
+                .format(desc.format)
+                .subresource_range(vk::ImageSubresourceRange {
+                    aspect_mask: aspect_of(desc.format),
+                    base_mip_level: level,
+                    level_count: 1,
+                    base_array_layer: 0,
+                    layer_count: desc.layers,
+                });
+            image
+                .level_views
+                .push(unsafe { ctx.device.create_image_view(&info, None) }?);
+        }
+        Ok(image)
     }
 
     /// A read-only sampled 2D array image with one mip level per entry of
@@ -456,6 +487,7 @@ impl Image {
             raw,
             view: vk::ImageView::null(),
             layer_views: Vec::new(),
+            level_views: Vec::new(),
             desc,
             mip_levels,
             state: Cell::new(ResourceState::default()),
@@ -575,7 +607,7 @@ pub(super) fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
 impl Drop for Image {
     fn drop(&mut self) {
         unsafe {
-            for v in self.layer_views.drain(..) {
+            for v in self.layer_views.drain(..).chain(self.level_views.drain(..)) {
                 self.ctx.device.destroy_image_view(v, None);
             }
             self.ctx.device.destroy_image_view(self.view, None);

@@ -1,0 +1,487 @@
+//! `pinhole`: Wand & Straßer 2003, "Real-Time Caustics": the reflector's
+//! surface sampled into small regions, each "a set of (reflecting) pinhole
+//! cameras that project an image of the light source onto the receiving
+//! surfaces" (Sect. 3), the light held as cube environment maps.
+//!
+//! Every frame, on the GPU, nothing precomputed (glsl/pinhole/):
+//! 1. "pinhole areas" (areas.comp): the reflector triangles' area CDF and
+//!    total area A (mirrors, and dielectrics with `dielectrics` = 1).
+//! 2. "pinhole candidates" (candidates.comp): M = `oversample` x N dense
+//!    uniform random points on the reflector, in a hash grid.
+//! 3. "pinhole samples" (select.comp): N sample points by one of Sect.
+//!    3.2's four strategies (`strategy`: random, grid, quantized grid,
+//!    neighbourhood-based removal, the default).
+//! 4. "pinhole gradients" (gradients.comp): per sample point the normal
+//!    gradient by Sect. 3.3's local linear regression over the dense
+//!    candidates around it, rotated onto its principal directions; and one
+//!    shadow ray per light (`light_visibility`).
+//! 5. "pinhole clusters" (clusters.comp): K-means of the sample points into
+//!    `clusters` clusters (Sect. 5's suggestion for lights near the
+//!    reflector).
+//! 6. "pinhole light maps" (light_maps.comp) and "pinhole light mips"
+//!    (mips.comp): one cube map per cluster and emitter slot, from the
+//!    cluster's centre: point and spot lights as spheres of radius
+//!    `light_radius` with L = I / (pi r^2), a directional light as a sun
+//!    disc of `sun_radius` with L = E / (pi sin^2 alpha)
+//!    (glsl/common/emitters.glsl), with their mip chains. Environment and
+//!    area lights come with the `lights` branch: each will be one more
+//!    emitter slot, rendered in `emitter_radiance` of light_maps.comp by its
+//!    glsl/common function.
+//! 7. "pinhole receivers" (receivers.comp): per diffuse pixel of the opaque
+//!    frame, Sect. 3.1's sum over sample points (the equation is written in
+//!    the shader), each lookup filtered over its Sect. 3.3 footprint with
+//!    `textureGrad` (`filter`), each contribution checked by a shadow ray
+//!    from the receiver to the sample point (`visibility`).
+//!
+//! The frame is the surface frame's (`passes::surface_frame`, as
+//! image_space's): shadows, G-buffers and direct light into the opaque frame
+//! (component `direct`), the receivers add the caustics to it (component
+//! `surface_caustics`), then what the camera sees in mirrors and glass
+//! (camera refraction).
+//!
+//! Cube maps are 2D-array images (six layers per map) with the face
+//! selection done in the shader (glsl/pinhole/common.glsl), so that one
+//! sampler reaches every cluster's maps without descriptor indexing or
+//! cube-array support; the lookup's gradients are projected onto the face
+//! as a cube lookup does. Filtering across face edges clamps to the face.
+//!
+//! Limits: one specular bounce (the paper's); the cube maps hold the
+//! emitters, not the scene, so light blocked between emitter and reflector
+//! is handled only by the per-sample shadow ray to each light's centre
+//! (`light_visibility`), and a sample point sees a light from its cluster's
+//! centre (parallax within a cluster: fewer clusters, more error). The
+//! sample points are drawn with a fixed seed: a static scene gets the same
+//! points every frame, a moving reflector new ones from its current
+//! triangles.
+
+pub mod bindings;
+pub mod params;
+
+use super::{Technique, TechniqueBuild};
+use crate::frame::{FrameTargets, SceneGpu};
+use crate::params::{ParamSet, Params};
+use crate::passes::camera_refraction::RefractionPush;
+use crate::passes::surface_frame::SurfaceFrame;
+use crate::radiometry::Component;
+use crate::scene::Scene;
+use crate::shader_bindings as sb;
+use crate::vk::{
+    barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline, Context,
+    DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageAccess, ImageDesc, Sampler,
+    VkResult,
+};
+use ash::vk;
+use bindings as b;
+use bytemuck::{Pod, Zeroable};
+pub use params::{PinholeParams, PinholePush};
+use std::mem::size_of;
+use std::sync::Arc;
+
+/// One reflector sample point, mirrored by `Sample` in
+/// glsl/pinhole/common.glsl (written by the GPU only; tests read it back).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuSample {
+    /// xyz position; w: material index (u32 bits).
+    pub position: [f32; 4],
+    /// xyz unit normal; w: cluster index (u32 bits).
+    pub normal: [f32; 4],
+    /// xyz principal direction u of the normal gradient; w: light
+    /// visibility mask (u32 bits).
+    pub tangent: [f32; 4],
+    /// xyz dn/du.
+    pub dn_du: [f32; 4],
+    /// xyz dn/dv along v = normal x u.
+    pub dn_dv: [f32; 4],
+}
+const _: () = assert!(size_of::<GpuSample>() == 80);
+const SAMPLE_BYTES: u64 = size_of::<GpuSample>() as u64;
+/// Bytes of one dense candidate (`Candidate`).
+const CANDIDATE_BYTES: u64 = 32;
+/// Bytes of the state block before its per-map normalisations.
+const STATE_HEADER_BYTES: u64 = 16 + 16 * b::PINHOLE_MAX_CLUSTERS as u64;
+const LIGHT_MAP_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+/// Largest light-map image `build` accepts (its mips included).
+const MAX_LIGHT_MAP_BYTES: u64 = 1 << 30;
+
+pub struct Pinhole {
+    /// Shadows, G-buffers, direct light on the opaque scene, camera refraction.
+    pub surface: SurfaceFrame,
+    /// The sample points (`Sample`), at most N.
+    pub samples: Buffer,
+    /// A, the kept count N, the grid cell, cluster centres, map normalisations.
+    pub state: Buffer,
+    cdf: Buffer,
+    candidates: Buffer,
+    heads: Buffer,
+    next: Buffer,
+    /// The light cube maps: K clusters x slots x 6 faces, with mips.
+    pub light_map: Image,
+    push: PinholePush,
+    areas: ComputePipeline,
+    candidates_pass: ComputePipeline,
+    select: ComputePipeline,
+    gradients: ComputePipeline,
+    clusters: ComputePipeline,
+    light_maps: ComputePipeline,
+    mips: ComputePipeline,
+    receivers: ComputePipeline,
+    set: DescriptorSet,
+    /// One set per mip level >= 1 (source: the level above).
+    mip_sets: Vec<DescriptorSet>,
+    _layout: DescriptorSetLayout,
+    _mip_layout: DescriptorSetLayout,
+    _sampler: Sampler,
+}
+
+impl Pinhole {
+    pub fn new(
+        ctx: &Arc<Context>,
+        params: &PinholeParams,
+        scene: &Scene,
+        scene_gpu: &SceneGpu,
+        width: u32,
+        height: u32,
+    ) -> VkResult<Self> {
+        let surface = SurfaceFrame::new(
+            ctx,
+            &params.direct,
+            scene,
+            scene_gpu,
+            width,
+            height,
+            RefractionPush {
+                tir_remedy: sb::TIR_CLAMP_CRITICAL,
+                use_eq632: 1,
+                search_steps: params.search_steps,
+                pad: 0,
+            },
+        )?;
+        let n = params.samples;
+        let m = n * params.oversample;
+        let hash_size = (2 * m).next_power_of_two();
+        let slots = (scene.lights.len() as u32).max(1);
+        let k = params.clusters;
+        let triangles = scene_gpu.triangle_count.max(1) as u64;
+        let samples = Buffer::new(ctx, "pinhole samples", n as u64 * SAMPLE_BYTES, BufferUsage::Storage)?;
+        let state = Buffer::new(
+            ctx,
+            "pinhole state",
+            STATE_HEADER_BYTES + 8 * (k * slots) as u64,
+            BufferUsage::Storage,
+        )?;
+        let cdf = Buffer::new(ctx, "pinhole area cdf", 4 * triangles, BufferUsage::Storage)?;
+        let candidates = Buffer::new(
+            ctx,
+            "pinhole candidates",
+            m as u64 * CANDIDATE_BYTES,
+            BufferUsage::Storage,
+        )?;
+        let heads = Buffer::new(ctx, "pinhole grid heads", 4 * hash_size as u64, BufferUsage::Storage)?;
+        let next = Buffer::new(ctx, "pinhole grid links", 4 * m as u64, BufferUsage::Storage)?;
+        let size = params.cube_size;
+        let levels = 32 - size.leading_zeros();
+        let light_map = Image::mipmapped(
+            ctx,
+            "pinhole light cube maps",
+            ImageDesc {
+                width: size,
+                height: size,
+                layers: k * slots * 6,
+                format: LIGHT_MAP_FORMAT,
+                usage: vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::SAMPLED,
+            },
+            levels,
+        )?;
+        let layout = DescriptorSetLayout::new(
+            ctx,
+            &[
+                (b::PINHOLE_BINDING_SAMPLES, BindingKind::Storage),
+                (b::PINHOLE_BINDING_STATE, BindingKind::Storage),
+                (b::PINHOLE_BINDING_CDF, BindingKind::Storage),
+                (b::PINHOLE_BINDING_CANDIDATES, BindingKind::Storage),
+                (b::PINHOLE_BINDING_HEADS, BindingKind::Storage),
+                (b::PINHOLE_BINDING_NEXT, BindingKind::Storage),
+                (b::PINHOLE_BINDING_LIGHT_MAP_LEVEL0, BindingKind::StorageImage),
+                (b::PINHOLE_BINDING_LIGHT_MAP, BindingKind::Sampled),
+                (b::PINHOLE_BINDING_POSITION, BindingKind::StorageImage),
+                (b::PINHOLE_BINDING_NORMAL, BindingKind::StorageImage),
+                (b::PINHOLE_BINDING_ALBEDO, BindingKind::StorageImage),
+                (b::PINHOLE_BINDING_RADIANCE, BindingKind::StorageImage),
+            ],
+        )?;
+        let sampler = Sampler::trilinear_clamp(ctx)?;
+        let gbuffer = surface.gbuffer();
+        let set = DescriptorSet::new(ctx, &layout)?;
+        set.write_buffer(b::PINHOLE_BINDING_SAMPLES, &samples)
+            .write_buffer(b::PINHOLE_BINDING_STATE, &state)
+            .write_buffer(b::PINHOLE_BINDING_CDF, &cdf)
+            .write_buffer(b::PINHOLE_BINDING_CANDIDATES, &candidates)
+            .write_buffer(b::PINHOLE_BINDING_HEADS, &heads)
+            .write_buffer(b::PINHOLE_BINDING_NEXT, &next)
+            .write_storage_view(b::PINHOLE_BINDING_LIGHT_MAP_LEVEL0, light_map.level_views[0])
+            .write_sampled_image(
+                b::PINHOLE_BINDING_LIGHT_MAP,
+                &light_map,
+                &sampler,
+                vk::ImageLayout::GENERAL,
+            )
+            .write_storage_image(b::PINHOLE_BINDING_POSITION, &gbuffer.position)
+            .write_storage_image(b::PINHOLE_BINDING_NORMAL, &gbuffer.normal)
+            .write_storage_image(b::PINHOLE_BINDING_ALBEDO, &gbuffer.albedo)
+            .write_storage_image(b::PINHOLE_BINDING_RADIANCE, surface.opaque());
+        let mip_layout = DescriptorSetLayout::new(
+            ctx,
+            &[
+                (b::PINHOLE_MIP_BINDING_SRC, BindingKind::StorageImage),
+                (b::PINHOLE_MIP_BINDING_DST, BindingKind::StorageImage),
+            ],
+        )?;
+        let mut mip_sets = Vec::new();
+        for level in 1..levels as usize {
+            let s = DescriptorSet::new(ctx, &mip_layout)?;
+            s.write_storage_view(b::PINHOLE_MIP_BINDING_SRC, light_map.level_views[level - 1])
+                .write_storage_view(b::PINHOLE_MIP_BINDING_DST, light_map.level_views[level]);
+            mip_sets.push(s);
+        }
+        let push_size = size_of::<PinholePush>() as u32;
+        let pipeline = |shader: &str| {
+            ComputePipeline::new(ctx, shader, &[&scene_gpu.layout, &layout], push_size)
+        };
+        let areas = pipeline("pinhole/areas.comp")?;
+        let candidates_pass = pipeline("pinhole/candidates.comp")?;
+        let select = pipeline("pinhole/select.comp")?;
+        let gradients = pipeline("pinhole/gradients.comp")?;
+        let clusters = pipeline("pinhole/clusters.comp")?;
+        let light_maps = pipeline("pinhole/light_maps.comp")?;
+        let receivers = pipeline("pinhole/receivers.comp")?;
+        let mips = ComputePipeline::new(ctx, "pinhole/mips.comp", &[&scene_gpu.layout, &mip_layout], 0)?;
+        let mut push = PinholePush {
+            target: n,
+            strategy: 0,
+            candidates: m,
+            clusters: k,
+            slots,
+            cube_size: size,
+            flags: 0,
+            hash_size,
+            light_radius: 0.0,
+            sun_cos: 1.0,
+            epsilon: 0.0,
+            medium_steps: params.direct.medium_steps,
+            first_candidate: 0,
+            pad: [0; 3],
+        };
+        params.apply_live(&mut push);
+        Ok(Self {
+            surface,
+            samples,
+            state,
+            cdf,
+            candidates,
+            heads,
+            next,
+            light_map,
+            push,
+            areas,
+            candidates_pass,
+            select,
+            gradients,
+            clusters,
+            light_maps,
+            mips,
+            receivers,
+            set,
+            mip_sets,
+            _layout: layout,
+            _mip_layout: mip_layout,
+            _sampler: sampler,
+        })
+    }
+
+    /// Takes the live parameters of `params`.
+    pub fn set_live(&mut self, params: &PinholeParams) {
+        self.surface.set_live(&params.direct, params.search_steps);
+        params.apply_live(&mut self.push);
+    }
+
+    /// Records the sample points, clusters, light maps and receivers'
+    /// caustics into the opaque frame (steps 1-7 of the module's list).
+    fn record_caustics(&self, rec: &mut FrameRecorder, scene: &SceneGpu) {
+        let ctx = rec.ctx().clone();
+        let push = bytemuck::bytes_of(&self.push);
+        let sets = [&scene.set, &self.set];
+        let one = [1, 1, 1];
+        // Each pass declares its next use of every buffer it touches; a
+        // write after a write or read gets a barrier from `barrier`.
+        let w = |buf| BufferAccess::new(buf, Access::ComputeWrite);
+        let r = |buf| BufferAccess::new(buf, Access::ComputeRead);
+        rec.pass("pinhole areas", |cmd| {
+            barrier(
+                &ctx,
+                cmd,
+                &[],
+                &[r(&scene.triangles), w(&self.cdf), w(&self.state), w(&self.heads)],
+            );
+            self.areas.dispatch(cmd, &sets, push, one);
+        });
+        rec.pass("pinhole candidates", |cmd| {
+            barrier(
+                &ctx,
+                cmd,
+                &[],
+                &[
+                    r(&self.cdf),
+                    r(&self.state),
+                    w(&self.candidates),
+                    w(&self.heads),
+                    w(&self.next),
+                ],
+            );
+            let groups = [self.push.candidates.div_ceil(64), 1, 1];
+            self.candidates_pass.dispatch(cmd, &sets, push, groups);
+        });
+        rec.pass("pinhole samples", |cmd| {
+            // One dispatch per chunk of candidates; each continues the
+            // previous one's kept count and flags.
+            for first in (0..self.push.candidates).step_by(b::PINHOLE_SELECT_CHUNK as usize) {
+                barrier(
+                    &ctx,
+                    cmd,
+                    &[],
+                    &[
+                        w(&self.candidates),
+                        r(&self.heads),
+                        r(&self.next),
+                        w(&self.samples),
+                        w(&self.state),
+                    ],
+                );
+                let chunk = PinholePush {
+                    first_candidate: first,
+                    ..self.push
+                };
+                self.select.dispatch(cmd, &sets, bytemuck::bytes_of(&chunk), one);
+            }
+        });
+        rec.pass("pinhole gradients", |cmd| {
+            barrier(
+                &ctx,
+                cmd,
+                &[],
+                &[r(&self.candidates), r(&self.state), w(&self.samples)],
+            );
+            let groups = [self.push.target.div_ceil(64), 1, 1];
+            self.gradients.dispatch(cmd, &sets, push, groups);
+        });
+        rec.pass("pinhole clusters", |cmd| {
+            barrier(&ctx, cmd, &[], &[w(&self.samples), w(&self.state)]);
+            self.clusters.dispatch(cmd, &sets, push, one);
+        });
+        rec.pass("pinhole light maps", |cmd| {
+            barrier(
+                &ctx,
+                cmd,
+                &[ImageAccess::discard(&self.light_map, Access::ComputeWrite)],
+                &[w(&self.state)],
+            );
+            let s = self.push.cube_size.div_ceil(8);
+            let groups = [s, s, self.light_map.desc.layers];
+            self.light_maps.dispatch(cmd, &sets, push, groups);
+        });
+        rec.pass("pinhole light mips", |cmd| {
+            for (l, set) in self.mip_sets.iter().enumerate() {
+                // Level l + 1 reads level l, written by the previous dispatch.
+                barrier(
+                    &ctx,
+                    cmd,
+                    &[ImageAccess::new(&self.light_map, Access::ComputeWrite)],
+                    &[],
+                );
+                let s = (self.push.cube_size >> (l + 1)).max(1).div_ceil(8);
+                let groups = [s, s, self.light_map.desc.layers];
+                self.mips.dispatch(cmd, &[&scene.set, set], &[], groups);
+            }
+        });
+        let gbuffer = self.surface.gbuffer();
+        let opaque = self.surface.opaque();
+        rec.pass("pinhole receivers", |cmd| {
+            barrier(
+                &ctx,
+                cmd,
+                &[
+                    ImageAccess::new(&self.light_map, Access::ComputeRead),
+                    ImageAccess::new(&gbuffer.position, Access::ComputeRead),
+                    ImageAccess::new(&gbuffer.normal, Access::ComputeRead),
+                    ImageAccess::new(&gbuffer.albedo, Access::ComputeRead),
+                    ImageAccess::new(opaque, Access::ComputeWrite),
+                ],
+                &[r(&self.samples), r(&self.state)],
+            );
+            let extent = opaque.extent();
+            let groups = [extent.width.div_ceil(8), extent.height.div_ceil(8), 1];
+            self.receivers.dispatch(cmd, &sets, push, groups);
+        });
+    }
+}
+
+impl TechniqueBuild for Pinhole {
+    const NAME: &'static str = "pinhole";
+    const DESCRIPTION: &'static str = "Wand & Straßer 2003: reflector sample points as pinhole cameras projecting cube maps of the lights onto the diffuse receivers, filtered by the normal gradient (surface caustics of one mirror bounce)";
+    const COMPONENTS: &'static [Component] = &[Component::Direct, Component::SurfaceCaustics];
+    type Params = PinholeParams;
+
+    fn build(
+        ctx: &Arc<Context>,
+        params: &PinholeParams,
+        scene: &Scene,
+        scene_gpu: &SceneGpu,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<Self> {
+        // The light maps: clusters x lights x 6 faces, RGBA32F with mips.
+        let slots = scene.lights.len().max(1) as u64;
+        let layers = params.clusters as u64 * slots * 6;
+        let size = params.cube_size as u64;
+        let bytes = layers * size * size * 16 * 4 / 3;
+        if layers > ctx.limits.max_image_array_layers as u64 || bytes > MAX_LIGHT_MAP_BYTES {
+            anyhow::bail!(
+                "pinhole: {} clusters x {slots} lights x 6 faces of {size}² texels ({layers} layers, {} MiB) exceed the device's {} layers or {} MiB: lower `clusters` or `cube_size`",
+                params.clusters,
+                bytes >> 20,
+                ctx.limits.max_image_array_layers,
+                MAX_LIGHT_MAP_BYTES >> 20
+            );
+        }
+        Ok(Self::new(ctx, params, scene, scene_gpu, width, height)?)
+    }
+}
+
+impl Technique for Pinhole {
+    fn name(&self) -> &'static str {
+        Self::NAME
+    }
+
+    fn update_live(&mut self, params: &Params) -> anyhow::Result<bool> {
+        self.set_live(&PinholeParams::from_params(params)?);
+        Ok(true)
+    }
+
+    fn record(
+        &mut self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        targets: &FrameTargets,
+    ) -> VkResult<()> {
+        self.surface.record_opaque(rec, scene)?;
+        self.record_caustics(rec, scene);
+        self.surface.record_refraction(rec, scene, targets);
+        Ok(())
+    }
+
+    /// The passes read the lights from the scene's buffer every frame; only
+    /// the surface frame's shadow views move.
+    fn set_lights(&mut self, lights: &[crate::scene::Light]) -> bool {
+        self.surface.set_lights(lights)
+    }
+}
