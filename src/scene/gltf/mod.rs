@@ -185,6 +185,25 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
             )
         })
         .collect();
+    // gltf-json 1.4.1's validation indexes the POSITION accessor before it
+    // checks that it exists (a panic, found by tests/fuzz.rs): check first.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let position = prim.attributes.get(&json::validation::Checked::Valid(
+                json::mesh::Semantic::Positions,
+            ));
+            if let Some(a) = position.filter(|a| a.value() >= root.accessors.len()) {
+                return Err(fail(
+                    &format!("meshes[{m}].primitives[{p}].attributes.POSITION"),
+                    format!(
+                        "accessor {} does not exist (the file has {})",
+                        a.value(),
+                        root.accessors.len()
+                    ),
+                ));
+            }
+        }
+    }
     let document = Document::from_json(root).map_err(|e| match e {
         ::gltf::Error::Validation(errors) => {
             let (p, why) = &errors[0];
