@@ -567,3 +567,25 @@ fn found_relative_index_before_the_first_vertex() {
     std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n").unwrap();
     assert_eq!(obj::load(&path).expect("loads").mesh.indices.len(), 1);
 }
+
+/// A TOML string holding an escaped newline (`kind = "poi\nt"`) was quoted
+/// raw in the message, which then took two lines: control characters are
+/// now escaped in every scene and glTF error.
+#[test]
+fn found_newline_quoted_in_an_error() {
+    let text = BASE.replace("kind = \"point\"", "kind = \"poi\\nt\"");
+    let e = Scene::from_str(&text, Path::new("s.toml"))
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(e.contains("unknown light kind `poi\\nt`"), "{e}");
+    assert!(!e.contains('\n'), "{e}");
+    let dir = temp_dir("found-newline");
+    let path = dir.join("m.gltf");
+    let (mut doc, bin) = gltf_base();
+    doc["extensionsRequired"] = json!(["EXT_a\nb"]);
+    std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
+    std::fs::write(dir.join("m.bin"), &bin).unwrap();
+    let e = gltf::load(&path).err().expect("refused").to_string();
+    assert!(e.contains("EXT_a\\nb") && !e.contains('\n'), "{e}");
+}

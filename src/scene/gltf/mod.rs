@@ -70,10 +70,13 @@ pub struct GltfError {
 
 impl fmt::Display for GltfError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        // The file's own strings (names, URIs) may hold newlines: one line.
+        let message = super::escape_control(&self.message);
         if self.at.is_empty() {
-            write!(f, "{}: {}", self.file.display(), self.message)
+            write!(f, "{}: {message}", self.file.display())
         } else {
-            write!(f, "{}: {}: {}", self.file.display(), self.at, self.message)
+            let at = super::escape_control(&self.at);
+            write!(f, "{}: {at}: {message}", self.file.display())
         }
     }
 }
