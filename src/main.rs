@@ -20,7 +20,7 @@ fn main() -> ExitCode {
     match cli::interrupt::install().and_then(|()| run(cli)) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", describe(&e));
+            eprintln!("error: {}", caustics::scene::escape_control(&describe(&e)));
             ExitCode::FAILURE
         }
     }

@@ -111,7 +111,7 @@ fn a_scene_the_technique_cannot_use_fails_before_the_device() {
     );
     one_line_error(
         &o,
-        &["ball_lens.toml: object: water_photons needs an object of shape = \"water\""],
+        &["ball_lens.toml: object: water_photons needs a `water` object (shape = \"water\")"],
     );
     assert!(o.stdout.is_empty(), "no device opened");
     assert!(!dir.exists(), "nothing created at --out");
@@ -133,10 +133,7 @@ fn a_scene_the_technique_cannot_use_fails_before_the_device() {
         ],
         &[],
     );
-    let e = one_line_error(
-        &o,
-        &["light: water_photons needs a light of kind = \"directional\""],
-    );
+    let e = one_line_error(&o, &["light: water_photons needs a directional light"]);
     assert!(!e.contains("device"), "{e}");
 }
 

@@ -58,6 +58,10 @@ fn obj_scene(dir: &Path, n: usize) -> PathBuf {
     scene
 }
 
+/// The two tests measure one at a time (the test harness runs them on
+/// parallel threads, which would make each the other's noise).
+static MEASURING: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// The best of `repeats` runs of `load`.
 fn best(repeats: usize, mut load: impl FnMut()) -> Duration {
     (0..repeats)
@@ -71,9 +75,10 @@ fn best(repeats: usize, mut load: impl FnMut()) -> Duration {
 }
 
 /// Asserts the times for sizes n, 2n, 4n, 8n grow linearly: over the
-/// three doublings at most 8 x 2 (a quadratic check gives 64; measured
-/// 9.6 for the TOML scene, 11-12 for the OBJ in a debug build), and no
-/// single doubling above 3x (quadratic: 4x).
+/// three doublings at most 20x (linear is 8; measured 6.6-12 on the loaded
+/// 2-core machine, where the larger sizes leave the caches; the quadratic
+/// name check measured 39x), and no single doubling above 3x (quadratic:
+/// 4x, measured 5.5x).
 fn assert_linear(what: &str, sizes: &[usize], times: &[Duration]) {
     let ms: Vec<f64> = times.iter().map(|t| t.as_secs_f64() * 1e3).collect();
     let report: Vec<String> = sizes
@@ -91,7 +96,7 @@ fn assert_linear(what: &str, sizes: &[usize], times: &[Duration]) {
     }
     let total = ms[ms.len() - 1] / ms[0];
     assert!(
-        total < 8.0 * 2.0,
+        total < 20.0,
         "{what}: 8x the size cost {total:.1}x: {report:?}"
     );
 }
@@ -106,6 +111,7 @@ const OBJ_SIZES: [usize; 4] = [4_000, 8_000, 16_000, 32_000];
 fn toml_scene_loading_is_linear() {
     let path = Path::new("scaling.toml");
     let texts: Vec<String> = SIZES.iter().map(|&n| toml_scene(n)).collect();
+    let _one_at_a_time = MEASURING.lock().unwrap_or_else(|e| e.into_inner());
     let times: Vec<Duration> = texts
         .iter()
         .map(|text| {
@@ -128,6 +134,7 @@ fn toml_scene_loading_is_linear() {
 #[test]
 fn obj_with_many_materials_loads_linearly() {
     let root = std::env::temp_dir().join(format!("caustics-scaling-{}", std::process::id()));
+    let _one_at_a_time = MEASURING.lock().unwrap_or_else(|e| e.into_inner());
     let times: Vec<Duration> = OBJ_SIZES
         .iter()
         .map(|&n| {

@@ -274,6 +274,21 @@ pub fn context(args: &DeviceArgs) -> anyhow::Result<Arc<Context>> {
     Ok(ctx)
 }
 
+/// Checks the image size against the device's limit before anything is
+/// allocated (`maxImageDimension2D`: every frame target is a 2D image of
+/// the output's size).
+pub fn check_device_limits(ctx: &Context, args: &SceneArgs) -> anyhow::Result<()> {
+    let max = ctx.limits.max_image_dimension2_d;
+    for (name, v) in [("--width", args.width), ("--height", args.height)] {
+        if v > max {
+            anyhow::bail!(
+                "{name} {v}: the device's largest 2D image is {max} pixels (maxImageDimension2D)"
+            );
+        }
+    }
+    Ok(())
+}
+
 /// Fails the command if the validation layer reported errors, leaked objects
 /// included: everything that used the device must be dropped before this.
 pub fn check_validation(ctx: Arc<Context>) -> anyhow::Result<()> {

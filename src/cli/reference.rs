@@ -38,6 +38,7 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
     let loaded = load_scene(&scene.scene, scene.time)?;
     let outputs = output::prepare(&out)?;
     let ctx = context(&device)?;
+    super::check_device_limits(&ctx, &scene)?;
     let settings = ReferenceSettings {
         diffuse_bounces,
         seed,

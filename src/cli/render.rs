@@ -90,6 +90,7 @@ fn start(
 ) -> anyhow::Result<(Arc<Context>, Renderer)> {
     let ctx = context(device)?;
     let s = &run.scene;
+    super::check_device_limits(&ctx, s)?;
     let mut renderer = Renderer::new(
         &ctx,
         scene,

@@ -83,16 +83,47 @@ impl Source<'_> {
             field: if field.is_empty() {
                 "(document)".into()
             } else {
-                field.into()
+                escape_control(field)
             },
-            message: message.into(),
+            message: escape_control(&message.into()),
         }
     }
+}
+
+/// `text` with control characters escaped (`\n`, `\t`, `\u{1b}`): a
+/// message quoting a key or string from the file (which TOML lets hold
+/// escaped newlines) stays one line (found by tests/fuzz.rs).
+pub fn escape_control(text: &str) -> String {
+    if !text.chars().any(char::is_control) {
+        return text.to_owned();
+    }
+    text.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn messages_stay_one_line() {
+        let src = Source {
+            path: Path::new("s.toml"),
+            text: "a = 1\n",
+        };
+        let e = src.err(&(0..1), "light[0].\"a\nb\"", "unknown kind `poi\nt\t`");
+        assert_eq!(
+            e.to_string(),
+            "s.toml:1:1: light[0].\"a\\nb\": unknown kind `poi\\nt\\t`"
+        );
+    }
 
     #[test]
     fn line_col_counts_lines_and_chars() {

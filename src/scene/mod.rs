@@ -20,7 +20,7 @@ mod types;
 pub mod water;
 
 pub use bounds::MAX_WORLD_EXTENT;
-pub use error::SceneError;
+pub use error::{escape_control, SceneError};
 pub use file::DEFAULT_FOV_Y_DEG;
 pub use node::{MAX_MAGNITUDE, MAX_RADIOMETRIC};
 pub use types::*;

@@ -14,7 +14,6 @@
 use super::types::{Material, MaterialKind, Mesh};
 use glam::{Vec2, Vec3};
 use std::collections::HashMap;
-use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
 /// Per-triangle material marker for faces with no `usemtl` (or an unknown one).
@@ -82,6 +81,79 @@ fn is_dielectric(m: &tobj::Material) -> bool {
     let transparent =
         m.optical_density.is_some_and(|n| n > 1.0) && m.dissolve.is_some_and(|d| d < 1.0);
     matches!(m.illumination_model, Some(4 | 6 | 7)) || transparent
+}
+
+/// Relative (negative) indices of faces, lines and points must stay within
+/// the `v`, `vt` and `vn` statements before them: tobj 4 turns one that
+/// reaches before the first into a huge index and overflows (a panic, found
+/// by tests/fuzz.rs). One pass over the bytes; only statements holding a
+/// `-` are parsed. The error is (1-based line, message).
+fn check_relative_indices(bytes: &[u8]) -> Result<(), (usize, String)> {
+    let mut counts = [0i64; 3]; // v, vt, vn
+    for (i, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        let line = line.trim_ascii_start();
+        match line {
+            [b'v', b' ' | b'\t', ..] => counts[0] += 1,
+            [b'v', b't', b' ' | b'\t', ..] => counts[1] += 1,
+            [b'v', b'n', b' ' | b'\t', ..] => counts[2] += 1,
+            [b'f' | b'l' | b'p', b' ' | b'\t', rest @ ..] if rest.contains(&b'-') => {
+                let text = String::from_utf8_lossy(line);
+                for corner in text.split_whitespace().skip(1) {
+                    for (k, index) in corner.split('/').enumerate().take(3) {
+                        let Ok(x) = index.parse::<i64>() else {
+                            continue;
+                        };
+                        if x < 0 && counts[k] + x < 0 {
+                            let what = ["v", "vt", "vn"][k];
+                            return Err((
+                                i + 1,
+                                format!(
+                                    "`{}`: relative index {x} reaches before the first `{what}` ({} so far)",
+                                    text.trim(),
+                                    counts[k]
+                                ),
+                            ));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// `Ka`, `Kd`, `Ks` and `Ke` with one number mean that number for r, g
+/// and b (the MTL format's rule); tobj 4 reads exactly three and panics on
+/// fewer (found by tests/fuzz.rs), so one is repeated here and none or two
+/// are an error naming the line.
+fn complete_colours(text: &str) -> Result<String, String> {
+    let mut out = String::with_capacity(text.len() + 16);
+    for (i, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let key = words.next().unwrap_or("");
+        let values: Vec<&str> = words.collect();
+        if matches!(key, "Ka" | "Kd" | "Ks" | "Ke") {
+            match values.len() {
+                1 => {
+                    let v = values[0];
+                    out.push_str(&format!("{key} {v} {v} {v}\n"));
+                    continue;
+                }
+                0 | 2 => {
+                    return Err(format!(
+                        "line {}: `{}`: {key} needs 3 numbers (or 1 for all three)",
+                        i + 1,
+                        line.trim()
+                    ))
+                }
+                _ => {}
+            }
+        }
+        out.push_str(line);
+        out.push('\n');
+    }
+    Ok(out)
 }
 
 /// The largest `Ni` a dielectric may have: the top of the MTL format's
@@ -158,9 +230,11 @@ pub fn check_mtl_values(m: &tobj::Material) -> Result<(), String> {
 /// Reads an OBJ file (and the MTL files it names, relative to it).
 /// The error is a message that names the file.
 pub fn load(path: &Path) -> Result<ObjMesh, String> {
-    let file = std::fs::File::open(path)
-        .map_err(|e| format!("cannot open OBJ file {}: {e}", path.display()))?;
-    let mut reader = BufReader::new(file);
+    let bytes =
+        std::fs::read(path).map_err(|e| format!("cannot open OBJ file {}: {e}", path.display()))?;
+    check_relative_indices(&bytes)
+        .map_err(|(line, why)| format!("OBJ file {}:{line}: {why}", path.display()))?;
+    let mut reader = &bytes[..];
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let mtl_errors = std::cell::RefCell::new(Vec::new());
     let options = tobj::LoadOptions {
@@ -171,11 +245,11 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
     };
     let (models, materials) = tobj::load_obj_buf(&mut reader, &options, |mtl: &Path| {
         let full = dir.join(mtl);
-        let result = std::fs::File::open(&full)
+        let result = std::fs::read_to_string(&full)
             .map_err(|e| format!("cannot read it: {e}"))
-            .and_then(|f| {
-                tobj::load_mtl_buf(&mut BufReader::new(f))
-                    .map_err(|e| format!("cannot read it: {e}"))
+            .and_then(|text| complete_colours(&text))
+            .and_then(|text| {
+                tobj::load_mtl_buf(&mut text.as_bytes()).map_err(|e| format!("cannot read it: {e}"))
             })
             .and_then(|(materials, names)| {
                 materials.iter().try_for_each(check_mtl_values)?;

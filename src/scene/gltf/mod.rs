@@ -70,10 +70,13 @@ pub struct GltfError {
 
 impl fmt::Display for GltfError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        // The file's own strings (names, URIs) may hold newlines: one line.
+        let message = super::escape_control(&self.message);
         if self.at.is_empty() {
-            write!(f, "{}: {}", self.file.display(), self.message)
+            write!(f, "{}: {message}", self.file.display())
         } else {
-            write!(f, "{}: {}: {}", self.file.display(), self.at, self.message)
+            let at = super::escape_control(&self.at);
+            write!(f, "{}: {at}: {message}", self.file.display())
         }
     }
 }
@@ -189,6 +192,25 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
             )
         })
         .collect();
+    // gltf-json 1.4.1's validation indexes the POSITION accessor before it
+    // checks that it exists (a panic, found by tests/fuzz.rs): check first.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let position = prim.attributes.get(&json::validation::Checked::Valid(
+                json::mesh::Semantic::Positions,
+            ));
+            if let Some(a) = position.filter(|a| a.value() >= root.accessors.len()) {
+                return Err(fail(
+                    &format!("meshes[{m}].primitives[{p}].attributes.POSITION"),
+                    format!(
+                        "accessor {} does not exist (the file has {})",
+                        a.value(),
+                        root.accessors.len()
+                    ),
+                ));
+            }
+        }
+    }
     let document = Document::from_json(root).map_err(|e| match e {
         ::gltf::Error::Validation(errors) => {
             let (p, why) = &errors[0];

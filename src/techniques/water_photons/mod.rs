@@ -430,12 +430,12 @@ impl TechniqueBuild for WaterPhotons {
         let file = scene.source.display();
         if !scene.objects.iter().any(|o| o.water.is_some()) {
             anyhow::bail!(
-                "{file}: object: water_photons needs an object of shape = \"water\"; the scene has none"
+                "{file}: object: water_photons needs a `water` object (shape = \"water\"); the scene has none"
             );
         }
         if first_directional(&scene.lights).is_none() {
             anyhow::bail!(
-                "{file}: light: water_photons needs a light of kind = \"directional\" (the paper's sun); the scene has none"
+                "{file}: light: water_photons needs a directional light (the paper's sun, kind = \"directional\"); the scene has none"
             );
         }
         Ok(())
