@@ -83,6 +83,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             frames_in_flight,
             device,
         }) => {
+            let technique = if technique == "auto" {
+                let picked = techniques::auto(&cli::load_scene(&scene, 0.0)?);
+                println!("technique: {picked} (auto)");
+                picked.to_owned()
+            } else {
+                technique
+            };
             let info = techniques::find(&technique)?;
             let params = Params::resolve(&technique, info.params(), &params)?;
             check_size(&SceneArgs {

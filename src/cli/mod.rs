@@ -104,10 +104,11 @@ pub enum Command {
 pub struct TechniqueArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// Technique name, or `list` (with `render`) to print them with their
-    /// parameters. The default, `image_space` (Wyman's caustic maps), is the
-    /// quickest one that draws caustics on lavapipe.
-    #[arg(long, default_value = "image_space")]
+    /// Technique name, `auto` (the default: the one that renders every
+    /// component the scene has, printed; `volume_lines` with a medium,
+    /// `water_photons` for sunlit water, else `image_space`), or `list`
+    /// (with `render`) to print them with their parameters.
+    #[arg(long, default_value = "auto")]
     pub technique: String,
     /// Technique parameter, NAME=VALUE (repeatable; `render --technique list` shows them).
     #[arg(long = "param")]
@@ -233,7 +234,8 @@ pub struct DemoArgs {
     /// Scene file: TOML, or a glTF 2.0 file (.gltf/.glb) as a whole scene (docs/SCENES.md). R reloads it.
     #[arg(long, default_value = DEFAULT_SCENE)]
     pub scene: PathBuf,
-    #[arg(long, default_value = "direct")]
+    /// Technique name, or `auto` (the default: as for `render`).
+    #[arg(long, default_value = "auto")]
     pub technique: String,
     #[arg(long = "param")]
     pub params: Vec<String>,
@@ -328,15 +330,27 @@ pub fn check_size(args: &SceneArgs) -> anyhow::Result<()> {
 
 /// What `render` and `bench` check before they touch the device: the
 /// technique and its parameters, the image size, the frame count, the scene.
-pub fn checked_technique_run(run: &TechniqueArgs, frames: u32) -> anyhow::Result<(Scene, Params)> {
-    let (scene, technique) = (&run.scene, run.technique.as_str());
-    let info = techniques::find(technique)?;
-    let params = Params::resolve(technique, info.params(), &run.params)?;
-    check_size(scene)?;
+/// `--technique auto` becomes the technique `techniques::auto` picks for the
+/// scene (in `run.technique`).
+pub fn checked_technique_run(
+    run: &mut TechniqueArgs,
+    frames: u32,
+) -> anyhow::Result<(Scene, Params)> {
+    if run.technique != "auto" {
+        techniques::find(&run.technique)?;
+    }
+    check_size(&run.scene)?;
     if frames == 0 {
         anyhow::bail!("--frames must be at least 1");
     }
-    let loaded = load_scene(&scene.scene, scene.time)?;
+    let loaded = load_scene(&run.scene.scene, run.scene.time)?;
+    if run.technique == "auto" {
+        // Printed with the timings (`render`'s and `bench`'s first line),
+        // after every check, so a failing command prints nothing.
+        run.technique = techniques::auto(&loaded).to_owned();
+    }
+    let info = techniques::find(&run.technique)?;
+    let params = Params::resolve(&run.technique, info.params(), &run.params)?;
     (info.check_scene)(&loaded)?;
     Ok((loaded, params))
 }

@@ -21,7 +21,7 @@ use std::time::Instant;
 
 pub fn render(args: RenderArgs) -> anyhow::Result<()> {
     let RenderArgs {
-        run,
+        mut run,
         frames,
         component,
         out,
@@ -33,7 +33,7 @@ pub fn render(args: RenderArgs) -> anyhow::Result<()> {
         return Ok(());
     }
     output::format_of(&out)?;
-    let (loaded, params) = checked_technique_run(&run, frames)?;
+    let (loaded, params) = checked_technique_run(&mut run, frames)?;
     let components = techniques::find(&run.technique)?.component_mask(&component)?;
     let options = frame.options()?;
     let outputs = output::prepare(&out)?;
@@ -106,14 +106,14 @@ fn start(
 
 pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
     let BenchArgs {
-        run,
+        mut run,
         frames,
         warmup,
         json,
         frame,
         device,
     } = args;
-    let (loaded, params) = checked_technique_run(&run, frames)?;
+    let (loaded, params) = checked_technique_run(&mut run, frames)?;
     let options = frame.options()?;
     if let Some(path) = &json {
         output::check_writable(path, "--json")?;

@@ -158,6 +158,23 @@ registry! {
     pinhole::Pinhole,
 }
 
+/// `--technique auto`: the technique that renders every component `scene`
+/// has. A participating medium needs airlight and volume caustics:
+/// `volume_lines` (`beams` renders them too; volume_lines is the closer to
+/// the reference on volume_cone, BENCHMARKS.md). Water lit by a sun:
+/// `water_photons`. Anything else: `image_space`, the surface caustics of
+/// mirrors and glass.
+pub fn auto(scene: &Scene) -> &'static str {
+    let water_photons = find("water_photons").expect("registered");
+    if scene.medium.is_some() {
+        "volume_lines"
+    } else if (water_photons.check_scene)(scene).is_ok() {
+        "water_photons"
+    } else {
+        "image_space"
+    }
+}
+
 pub fn find(name: &str) -> anyhow::Result<&'static TechniqueInfo> {
     TECHNIQUES.iter().find(|t| t.name == name).ok_or_else(|| {
         let names: Vec<_> = TECHNIQUES.iter().map(|t| t.name).collect();
@@ -194,4 +211,26 @@ pub fn create_named(
     height: u32,
 ) -> anyhow::Result<Box<dyn Technique>> {
     (find(name)?.create)(ctx, params, scene, scene_gpu, width, height)
+}
+
+#[cfg(test)]
+mod auto_tests {
+    use super::*;
+
+    /// `--technique auto` on the canonical scenes: a medium, sunlit water,
+    /// and glass over a floor.
+    #[test]
+    fn auto_picks_by_what_the_scene_has() {
+        let load = |name: &str| {
+            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("assets/scenes")
+                .join(name);
+            Scene::load(&path).unwrap()
+        };
+        assert_eq!(auto(&load("smoke.toml")), "volume_lines");
+        assert_eq!(auto(&load("volume_cone.toml")), "volume_lines");
+        assert_eq!(auto(&load("water_pool.toml")), "water_photons");
+        assert_eq!(auto(&load("ball_lens.toml")), "image_space");
+        assert_eq!(auto(&load("ring.toml")), "image_space");
+    }
 }
