@@ -3,7 +3,10 @@
 //! agree without padding rules; the const assertions below pin sizes and
 //! offsets, and the GLSL side mirrors the same field order.
 
-use crate::scene::{Density, Light, LightKind, Material, MaterialKind, Medium, Triangle, Wave};
+use crate::scene::{
+    Density, Emitter, EmitterShape, Light, LightKind, Material, MaterialKind, Medium, Triangle,
+    Wave,
+};
 use crate::shader_bindings as b;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3, Vec4};
@@ -61,6 +64,41 @@ pub struct GpuMaterial {
     /// x = albedo texture layer (int bits, -1: none); yz = uv_scale; w unused.
     /// A diffuse albedo is `color.rgb` times the layer at `uv * uv_scale`.
     pub texture: [f32; 4],
+    /// rgb radiance emitted from front faces (area lights' own material); w unused.
+    pub emission: [f32; 4],
+}
+
+/// An area light (glsl/common/scene.glsl `Emitter`): what the reference
+/// samples photons from. Its geometry is ordinary triangles with an
+/// emitting material.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuEmitter {
+    /// xyz centre; w = kind (EMITTER_RECT / EMITTER_SPHERE, uint bits).
+    pub position: [f32; 4],
+    /// xyz unit normal (rect: the side it emits to); w = width (rect) or radius (sphere).
+    pub normal: [f32; 4],
+    /// xyz unit tangent, the direction of the width (rect); w = height (rect).
+    pub tangent: [f32; 4],
+    /// rgb radiance; w = power (luminance, W) for light selection.
+    pub radiance: [f32; 4],
+}
+
+/// The environment light's constants, the head of the BINDING_ENVIRONMENT_DATA
+/// buffer (its sampling tables follow, `environment::sampling_tables`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuEnvironment {
+    /// x = 1 when the scene has an environment; y unused; zw = cos, sin of
+    /// the rotation about +y (image frame -> world).
+    pub params: [f32; 4],
+    /// xyz unit direction toward the sun (world); w = cos of its angular radius (2: no sun).
+    pub sun: [f32; 4],
+    /// rgb sun radiance (scaled); w = sun power (luminance, W: L Ω π R²).
+    pub sun_radiance: [f32; 4],
+    /// x width, y height of the table; z = table power (luminance, W:
+    /// π R² ∫ L dω); w unused.
+    pub table: [f32; 4],
 }
 
 #[repr(C)]
@@ -110,7 +148,7 @@ pub struct GpuFrame {
     /// x lights, y triangles, z materials, w frame index.
     pub counts: [u32; 4],
     /// x: the path-type components techniques draw, a bit mask
-    /// (1 << COMPONENT_*; `Component::mask`); yzw reserved.
+    /// (1 << COMPONENT_*; `Component::mask`); y: area lights; zw reserved.
     pub components: [u32; 4],
 }
 
@@ -144,8 +182,11 @@ const _: () = {
     assert!(offset_of!(GpuBvhNode, count) == 28);
     assert!(size_of::<GpuTriangleUv>() == 32);
     assert!(offset_of!(GpuTriangleUv, uv2) == 16);
-    assert!(size_of::<GpuMaterial>() == 48);
+    assert!(size_of::<GpuMaterial>() == 64);
     assert!(offset_of!(GpuMaterial, texture) == 32);
+    assert!(offset_of!(GpuMaterial, emission) == 48);
+    assert!(size_of::<GpuEmitter>() == 64);
+    assert!(size_of::<GpuEnvironment>() == 64);
     assert!(size_of::<GpuLight>() == 64);
     assert!(size_of::<GpuMedium>() == 96);
     assert!(offset_of!(GpuMedium, dims) == 80);
@@ -209,6 +250,7 @@ impl GpuMaterial {
             color: v4(m.color, f32::from_bits(kind)),
             absorption_ior: v4(m.absorption, m.ior),
             texture: [f32::from_bits(layer as u32), uv_scale.x, uv_scale.y, 0.0],
+            emission: v4(m.emission, 0.0),
         }
     }
 }
@@ -243,6 +285,32 @@ impl GpuLight {
                 0.0,
                 0.0,
             ],
+        }
+    }
+}
+
+impl GpuEmitter {
+    pub fn new(e: &Emitter) -> Self {
+        let power = crate::environment::emitter_power(e).dot(LUMINANCE);
+        let radiance = v4(e.radiance, power);
+        match e.shape {
+            EmitterShape::Rect {
+                center,
+                normal,
+                tangent,
+                size,
+            } => Self {
+                position: v4(center, f32::from_bits(b::EMITTER_RECT)),
+                normal: v4(normal, size[0]),
+                tangent: v4(tangent, size[1]),
+                radiance,
+            },
+            EmitterShape::Sphere { center, radius } => Self {
+                position: v4(center, f32::from_bits(b::EMITTER_SPHERE)),
+                normal: v4(Vec3::Y, radius),
+                tangent: v4(Vec3::X, 0.0),
+                radiance,
+            },
         }
     }
 }

@@ -4,6 +4,7 @@
 pub mod app;
 pub mod bvh;
 pub mod cascades;
+pub mod environment;
 pub mod frame;
 pub mod gpu;
 pub mod output;

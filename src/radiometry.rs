@@ -74,17 +74,21 @@ pub enum Component {
     VolumeCaustics,
     /// Everything else (diffuse interreflection, multiple scattering).
     Other,
+    /// L S* E: the environment and area lights seen directly or through
+    /// specular chains (the background, a lamp, the sky in a mirror).
+    Emitted,
     /// The sum of all.
     All,
 }
 
 impl Component {
-    pub const NAMED: [(&'static str, Component); 6] = [
+    pub const NAMED: [(&'static str, Component); 7] = [
         ("direct", Component::Direct),
         ("surface_caustics", Component::SurfaceCaustics),
         ("airlight", Component::Airlight),
         ("volume_caustics", Component::VolumeCaustics),
         ("other", Component::Other),
+        ("emitted", Component::Emitted),
         ("all", Component::All),
     ];
 
@@ -124,6 +128,7 @@ impl Component {
             Component::Airlight => b::COMPONENT_AIRLIGHT,
             Component::VolumeCaustics => b::COMPONENT_VOLUME_CAUSTICS,
             Component::Other => b::COMPONENT_OTHER,
+            Component::Emitted => b::COMPONENT_EMITTED,
             Component::All => b::COMPONENT_COUNT,
         }
     }

@@ -3,8 +3,10 @@
 // L = albedo / pi * sum_l E_l * V_l for diffuse surfaces, where E_l is the
 // light's irradiance (glsl/common/lights.glsl: I cos / r^2 with the spot
 // falloff, or E cos for directional light) and V_l the shadow-map visibility.
-// Specular surfaces seen directly and the background get 0: the ground
-// truth follows specular chains, which later techniques add.
+// Specular surfaces seen directly get 0: the ground truth follows specular
+// chains, which later techniques add. The background is the environment
+// (glsl/common/emitters.glsl) and an area light's front face its radiance:
+// both the emitted component.
 // In a participating medium (Hu et al. 2010 Sect. 5.3, Fig. 2 C) each
 // light's irradiance is attenuated by the transmittance tau(s, x) from the
 // light to x, and the surface radiance by tau(x, v) toward the eye, both
@@ -15,6 +17,7 @@
 #include "optics.glsl"
 #include "random.glsl"
 #include "medium.glsl"
+#include "emitters.glsl"
 
 #define SHADOW_SET 1
 #define SHADOW_BINDING_LIGHTS DIRECT_BINDING_SHADOW_LIGHTS
@@ -39,7 +42,17 @@ void main() {
     if (any(greaterThanEqual(p, imageSize(radiance)))) return;
     vec4 position = imageLoad(g_position, p);
     if (position.w == 0.0) {
-        imageStore(radiance, p, vec4(0.0));
+        // The background: the environment along the pixel centre's ray
+        // (through the medium's bounds), the emitted component.
+        vec2 ndc = (vec2(p) + 0.5) / frame.viewport.xy * 2.0 - 1.0;
+        vec4 far = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
+        vec3 dir = normalize(far.xyz / far.w - frame.eye.xyz);
+        vec3 background = environment_radiance(dir);
+        if (environment_present()) {
+            float travel = 2.0 * frame.scene_sphere.w + length(frame.eye.xyz - frame.scene_sphere.xyz);
+            background *= medium_transmittance_steps(frame.eye.xyz, dir, travel, pc.medium_steps);
+        }
+        imageStore(radiance, p, vec4(component_weight(COMPONENT_EMITTED) * background, 0.0));
         return;
     }
     vec4 nm = imageLoad(g_normal, p);
@@ -60,9 +73,13 @@ void main() {
         if (v == 0.0) continue;
         e_sum += e * v * medium_transmittance_steps(x, to_light, light_travel(dist, x), pc.medium_steps);
     }
-    vec3 albedo = imageLoad(g_albedo, p).rgb;
+    vec4 albedo = imageLoad(g_albedo, p);
+    // An area light's front face (albedo.a: the camera sees the front).
+    vec3 emission = albedo.a > 0.5 ? materials[material].emission.rgb : vec3(0.0);
     vec3 to_eye = frame.eye.xyz - x;
     float eye_dist = length(to_eye);
     vec3 tau_eye = medium_transmittance_steps(x, to_eye / eye_dist, eye_dist, pc.medium_steps);
-    imageStore(radiance, p, vec4(component_weight(COMPONENT_DIRECT) * albedo / PI * e_sum * tau_eye, 1.0));
+    vec3 l = component_weight(COMPONENT_DIRECT) * albedo.rgb / PI * e_sum
+        + component_weight(COMPONENT_EMITTED) * emission;
+    imageStore(radiance, p, vec4(l * tau_eye, 1.0));
 }

@@ -57,6 +57,7 @@ pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
             ior: ni.filter(|&n| n >= 1.0).unwrap_or(1.5),
             absorption: Vec3::ZERO,
             texture: None,
+            emission: Vec3::ZERO,
         }
     } else if illum == 3 {
         Material {
@@ -66,6 +67,7 @@ pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
             ior: 1.0,
             absorption: Vec3::ZERO,
             texture: None,
+            emission: Vec3::ZERO,
         }
     } else {
         Material {
@@ -75,6 +77,7 @@ pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
             ior: 1.0,
             absorption: Vec3::ZERO,
             texture: None,
+            emission: Vec3::ZERO,
         }
     }
 }
