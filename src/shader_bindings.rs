@@ -79,6 +79,10 @@ pub const DIRECT_BINDING_RADIANCE: u32 = 2;
 pub const DIRECT_BINDING_SHADOW_MAP: u32 = 3;
 pub const DIRECT_BINDING_SHADOW_LIGHTS: u32 = 4;
 pub const DIRECT_BINDING_ALBEDO: u32 = 5;
+/// The environment's irradiance as 9 spherical-harmonic coefficients (rgb, vec4 each).
+pub const DIRECT_BINDING_ENVIRONMENT_SH: u32 = 6;
+/// Workgroup size of glsl/direct/environment_sh.comp (one workgroup).
+pub const DIRECT_SH_GROUP_SIZE: u32 = 64;
 
 // BVH probe (glsl/tests/bvh_probe.comp, tests/bvh_gpu.rs), descriptor set 1
 // (set 0 is the scene). Numbers kept from the probe's first version.

@@ -82,4 +82,71 @@ vec3 sample_environment_table(vec2 u, out float pdf) {
     return environment_to_world(equirect_dir(uv));
 }
 
+// Unoccluded irradiance at x (normal n) from rect area light `em`:
+// Lambert's polygon formula, E = L/2 |sum_i Theta_i (n . gamma_i)| with
+// Theta_i the angle edge i subtends at x and gamma_i the unit normal of the
+// plane through x and that edge (Arvo 1995, "Applications of Irradiance
+// Tensors to the Simulation of Non-Lambertian Phenomena", Sect. 3), after
+// clipping the rect to the receiver's upper half-space; 0 behind the
+// emitting side. Exact.
+vec3 rect_irradiance(Emitter em, vec3 x, vec3 n) {
+    vec3 c = em.position.xyz, nr = em.normal.xyz, t = em.tangent.xyz;
+    if (dot(x - c, nr) <= 0.0) return vec3(0.0);
+    vec3 hu = t * (0.5 * em.normal.w), hv = cross(nr, t) * (0.5 * em.tangent.w);
+    vec3 q[4] = vec3[4](c - hu - hv - x, c + hu - hv - x, c + hu + hv - x, c - hu + hv - x);
+    vec3 p[8];
+    int m = 0;
+    for (int i = 0; i < 4; ++i) {
+        vec3 a = q[i], b = q[(i + 1) % 4];
+        float da = dot(a, n), db = dot(b, n);
+        if (da >= 0.0) p[m++] = a;
+        if ((da >= 0.0) != (db >= 0.0)) p[m++] = a + (b - a) * (da / (da - db));
+    }
+    float sum = 0.0;
+    for (int i = 0; i < m; ++i) {
+        vec3 a = normalize(p[i]), b = normalize(p[(i + 1) % m]);
+        vec3 g = cross(a, b);
+        float len = length(g);
+        if (len < 1e-12) continue;
+        sum += atan(len, dot(a, b)) * dot(g / len, n);
+    }
+    return em.radiance.rgb * (0.5 * abs(sum));
+}
+
+// Unoccluded irradiance at x (normal n) from sphere light `em`: a
+// Lambertian sphere of radiance L seen whole above the receiver's horizon
+// gives exactly E = pi L (r/d)^2 cos(omega) (it acts as a point of
+// intensity pi r^2 L); where the sphere dips below the horizon (within r of
+// the receiver's plane) this clamped form is an approximation.
+vec3 sphere_irradiance(Emitter em, vec3 x, vec3 n) {
+    vec3 v = em.position.xyz - x;
+    float d2 = dot(v, v);
+    float r = em.normal.w;
+    if (d2 <= r * r) return vec3(0.0);
+    return em.radiance.rgb * (PI * r * r / d2) * max(dot(n, v * inversesqrt(d2)), 0.0);
+}
+
+// The unoccluded irradiance from area light e, the direction toward the
+// point its shadow is taken from (its centre) and how far a shadow ray may
+// go before it would meet the light's own geometry.
+vec3 emitter_irradiance(uint e, vec3 x, vec3 n, out vec3 to_light, out float reach) {
+    Emitter em = emitters[e];
+    vec3 v = em.position.xyz - x;
+    float d = length(v);
+    to_light = v / max(d, 1e-30);
+    if (floatBitsToUint(em.position.w) == EMITTER_RECT) {
+        reach = d * (1.0 - 1e-3);
+        return rect_irradiance(em, x, n);
+    }
+    reach = d - em.normal.w * 1.001; // short of the inscribed tessellation
+    return sphere_irradiance(em, x, n);
+}
+
+// The sky's sun as a directional light: irradiance on a surface facing it,
+// E = L 2 pi (1 - cos alpha), and the way its light travels (-sun).
+vec3 environment_sun_irradiance() {
+    if (!environment_present() || environment.sun.w > 1.5) return vec3(0.0);
+    return environment.sun_radiance.rgb * (2.0 * PI * (1.0 - environment.sun.w));
+}
+
 #endif

@@ -18,6 +18,8 @@
 #include "random.glsl"
 #include "medium.glsl"
 #include "emitters.glsl"
+#include "bvh.glsl"
+#include "sh.glsl"
 
 #define SHADOW_SET 1
 #define SHADOW_BINDING_LIGHTS DIRECT_BINDING_SHADOW_LIGHTS
@@ -30,12 +32,52 @@ layout(set = 1, binding = DIRECT_BINDING_POSITION, rgba32f) uniform readonly ima
 layout(set = 1, binding = DIRECT_BINDING_NORMAL, rgba32f) uniform readonly image2D g_normal;
 layout(set = 1, binding = DIRECT_BINDING_ALBEDO, rgba32f) uniform readonly image2D g_albedo;
 layout(set = 1, binding = DIRECT_BINDING_RADIANCE, rgba32f) uniform writeonly image2D radiance;
-
 layout(push_constant) uniform Push {
     uint light_count; // lights with shadow maps (<= MAX_LIGHTS)
     int pcf_radius;   // PCF window half-width in texels
     uint medium_steps; // midpoint steps of inhomogeneous transmittance
 } pc;
+
+// A_l L_lm of the environment's table (environment_sh.comp).
+layout(set = 1, binding = DIRECT_BINDING_ENVIRONMENT_SH, std430) readonly buffer ShBlock { vec4 sh[9]; };
+
+// Offsets a shadow ray's origin off the surface, scaled with |x| to
+// survive float rounding.
+vec3 shadow_origin(vec3 x, vec3 n) {
+    return x + n * (1e-4 * (1.0 + max(abs(x.x), max(abs(x.y), abs(x.z)))));
+}
+
+// Irradiance at x (normal n, facing the camera) from the environment and the
+// area lights (docs/ARCHITECTURE.md, "Environment and area lights in
+// direct"): the environment's table by its order-2 spherical-harmonic
+// irradiance, unoccluded; the sky's sun as a directional light with a BVH
+// shadow ray toward its centre; each area light's exact unoccluded
+// irradiance (emitters.glsl) times one BVH shadow ray toward its centre.
+vec3 extended_irradiance(vec3 x, vec3 n) {
+    vec3 e = vec3(0.0);
+    if (environment_present()) {
+        float y[9];
+        sh_basis(n, y);
+        vec3 sky = vec3(0.0);
+        for (int k = 0; k < 9; ++k) sky += sh[k].rgb * y[k];
+        e += max(sky, vec3(0.0));
+        vec3 sun = environment_sun_irradiance();
+        float cos_sun = dot(n, environment.sun.xyz);
+        if (cos_sun > 0.0 && any(greaterThan(sun, vec3(0.0)))
+                && !trace_any(shadow_origin(x, n), environment.sun.xyz, 0.0, 1e30)) {
+            e += sun * cos_sun * medium_transmittance_steps(x, environment.sun.xyz, light_travel(1e30, x), pc.medium_steps);
+        }
+    }
+    for (uint i = 0u; i < frame.components.y; ++i) {
+        vec3 to_light;
+        float reach;
+        vec3 ei = emitter_irradiance(i, x, n, to_light, reach);
+        if (all(equal(ei, vec3(0.0)))) continue;
+        if (trace_any(shadow_origin(x, n), to_light, 0.0, reach)) continue;
+        e += ei * medium_transmittance_steps(x, to_light, reach, pc.medium_steps);
+    }
+    return e;
+}
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -73,6 +115,7 @@ void main() {
         if (v == 0.0) continue;
         e_sum += e * v * medium_transmittance_steps(x, to_light, light_travel(dist, x), pc.medium_steps);
     }
+    e_sum += extended_irradiance(x, n);
     vec4 albedo = imageLoad(g_albedo, p);
     // An area light's front face (albedo.a: the camera sees the front).
     vec3 emission = albedo.a > 0.5 ? materials[material].emission.rgb : vec3(0.0);

@@ -1,0 +1,102 @@
+//! `direct` with environment and area lights against the ground truth on a
+//! diffuse scene (floor, box, sphere), one light kind at a time: the sun and
+//! sky, a rect lamp, a sphere lamp. `direct`'s approximations
+//! (docs/ARCHITECTURE.md, "Environment and area lights in direct"): the sky
+//! by order-2 SH irradiance without occlusion, the sun and each lamp with
+//! one hard shadow ray to its centre. Compared: the whole frame (direct +
+//! emitted; the reference's `all`, no diffuse bounces) by relative total
+//! energy and FLIP mean (nv-flip, 67 px/degree) of the tonemapped images.
+//! Measurements and bounds in BENCHMARKS.md ("direct with environment and
+//! area lights"); the images (actual, reference, FLIP map) are written to
+//! `$CARGO_TARGET_TMPDIR/test-output/` every run. 64², 3 M photons each.
+
+mod common;
+
+use caustics::params::{ParamSet, Params};
+use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
+use caustics::renderer::Renderer;
+use caustics::scene::Scene;
+use caustics::techniques;
+use common::*;
+use std::path::Path;
+
+const SIZE: u32 = 64;
+const PHOTONS: u64 = 3_000_000;
+
+const GEOMETRY: &str = "[camera]\neye = [0.0, 2.2, 3.2]\ntarget = [0.0, 0.4, 0.0]\nfov_y = 50\n\
+[[material]]\nname = \"floor\"\nkind = \"diffuse\"\nalbedo = 0.7\n\
+[[material]]\nname = \"grey\"\nkind = \"diffuse\"\nalbedo = 0.5\n\
+[[object]]\nshape = \"plane\"\nsize = [4.0, 4.0]\nmaterial = \"floor\"\n\
+[[object]]\nshape = \"box\"\nmin = [-0.9, 0.0, -0.6]\nmax = [-0.3, 0.8, 0.0]\nmaterial = \"grey\"\n\
+[[object]]\nshape = \"sphere\"\ncenter = [0.6, 0.4, 0.2]\nradius = 0.4\nmaterial = \"grey\"\n";
+
+/// Renders `direct` and the reference for `light` over the geometry and
+/// returns (relative energy error, FLIP mean).
+fn compare(name: &str, light: &str) -> (f64, f32) {
+    let ctx = validated_context();
+    let text = format!("{GEOMETRY}\n{light}");
+    let load = || Scene::from_str(&text, Path::new("direct_lights.toml")).unwrap();
+    let params = Params::resolve("direct", techniques::direct::DirectParams::specs(), &[]).unwrap();
+    let actual = {
+        let mut r = Renderer::new(&ctx, load(), "direct", &params, SIZE, SIZE, 0.0).unwrap();
+        r.render_frame(0.0).unwrap();
+        r.radiance().unwrap()
+    };
+    assert_finite(&actual);
+    let mut reference =
+        ReferenceRenderer::new(&ctx, load(), SIZE, SIZE, 0.0, ReferenceSettings::default())
+            .unwrap();
+    reference.trace(PHOTONS, |_, _| {}).unwrap();
+    let truth = reference.resolve(Component::All).unwrap();
+    assert_finite(&truth);
+    drop(reference);
+    let energy = energy(&actual) / energy(&truth) - 1.0;
+    let (actual_ldr, truth_ldr) = (tonemap(&actual), tonemap(&truth));
+    let (flip_mean, map) = flip(&actual_ldr, &truth_ldr, SIZE);
+    eprintln!("{name}: energy {energy:+.4}, FLIP mean {flip_mean:.4}");
+    assert_validation_clean(&ctx);
+    let dir = write_comparison_pngs(
+        &format!("direct_lights_{name}"),
+        SIZE,
+        &actual_ldr,
+        &truth_ldr,
+        &map,
+    );
+    eprintln!("actual, reference and FLIP map in {dir}");
+    (energy, flip_mean)
+}
+
+#[test]
+fn direct_with_sun_and_sky_against_the_reference() {
+    let (energy, flip) = compare(
+        "sky",
+        "[[light]]\nkind = \"environment\"\nsky = { sun_direction = [0.5, 1.0, 0.3], sun_radius = 2.0, sun_radiance = 800.0, zenith = [0.15, 0.25, 0.45], horizon = [0.35, 0.35, 0.35] }\n",
+    );
+    // Measured +0.033, 0.052: the sky lights the floor next to the box and
+    // under the sphere unoccluded (no ambient occlusion in `direct`).
+    assert!(energy.abs() < 0.055, "energy {energy}");
+    assert!(flip < 0.07, "FLIP {flip}");
+}
+
+#[test]
+fn direct_with_a_rect_light_against_the_reference() {
+    let (energy, flip) = compare(
+        "rect",
+        "[[light]]\nkind = \"rect\"\ncenter = [0.0, 1.6, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [0.4, 0.4]\nradiance = 30.0\n",
+    );
+    // Measured +0.009, 0.036: hard shadows from the lamp's centre.
+    assert!(energy.abs() < 0.025, "energy {energy}");
+    assert!(flip < 0.055, "FLIP {flip}");
+}
+
+#[test]
+fn direct_with_a_sphere_light_against_the_reference() {
+    let (energy, flip) = compare(
+        "sphere",
+        "[[light]]\nkind = \"sphere\"\ncenter = [0.0, 1.2, 0.6]\nradius = 0.15\nradiance = 40.0\n",
+    );
+    // Measured +0.037, 0.041: hard shadows, and the clamped irradiance
+    // where the grey sphere's horizon cuts the lamp.
+    assert!(energy.abs() < 0.06, "energy {energy}");
+    assert!(flip < 0.06, "FLIP {flip}");
+}
