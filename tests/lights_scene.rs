@@ -263,3 +263,25 @@ fn bad_lights_are_rejected() {
         "at most one",
     );
 }
+
+#[test]
+fn canonical_light_scenes_load() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes");
+    let s = Scene::load(&dir.join("ring_sky.toml")).expect("ring_sky");
+    let env = s.environment.expect("an environment");
+    let EnvironmentKind::Image(t) = &env.kind else {
+        panic!("an image")
+    };
+    assert_eq!((t.width, t.height), (256, 128));
+    // Brighter toward the sun (-x, 25 degrees up) than straight up.
+    let texel = |d: Vec3| {
+        let (u, v) = caustics::environment::equirect_uv(d);
+        let (i, j) = ((u * 256.0) as usize, (v * 128.0) as usize);
+        Vec3::from(t.texels[j * 256 + i])
+    };
+    let to_sun = Vec3::new(-25f32.to_radians().cos(), 25f32.to_radians().sin(), 0.0);
+    assert!(texel(to_sun).x > 100.0 * texel(Vec3::Y).x);
+    let s = Scene::load(&dir.join("volume_box.toml")).expect("volume_box");
+    assert_eq!(s.emitters.len(), 1);
+    assert!(s.medium.is_some());
+}
