@@ -51,18 +51,86 @@ pub fn sun_solid_angle(sky: &Sky) -> f32 {
     2.0 * PI * (1.0 - sky.sun_radius_deg.to_radians().cos())
 }
 
-/// Irradiance of the sun on a surface facing it, E = L · 2π(1 − cos α)
-/// (radiance times the disc's solid angle; the exact π L sin²α differs by
-/// α²/4 relative, under 1e-4 below 1°), times `scale`: the directional
-/// light a sky's sun stands for.
+/// The directional light an environment's sun stands for: the way its
+/// light travels and its irradiance on a surface facing it. A sky's sun:
+/// E = L · 2π(1 − cos α) (radiance times the disc's solid angle; the exact
+/// π L sin²α differs by α²/4 relative, under 1e-4 below 1°), times
+/// `scale`. An image's: the sun [`extract_sun`] finds in it.
 pub fn sun_irradiance(env: &Environment) -> Option<(Vec3, Vec3)> {
     match &env.kind {
         EnvironmentKind::Sky(sky) if sky.sun_radiance.max_element() > 0.0 => Some((
             -sky.sun_direction,
             sky.sun_radiance * sun_solid_angle(sky) * env.scale,
         )),
-        _ => None,
+        EnvironmentKind::Sky(_) => None,
+        EnvironmentKind::Image(_) => {
+            let (w, h, texels) = table(env);
+            extract_sun(w, h, &texels).map(|s| (-(rotation(env) * s.direction), s.irradiance))
+        }
     }
+}
+
+/// A sun found in an equirectangular table (image frame): the texels
+/// within [`SUN_SEARCH_DEG`] of the brightest one whose luminance exceeds
+/// `threshold` (50 times the table's mean luminance over the sphere, at
+/// least 1e-3 of the peak); none when the peak is below that.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExtractedSun {
+    /// Unit direction toward the sun (image frame): the texels' mean
+    /// direction weighted by luminance times solid angle.
+    pub direction: Vec3,
+    /// Direction of the brightest texel and the cosine of the search cone
+    /// around it: a texel belongs to the sun when it lies in this cone and
+    /// is brighter than `threshold` (glsl/direct/environment_sh.comp leaves
+    /// exactly those out of the sky's spherical harmonics).
+    pub peak: Vec3,
+    pub cos_search: f32,
+    pub threshold: f32,
+    /// Σ L ΔΩ over the sun's texels: irradiance on a surface facing it.
+    pub irradiance: Vec3,
+}
+
+/// Half-angle of the cone around an image's brightest texel searched for
+/// the rest of its sun.
+pub const SUN_SEARCH_DEG: f32 = 10.0;
+
+pub fn extract_sun(w: u32, h: u32, texels: &[[f32; 3]]) -> Option<ExtractedSun> {
+    let lum = |t: &[f32; 3]| Vec3::from(*t).dot(LUMINANCE);
+    let dir =
+        |i: u32, j: u32| equirect_dir((i as f32 + 0.5) / w as f32, (j as f32 + 0.5) / h as f32);
+    let mut integral = 0.0f64;
+    let (mut peak_i, mut peak_l) = (0usize, -1.0f32);
+    for (k, t) in texels.iter().enumerate() {
+        let l = lum(t);
+        integral += (l * texel_solid_angle(k as u32 / w, w, h)) as f64;
+        if l > peak_l {
+            (peak_i, peak_l) = (k, l);
+        }
+    }
+    let mean = (integral / (4.0 * std::f64::consts::PI)) as f32;
+    let threshold = (50.0 * mean).max(1e-3 * peak_l);
+    if !(peak_l > threshold) {
+        return None;
+    }
+    let peak = dir(peak_i as u32 % w, peak_i as u32 / w);
+    let cos_search = SUN_SEARCH_DEG.to_radians().cos();
+    let (mut sum_d, mut e) = (Vec3::ZERO, Vec3::ZERO);
+    for (k, t) in texels.iter().enumerate() {
+        let (i, j) = (k as u32 % w, k as u32 / w);
+        let d = dir(i, j);
+        if d.dot(peak) >= cos_search && lum(t) > threshold {
+            let omega = texel_solid_angle(j, w, h);
+            e += Vec3::from(*t) * omega;
+            sum_d += d * lum(t) * omega;
+        }
+    }
+    Some(ExtractedSun {
+        direction: sum_d.normalize(),
+        peak,
+        cos_search,
+        threshold,
+        irradiance: e,
+    })
 }
 
 /// The environment as an equirectangular table of radiance in the image's
@@ -184,6 +252,25 @@ mod tests {
         let (w, h) = (64, 32);
         let sum: f32 = (0..h).map(|j| texel_solid_angle(j, w, h) * w as f32).sum();
         assert!((sum - 4.0 * PI).abs() < 1e-4);
+    }
+
+    #[test]
+    fn a_bright_blob_is_extracted_as_the_sun() {
+        let (w, h) = (64u32, 32u32);
+        let mut texels = vec![[1.0f32; 3]; (w * h) as usize];
+        // Two texels near (u, v) = (0.5, 0.3), 1e4 times the sky.
+        for i in [31usize, 32] {
+            texels[9 * w as usize + i] = [1e4, 2e4, 3e4];
+        }
+        let sun = extract_sun(w, h, &texels).expect("a sun");
+        let omega = texel_solid_angle(9, w, h);
+        assert!(
+            (sun.irradiance - Vec3::new(2e4, 4e4, 6e4) * omega).length()
+                < 1e-2 * sun.irradiance.length()
+        );
+        let expected = equirect_dir(0.5, 9.5 / 32.0);
+        assert!(sun.direction.dot(expected) > 0.9999, "{}", sun.direction);
+        assert!(extract_sun(w, h, &vec![[1.0; 3]; (w * h) as usize]).is_none());
     }
 
     #[test]

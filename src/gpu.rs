@@ -99,6 +99,14 @@ pub struct GpuEnvironment {
     /// x width, y height of the table; z = table power (luminance, W:
     /// π R² ∫ L dω); w unused.
     pub table: [f32; 4],
+    /// The sun found in an image's table (`environment::extract_sun`), for
+    /// `direct` only: xyz its peak texel's direction (world), w the cosine
+    /// of the search cone (2: none).
+    pub image_sun_peak: [f32; 4],
+    /// xyz its mean direction toward the sun (world); w its luminance threshold.
+    pub image_sun_direction: [f32; 4],
+    /// rgb its irradiance on a surface facing it (W/m²); w unused.
+    pub image_sun_irradiance: [f32; 4],
 }
 
 #[repr(C)]
@@ -186,7 +194,7 @@ const _: () = {
     assert!(offset_of!(GpuMaterial, texture) == 32);
     assert!(offset_of!(GpuMaterial, emission) == 48);
     assert!(size_of::<GpuEmitter>() == 64);
-    assert!(size_of::<GpuEnvironment>() == 64);
+    assert!(size_of::<GpuEnvironment>() == 112);
     assert!(size_of::<GpuLight>() == 64);
     assert!(size_of::<GpuMedium>() == 96);
     assert!(offset_of!(GpuMedium, dims) == 80);

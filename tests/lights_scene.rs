@@ -281,6 +281,12 @@ fn canonical_light_scenes_load() {
     };
     let to_sun = Vec3::new(-25f32.to_radians().cos(), 25f32.to_radians().sin(), 0.0);
     assert!(texel(to_sun).x > 100.0 * texel(Vec3::Y).x);
+    // The sun `direct` extracts from the image: the script's 700 W/m² red
+    // (less the faint rim texels left to the sky), from -x at 25 degrees.
+    let (travel, e) = caustics::environment::sun_irradiance(&env).expect("a sun in the image");
+    eprintln!("extracted sun: E {e}, toward {}", -travel);
+    assert!((-travel).dot(to_sun) > 0.9995, "{travel}");
+    assert!((e.x / 700.0 - 1.0).abs() < 0.05, "{e}");
     let s = Scene::load(&dir.join("volume_box.toml")).expect("volume_box");
     assert_eq!(s.emitters.len(), 1);
     assert!(s.medium.is_some());

@@ -142,11 +142,23 @@ vec3 emitter_irradiance(uint e, vec3 x, vec3 n, out vec3 to_light, out float rea
     return sphere_irradiance(em, x, n);
 }
 
-// The sky's sun as a directional light: irradiance on a surface facing it,
-// E = L 2 pi (1 - cos alpha), and the way its light travels (-sun).
-vec3 environment_sun_irradiance() {
-    if (!environment_present() || environment.sun.w > 1.5) return vec3(0.0);
-    return environment.sun_radiance.rgb * (2.0 * PI * (1.0 - environment.sun.w));
+// The environment's sun as a directional light: a sky's sun, E = L 2 pi
+// (1 - cos alpha), or the sun found in an image (src/environment.rs
+// extract_sun; the reference samples it as part of the table). `to_sun`:
+// toward it. For techniques that need a directional light (`direct`).
+vec3 environment_sun_irradiance(out vec3 to_sun) {
+    to_sun = environment.sun.xyz;
+    if (!environment_present()) return vec3(0.0);
+    if (environment.sun.w <= 1.0) return environment.sun_radiance.rgb * (2.0 * PI * (1.0 - environment.sun.w));
+    to_sun = environment.image_sun_direction.xyz;
+    return environment.image_sun_peak.w <= 1.0 ? environment.image_sun_irradiance.rgb : vec3(0.0);
+}
+
+// Whether an image texel (direction d, world; radiance l) belongs to the
+// image's sun, which `direct` takes as a directional light instead.
+bool environment_image_sun_texel(vec3 d, vec3 l) {
+    return environment.image_sun_peak.w <= 1.0 && dot(d, environment.image_sun_peak.xyz) >= environment.image_sun_peak.w
+        && luminance(l) > environment.image_sun_direction.w;
 }
 
 #endif

@@ -54,6 +54,10 @@ struct EnvironmentInfo {
     vec4 sun;          // xyz toward the sun (world); w: cos of its angular radius (2: none)
     vec4 sun_radiance; // rgb; w: luminance power for light selection
     vec4 table;        // x width, y height of the radiance table; z: its luminance power
+    // The sun found in an image (src/environment.rs extract_sun), for direct:
+    vec4 image_sun_peak;       // xyz peak texel's direction; w: cos of the search cone (2: none)
+    vec4 image_sun_direction;  // xyz mean direction toward it; w: luminance threshold
+    vec4 image_sun_irradiance; // rgb irradiance facing it
 };
 
 struct Light {

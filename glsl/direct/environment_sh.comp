@@ -1,6 +1,7 @@
 #version 460
 // The environment's irradiance for `direct`: projects its radiance table
-// (glsl/common/emitters.glsl; the sky's sun is not in it) onto the 9 real
+// (glsl/common/emitters.glsl; a sky's sun is not in it, an image's sun is
+// left out: lighting.comp takes both as a directional light) onto the 9 real
 // spherical harmonics of order 2, L_lm = sum over texels of
 // L(w) Y_lm(w) dOmega_texel, dOmega_texel = (2 pi / W)(cos theta_0 - cos theta_1)
 // exactly, and stores A_l L_lm (sh.glsl), so lighting.comp's irradiance is
@@ -28,7 +29,10 @@ void main() {
             vec2 uv = (vec2(x, y) + 0.5) / vec2(w, h);
             vec3 d = environment_to_world(equirect_dir(uv));
             float omega = 2.0 * PI / float(w) * (cos(PI * float(y) / float(h)) - cos(PI * float(y + 1u) / float(h)));
-            vec3 l = texelFetch(environment_map, ivec3(x, y, 0), 0).rgb * omega;
+            vec3 l = texelFetch(environment_map, ivec3(x, y, 0), 0).rgb;
+            // An image's sun is lit as a directional light with a shadow.
+            if (environment_image_sun_texel(d, l)) continue;
+            l *= omega;
             float basis[9];
             sh_basis(d, basis);
             for (int k = 0; k < 9; ++k) acc[k] += l * basis[k];

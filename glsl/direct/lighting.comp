@@ -50,8 +50,8 @@ vec3 shadow_origin(vec3 x, vec3 n) {
 // Irradiance at x (normal n, facing the camera) from the environment and the
 // area lights (docs/ARCHITECTURE.md, "Environment and area lights in
 // direct"): the environment's table by its order-2 spherical-harmonic
-// irradiance, unoccluded; the sky's sun as a directional light with a BVH
-// shadow ray toward its centre; each area light's exact unoccluded
+// irradiance, unoccluded; the environment's sun (a sky's, or the one found in
+// an image) as a directional light with a BVH shadow ray toward its centre; each area light's exact unoccluded
 // irradiance (emitters.glsl) times one BVH shadow ray toward its centre.
 vec3 extended_irradiance(vec3 x, vec3 n) {
     vec3 e = vec3(0.0);
@@ -61,11 +61,12 @@ vec3 extended_irradiance(vec3 x, vec3 n) {
         vec3 sky = vec3(0.0);
         for (int k = 0; k < 9; ++k) sky += sh[k].rgb * y[k];
         e += max(sky, vec3(0.0));
-        vec3 sun = environment_sun_irradiance();
-        float cos_sun = dot(n, environment.sun.xyz);
+        vec3 to_sun;
+        vec3 sun = environment_sun_irradiance(to_sun);
+        float cos_sun = dot(n, to_sun);
         if (cos_sun > 0.0 && any(greaterThan(sun, vec3(0.0)))
-                && !trace_any(shadow_origin(x, n), environment.sun.xyz, 0.0, 1e30)) {
-            e += sun * cos_sun * medium_transmittance_steps(x, environment.sun.xyz, light_travel(1e30, x), pc.medium_steps);
+                && !trace_any(shadow_origin(x, n), to_sun, 0.0, 1e30)) {
+            e += sun * cos_sun * medium_transmittance_steps(x, to_sun, light_travel(1e30, x), pc.medium_steps);
         }
     }
     for (uint i = 0u; i < frame.components.y; ++i) {

@@ -34,11 +34,23 @@ impl EnvironmentGpu {
             sun: [0.0, 1.0, 0.0, 2.0],
             sun_radiance: [0.0; 4],
             table: [w as f32, h as f32, 0.0, 0.0],
+            image_sun_peak: [0.0, 1.0, 0.0, 2.0],
+            image_sun_direction: [0.0, 1.0, 0.0, f32::MAX],
+            image_sun_irradiance: [0.0; 4],
         };
         if let Some(env) = env {
             let (s, c) = env.rotate_deg.to_radians().sin_cos();
             constants.params = [1.0, 0.0, c, s];
             constants.table[2] = integral * disc;
+            if let EnvironmentKind::Image(_) = &env.kind {
+                if let Some(sun) = environment::extract_sun(w, h, &texels) {
+                    let rot = environment::rotation(env);
+                    let (p, d) = (rot * sun.peak, rot * sun.direction);
+                    constants.image_sun_peak = [p.x, p.y, p.z, sun.cos_search];
+                    constants.image_sun_direction = [d.x, d.y, d.z, sun.threshold];
+                    constants.image_sun_irradiance = sun.irradiance.extend(0.0).to_array();
+                }
+            }
             if let EnvironmentKind::Sky(sky) = &env.kind {
                 let l = sky.sun_radiance * env.scale;
                 let d = sky.sun_direction;
