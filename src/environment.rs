@@ -109,7 +109,7 @@ pub fn extract_sun(w: u32, h: u32, texels: &[[f32; 3]]) -> Option<ExtractedSun> 
     }
     let mean = (integral / (4.0 * std::f64::consts::PI)) as f32;
     let threshold = (50.0 * mean).max(1e-3 * peak_l);
-    if !(peak_l > threshold) {
+    if peak_l.is_nan() || peak_l <= threshold {
         return None;
     }
     let peak = dir(peak_i as u32 % w, peak_i as u32 / w);

@@ -117,3 +117,42 @@ fn direct_with_the_sky_image_against_the_reference() {
     assert!(energy.abs() < 0.045, "energy {energy}");
     assert!(flip < 0.075, "FLIP {flip}");
 }
+
+/// A sky's sun stands for a directional light of E = L 2π(1 − cos α)
+/// (docs/SCENES.md): `water_photons` on the pool lit by a black sky with a
+/// sun of that E draws the same caustics as under the directional light.
+#[test]
+fn water_photons_takes_the_sky_sun_as_its_directional_light() {
+    use caustics::radiometry::Component;
+    let ctx = validated_context();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/water_pool.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let omega = 2.0 * std::f64::consts::PI * (1.0 - 0.5f64.to_radians().cos());
+    let sky = format!(
+        "[[light]]\nkind = \"environment\"\nsky = {{ sun_direction = [0.35, 1.0, 0.45], sun_radius = 0.5, sun_radiance = [{}, {}, {}], zenith = 0.0, horizon = 0.0 }}\n",
+        1000.0 / omega,
+        980.0 / omega,
+        950.0 / omega
+    );
+    let directional = "[[light]]\nkind = \"directional\"\ndirection = [-0.35, -1.0, -0.45]\nirradiance = [1000.0, 980.0, 950.0]\n";
+    assert!(text.contains(directional));
+    let params = Params::resolve(
+        "water_photons",
+        techniques::water_photons::WaterPhotonsParams::specs(),
+        &[],
+    )
+    .unwrap();
+    let caustics = |text: &str| {
+        let scene = Scene::from_str(text, &path).unwrap();
+        let mut r = Renderer::new(&ctx, scene, "water_photons", &params, 48, 48, 0.0).unwrap();
+        r.scene_gpu.components = Component::SurfaceCaustics.mask();
+        r.render_frame(0.0).unwrap();
+        energy(&r.radiance().unwrap())
+    };
+    let under_light = caustics(&text);
+    let under_sky = caustics(&text.replace(directional, &sky));
+    let rel = under_sky / under_light - 1.0;
+    eprintln!("caustic energy: directional {under_light:.3}, sky sun {under_sky:.3} ({rel:+.2e})");
+    assert!(under_light > 0.0 && rel.abs() < 1e-3, "{rel}");
+    assert_validation_clean(&ctx);
+}
