@@ -107,7 +107,11 @@ impl ImageSpace {
 impl TechniqueBuild for ImageSpace {
     const NAME: &'static str = "image_space";
     const DESCRIPTION: &'static str = "Wyman 2005-06: two-sided image-space refraction of what the camera sees through glass (and in mirrors), and caustic maps (photons through the specular objects, Gaussian splats, projected onto diffuse receivers)";
-    const COMPONENTS: &'static [Component] = &[Component::Direct, Component::SurfaceCaustics];
+    const COMPONENTS: &'static [Component] = &[
+        Component::Direct,
+        Component::SurfaceCaustics,
+        Component::Emitted,
+    ];
     type Params = ImageSpaceParams;
 
     fn build(

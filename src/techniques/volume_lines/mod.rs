@@ -225,6 +225,7 @@ impl TechniqueBuild for VolumeLines {
         Component::SurfaceCaustics,
         Component::Airlight,
         Component::VolumeCaustics,
+        Component::Emitted,
     ];
     type Params = VolumeLinesParams;
 

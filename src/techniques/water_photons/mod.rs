@@ -446,7 +446,11 @@ impl WaterPhotons {
 impl TechniqueBuild for WaterPhotons {
     const NAME: &'static str = "water_photons";
     const DESCRIPTION: &'static str = "Kougianos & Moustakas 2021: cascaded caustic maps of the water from the sun, photon differentials traced through the BVH, splats drawn indirect into a screen-space caustic buffer";
-    const COMPONENTS: &'static [Component] = &[Component::Direct, Component::SurfaceCaustics];
+    const COMPONENTS: &'static [Component] = &[
+        Component::Direct,
+        Component::SurfaceCaustics,
+        Component::Emitted,
+    ];
     type Params = WaterPhotonsParams;
 
     fn build(
