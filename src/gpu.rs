@@ -280,6 +280,8 @@ impl GpuLight {
             .max(0.0)
             .to_radians();
         let (cos_outer, cos_inner) = match l.kind {
+            // A rect light's stand-in: the cosine profile (spot_falloff).
+            LightKind::Spot if l.cone_falloff_deg < 0.0 => (0.0, 2.0),
             LightKind::Spot => (outer.cos(), inner.cos()),
             _ => (-1.0, -1.0),
         };

@@ -139,11 +139,16 @@ impl SceneGpu {
         };
         let sphere = scene.bounding_sphere(time);
         let materials: Vec<GpuMaterial> = scene.materials.iter().map(GpuMaterial::new).collect();
-        let lights: Vec<GpuLight> = scene
-            .lights
+        // The scene's lights, then the stand-ins of its sun and rect lights
+        // (`environment::caustic_lights`): the reference and `direct` use
+        // only the first `frame.counts.x`, the caustic techniques all.
+        let mut lights: Vec<GpuLight> = crate::environment::caustic_lights(scene)
             .iter()
             .map(|l| GpuLight::new(l, sphere.1))
             .collect();
+        if lights.is_empty() {
+            lights.push(bytemuck::Zeroable::zeroed());
+        }
         let medium = gpu_medium(scene);
         let grid: Vec<f32> = match scene.medium.as_ref().map(|m| &m.density) {
             Some(Density::Grid { values, .. }) => values.clone(),
@@ -278,8 +283,7 @@ impl SceneGpu {
     /// Re-uploads moved lights (same count). The caller has waited for every
     /// frame that read the old ones.
     pub fn update_lights(&self, scene: &Scene) -> VkResult<()> {
-        let lights: Vec<GpuLight> = scene
-            .lights
+        let lights: Vec<GpuLight> = crate::environment::caustic_lights(scene)
             .iter()
             .map(|l| GpuLight::new(l, self.sphere.1))
             .collect();

@@ -122,6 +122,7 @@ impl TechniqueBuild for ImageSpace {
         width: u32,
         height: u32,
     ) -> anyhow::Result<Self> {
+        crate::environment::check_stand_ins(scene, Self::NAME).map_err(anyhow::Error::msg)?;
         Ok(Self::new(ctx, params, scene, scene_gpu, width, height)?)
     }
 }
