@@ -299,7 +299,8 @@ pub fn caustic_lights(scene: &Scene) -> Vec<Light> {
 /// stand-ins cannot represent: a sphere light (a point at its centre lies
 /// inside its own geometry), a rect larger than
 /// [`STAND_IN_MAX_SIZE_RATIO`] of its distance to the nearest other
-/// surface, or more lights than `MAX_LIGHTS` with the stand-ins.
+/// surface not entirely behind it, or more lights than `MAX_LIGHTS` with
+/// the stand-ins.
 pub fn check_stand_ins(scene: &Scene, technique: &str) -> Result<(), String> {
     let triangles = scene.triangles(0.0);
     for (i, e) in scene.emitters.iter().enumerate() {
@@ -309,11 +310,18 @@ pub fn check_stand_ins(scene: &Scene, technique: &str) -> Result<(), String> {
                     "{technique} does not support sphere lights (area light {i}); use `direct` or `reference`"
                 ))
             }
-            EmitterShape::Rect { center, size, .. } => {
+            EmitterShape::Rect {
+                center,
+                normal,
+                size,
+                ..
+            } => {
                 let half = 0.5 * (size[0] * size[0] + size[1] * size[1]).sqrt();
+                // Surfaces entirely behind the rect receive none of its light.
                 let nearest = triangles
                     .iter()
                     .filter(|t| t.object != e.object)
+                    .filter(|t| t.positions.iter().any(|&p| (p - center).dot(normal) > 0.0))
                     .map(|t| point_triangle_distance(center, t.positions))
                     .fold(f32::INFINITY, f32::min);
                 if half > STAND_IN_MAX_SIZE_RATIO * nearest {
