@@ -3,7 +3,10 @@
 //! agree without padding rules; the const assertions below pin sizes and
 //! offsets, and the GLSL side mirrors the same field order.
 
-use crate::scene::{Density, Light, LightKind, Material, MaterialKind, Medium, Triangle, Wave};
+use crate::scene::{
+    Density, Emitter, EmitterShape, Light, LightKind, Material, MaterialKind, Medium, Triangle,
+    Wave,
+};
 use crate::shader_bindings as b;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3, Vec4};
@@ -63,6 +66,49 @@ pub struct GpuMaterial {
     /// `uv * uv_scale`; where the layer's alpha is below the cutoff the
     /// surface is cut out.
     pub texture: [f32; 4],
+    /// rgb radiance emitted from front faces (area lights' own material); w unused.
+    pub emission: [f32; 4],
+}
+
+/// An area light (glsl/common/scene.glsl `Emitter`): what the reference
+/// samples photons from. Its geometry is ordinary triangles with an
+/// emitting material.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuEmitter {
+    /// xyz centre; w = kind (EMITTER_RECT / EMITTER_SPHERE, uint bits).
+    pub position: [f32; 4],
+    /// xyz unit normal (rect: the side it emits to); w = width (rect) or radius (sphere).
+    pub normal: [f32; 4],
+    /// xyz unit tangent, the direction of the width (rect); w = height (rect).
+    pub tangent: [f32; 4],
+    /// rgb radiance; w = power (luminance, W) for light selection.
+    pub radiance: [f32; 4],
+}
+
+/// The environment light's constants, the head of the BINDING_ENVIRONMENT_DATA
+/// buffer (its sampling tables follow, `environment::sampling_tables`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuEnvironment {
+    /// x = 1 when the scene has an environment; y unused; zw = cos, sin of
+    /// the rotation about +y (image frame -> world).
+    pub params: [f32; 4],
+    /// xyz unit direction toward the sun (world); w = cos of its angular radius (2: no sun).
+    pub sun: [f32; 4],
+    /// rgb sun radiance (scaled); w = sun power (luminance, W: L Ω π R²).
+    pub sun_radiance: [f32; 4],
+    /// x width, y height of the table; z = table power (luminance, W:
+    /// π R² ∫ L dω); w unused.
+    pub table: [f32; 4],
+    /// The sun found in an image's table (`environment::extract_sun`), for
+    /// `direct` only: xyz its peak texel's direction (world), w the cosine
+    /// of the search cone (2: none).
+    pub image_sun_peak: [f32; 4],
+    /// xyz its mean direction toward the sun (world); w its luminance threshold.
+    pub image_sun_direction: [f32; 4],
+    /// rgb its irradiance on a surface facing it (W/m²); w unused.
+    pub image_sun_irradiance: [f32; 4],
 }
 
 #[repr(C)]
@@ -112,7 +158,7 @@ pub struct GpuFrame {
     /// x lights, y triangles, z materials, w frame index.
     pub counts: [u32; 4],
     /// x: the path-type components techniques draw, a bit mask
-    /// (1 << COMPONENT_*; `Component::mask`); yzw reserved.
+    /// (1 << COMPONENT_*; `Component::mask`); y: area lights; zw reserved.
     pub components: [u32; 4],
 }
 
@@ -146,8 +192,11 @@ const _: () = {
     assert!(offset_of!(GpuBvhNode, count) == 28);
     assert!(size_of::<GpuTriangleUv>() == 32);
     assert!(offset_of!(GpuTriangleUv, uv2) == 16);
-    assert!(size_of::<GpuMaterial>() == 48);
+    assert!(size_of::<GpuMaterial>() == 64);
     assert!(offset_of!(GpuMaterial, texture) == 32);
+    assert!(offset_of!(GpuMaterial, emission) == 48);
+    assert!(size_of::<GpuEmitter>() == 64);
+    assert!(size_of::<GpuEnvironment>() == 112);
     assert!(size_of::<GpuLight>() == 64);
     assert!(size_of::<GpuMedium>() == 96);
     assert!(offset_of!(GpuMedium, dims) == 80);
@@ -218,6 +267,7 @@ impl GpuMaterial {
                 uv_scale.y,
                 alpha_cutoff,
             ],
+            emission: v4(m.emission, 0.0),
         }
     }
 }
@@ -239,6 +289,8 @@ impl GpuLight {
             .max(0.0)
             .to_radians();
         let (cos_outer, cos_inner) = match l.kind {
+            // A rect light's stand-in: the cosine profile (spot_falloff).
+            LightKind::Spot if l.cone_falloff_deg < 0.0 => (0.0, 2.0),
             LightKind::Spot => (outer.cos(), inner.cos()),
             _ => (-1.0, -1.0),
         };
@@ -252,6 +304,32 @@ impl GpuLight {
                 0.0,
                 0.0,
             ],
+        }
+    }
+}
+
+impl GpuEmitter {
+    pub fn new(e: &Emitter) -> Self {
+        let power = crate::environment::emitter_power(e).dot(LUMINANCE);
+        let radiance = v4(e.radiance, power);
+        match e.shape {
+            EmitterShape::Rect {
+                center,
+                normal,
+                tangent,
+                size,
+            } => Self {
+                position: v4(center, f32::from_bits(b::EMITTER_RECT)),
+                normal: v4(normal, size[0]),
+                tangent: v4(tangent, size[1]),
+                radiance,
+            },
+            EmitterShape::Sphere { center, radius } => Self {
+                position: v4(center, f32::from_bits(b::EMITTER_SPHERE)),
+                normal: v4(Vec3::Y, radius),
+                tangent: v4(Vec3::X, 0.0),
+                radiance,
+            },
         }
     }
 }

@@ -5,6 +5,7 @@ pub mod app;
 pub mod bvh;
 pub mod cascades;
 pub mod compare;
+pub mod environment;
 pub mod frame;
 pub mod gpu;
 pub mod output;

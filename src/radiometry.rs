@@ -8,7 +8,12 @@ use std::f32::consts::PI;
 
 /// Spot-light angular falloff: 1 inside `cos_inner`, 0 outside `cos_outer`,
 /// smoothstep in cos(theta) between (glsl/common/lights.glsl: spot_falloff).
+/// `cos_inner` > 1 marks the cosine profile of a rect light's stand-in
+/// (`environment::LAMBERTIAN_FALLOFF`): max(cos θ, 0).
 pub fn spot_falloff(cos_theta: f32, cos_outer: f32, cos_inner: f32) -> f32 {
+    if cos_inner > 1.5 {
+        return cos_theta.max(0.0);
+    }
     if cos_inner <= cos_outer {
         return if cos_theta >= cos_outer { 1.0 } else { 0.0 };
     }
@@ -24,6 +29,7 @@ pub fn spot_falloff(cos_theta: f32, cos_outer: f32, cos_inner: f32) -> f32 {
 pub fn light_power(light: &Light, scene_radius: f32) -> Vec3 {
     match light.kind {
         LightKind::Point => light.intensity * 4.0 * PI,
+        LightKind::Spot if light.cone_falloff_deg < 0.0 => light.intensity * PI,
         LightKind::Spot => {
             let cos_outer = light.cone_angle_deg.to_radians().cos();
             let cos_inner = (light.cone_angle_deg - light.cone_falloff_deg)
@@ -74,17 +80,21 @@ pub enum Component {
     VolumeCaustics,
     /// Everything else (diffuse interreflection, multiple scattering).
     Other,
+    /// L S* E: the environment and area lights seen directly or through
+    /// specular chains (the background, a lamp, the sky in a mirror).
+    Emitted,
     /// The sum of all.
     All,
 }
 
 impl Component {
-    pub const NAMED: [(&'static str, Component); 6] = [
+    pub const NAMED: [(&'static str, Component); 7] = [
         ("direct", Component::Direct),
         ("surface_caustics", Component::SurfaceCaustics),
         ("airlight", Component::Airlight),
         ("volume_caustics", Component::VolumeCaustics),
         ("other", Component::Other),
+        ("emitted", Component::Emitted),
         ("all", Component::All),
     ];
 
@@ -124,6 +134,7 @@ impl Component {
             Component::Airlight => b::COMPONENT_AIRLIGHT,
             Component::VolumeCaustics => b::COMPONENT_VOLUME_CAUSTICS,
             Component::Other => b::COMPONENT_OTHER,
+            Component::Emitted => b::COMPONENT_EMITTED,
             Component::All => b::COMPONENT_COUNT,
         }
     }

@@ -19,6 +19,16 @@ pub const BINDING_DENSITY_GRID: u32 = 6;
 pub const BINDING_TRIANGLE_UVS: u32 = 7;
 /// The albedo texture array (sampler2DArray; src/frame/textures.rs).
 pub const BINDING_ALBEDO_TEXTURES: u32 = 8;
+/// Area lights (`GpuEmitter`), at least one record (zeroed when none).
+pub const BINDING_EMITTERS: u32 = 9;
+/// The environment's equirectangular radiance table (sampler2D, RGBA32F).
+pub const BINDING_ENVIRONMENT: u32 = 10;
+/// The environment's constants (`GpuEnvironment`) and sampling tables.
+pub const BINDING_ENVIRONMENT_DATA: u32 = 11;
+
+// Area light kinds (GpuEmitter.position.w as uint bits).
+pub const EMITTER_RECT: u32 = 0;
+pub const EMITTER_SPHERE: u32 = 1;
 
 // Material kinds (GpuMaterial.color.w as uint bits).
 pub const MATERIAL_DIFFUSE: u32 = 0;
@@ -42,7 +52,10 @@ pub const COMPONENT_SURFACE_CAUSTICS: u32 = 1;
 pub const COMPONENT_AIRLIGHT: u32 = 2;
 pub const COMPONENT_VOLUME_CAUSTICS: u32 = 3;
 pub const COMPONENT_OTHER: u32 = 4;
-pub const COMPONENT_COUNT: u32 = 5;
+/// L S* E: emitters (the environment, area lights) seen directly or
+/// through specular chains.
+pub const COMPONENT_EMITTED: u32 = 5;
+pub const COMPONENT_COUNT: u32 = 6;
 
 /// Most lights a scene may hold (one shadow map slot of 6 layers each).
 pub const MAX_LIGHTS: u32 = 8;
@@ -66,6 +79,10 @@ pub const DIRECT_BINDING_RADIANCE: u32 = 2;
 pub const DIRECT_BINDING_SHADOW_MAP: u32 = 3;
 pub const DIRECT_BINDING_SHADOW_LIGHTS: u32 = 4;
 pub const DIRECT_BINDING_ALBEDO: u32 = 5;
+/// The environment's irradiance as 9 spherical-harmonic coefficients (rgb, vec4 each).
+pub const DIRECT_BINDING_ENVIRONMENT_SH: u32 = 6;
+/// Workgroup size of glsl/direct/environment_sh.comp (one workgroup).
+pub const DIRECT_SH_GROUP_SIZE: u32 = 64;
 
 // BVH probe (glsl/tests/bvh_probe.comp, tests/bvh_gpu.rs), descriptor set 1
 // (set 0 is the scene). Numbers kept from the probe's first version.

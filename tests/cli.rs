@@ -406,7 +406,7 @@ fn bad_arguments_fail_cleanly() {
             ],
             vec![
                 "technique `direct` does not render component `surface_caustics`",
-                "it renders: direct, all",
+                "it renders: direct, emitted, all",
             ],
         ),
         (

@@ -91,6 +91,7 @@ fn compare_writes_every_file_with_the_tests_numbers() {
         "reference_airlight",
         "reference_volume_caustics",
         "reference_other",
+        "reference_emitted",
     ] {
         expected.push(format!("{stem}.exr"));
         expected.push(format!("{stem}.png"));

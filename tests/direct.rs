@@ -43,6 +43,7 @@ fn diffuse(name: &str) -> Material {
         ior: 1.0,
         absorption: Vec3::ZERO,
         texture: None,
+        emission: glam::Vec3::ZERO,
     }
 }
 
@@ -117,6 +118,8 @@ fn scene(lights: Vec<Light>, with_box: bool) -> Scene {
         objects,
         medium: None,
         output: Output { exposure: 1.0 },
+        environment: None,
+        emitters: Vec::new(),
         textures: Vec::new(),
     }
 }

@@ -980,6 +980,7 @@ fn mirror_ring_cardioid_cusp() {
         ior: 1.0,
         absorption: Vec3::ZERO,
         texture: None,
+        emission: glam::Vec3::ZERO,
     };
     let mut ring = caustics::scene::shapes::cylinder(
         Vec3::ZERO,

@@ -319,6 +319,7 @@ fn glass_slab_transmits_one_minus_fresnel_squared() {
                 // Absorbs in green only: 1/m over the slab's 0.2 m.
                 absorption: Vec3::new(0.0, absorption, 0.0),
                 texture: None,
+                emission: glam::Vec3::ZERO,
                 ..dielectric("glass", n)
             },
         ],
@@ -496,6 +497,7 @@ fn mirror_shows_the_reflected_floor_times_its_reflectance() {
         ior: 1.0,
         absorption: Vec3::ZERO,
         texture: None,
+        emission: glam::Vec3::ZERO,
     };
     let s = scene(
         cam,

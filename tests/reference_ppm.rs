@@ -22,6 +22,7 @@ fn mirror(name: &str, reflectance: f32) -> Material {
         ior: 1.0,
         absorption: Vec3::ZERO,
         texture: None,
+        emission: glam::Vec3::ZERO,
     }
 }
 

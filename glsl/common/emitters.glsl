@@ -1,49 +1,164 @@
-// Emitters seen along a ray, as radiance (W m^-2 sr^-1): what an environment
-// map of the lights holds (Wand & Strasser 2003 Sect. 3.1: "represent the
-// incoming light as an environment map"). Point and spot lights, which have
-// no extent in the scene model, are drawn as spheres of a stated radius r
-// with the radiance that gives their intensity, L = I / (pi r^2) (a sphere
-// of radius r and radiance L has intensity pi r^2 L in every direction;
-// spot: I times its cone profile toward the viewer); a directional light as
-// a sun disc of angular radius alpha with L = E / (pi sin^2 alpha), so that a
-// surface facing it receives exactly E (integral of L cos over the cap).
-// Requires scene.glsl, lights.glsl, optics.glsl.
+// The environment light and area lights (GUIDE §2: both in radiance,
+// W m^-2 sr^-1): evaluation for any pass, sampling for the reference.
+// Mirrors src/environment.rs. Requires scene.glsl and optics.glsl.
+//
+// Equirectangular convention (docs/SCENES.md): in the image's frame,
+// u = phi / 2pi with phi from +x toward +z, v = theta / pi with theta from
+// +y (row 0 is straight up); the image frame turns into the world by
+// `rotate` about +y.
 #ifndef COMMON_EMITTERS_GLSL
 #define COMMON_EMITTERS_GLSL
 
-// Radiance of light l seen from `origin` along unit `dir`, 0 where the ray
-// misses it. `radius`: r of point and spot lights (m); `sun_cos`: cos alpha.
-vec3 light_emitter_radiance(uint l, vec3 origin, vec3 dir, float radius, float sun_cos) {
-    Light light = lights[l];
-    uint kind = floatBitsToUint(light.position.w);
-    if (kind == LIGHT_DIRECTIONAL) {
-        if (dot(dir, -light.direction.xyz) < sun_cos) return vec3(0.0);
-        float sin2 = max(1.0 - sun_cos * sun_cos, 1e-12);
-        return light.intensity.rgb / (PI * sin2);
-    }
-    // Ray-sphere: |origin + t dir - P|^2 = r^2 with t > 0.
-    vec3 oc = light.position.xyz - origin;
-    float tc = dot(oc, dir);
-    float d2 = dot(oc, oc) - tc * tc;
-    if (tc <= 0.0 || d2 > radius * radius) return vec3(0.0);
-    vec3 intensity = light.intensity.rgb;
-    if (kind == LIGHT_SPOT) {
-        vec3 to_origin = -oc / max(length(oc), 1e-30);
-        intensity *= spot_falloff(dot(to_origin, light.direction.xyz), light.direction.w, light.intensity.w);
-    }
-    return intensity / (PI * radius * radius);
+bool environment_present() { return environment.params.x != 0.0; }
+
+// World -> image frame (rotation by -rotate about +y) and back.
+vec3 environment_to_image(vec3 d) {
+    float c = environment.params.z, s = environment.params.w;
+    return vec3(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
+}
+vec3 environment_to_world(vec3 d) {
+    float c = environment.params.z, s = environment.params.w;
+    return vec3(c * d.x + s * d.z, d.y, -s * d.x + c * d.z);
 }
 
-// Solid angle the emitter of light l subtends from `origin` (the sphere's
-// cap 2 pi (1 - sqrt(1 - r^2/D^2)), the sun's 2 pi (1 - cos alpha)).
-float light_emitter_solid_angle(uint l, vec3 origin, float radius, float sun_cos) {
-    Light light = lights[l];
-    if (floatBitsToUint(light.position.w) == LIGHT_DIRECTIONAL) return 2.0 * PI * (1.0 - sun_cos);
-    float d2 = dot(light.position.xyz - origin, light.position.xyz - origin);
-    if (d2 <= radius * radius) return 4.0 * PI;
-    float s2 = radius * radius / d2;
-    // 1 - sqrt(1 - s2) without cancellation.
-    return 2.0 * PI * s2 / (1.0 + sqrt(1.0 - s2));
+vec2 equirect_uv(vec3 d) {
+    float u = atan(d.z, d.x) / (2.0 * PI);
+    return vec2(u - floor(u), acos(clamp(d.y, -1.0, 1.0)) / PI);
+}
+
+vec3 equirect_dir(vec2 uv) {
+    float theta = PI * uv.y, phi = 2.0 * PI * uv.x;
+    return vec3(sin(theta) * cos(phi), cos(theta), sin(theta) * sin(phi));
+}
+
+// The tabulated part (an image, or a sky's gradient), bilinear; repeat in
+// u, clamped to texel centres in v so the poles do not wrap.
+vec3 environment_table_radiance(vec3 dir) {
+    vec2 uv = equirect_uv(environment_to_image(dir));
+    float h = environment.table.y;
+    uv.y = clamp(uv.y, 0.5 / h, 1.0 - 0.5 / h);
+    return textureLod(environment_map, vec3(uv, 0.0), 0.0).rgb;
+}
+
+// A sky's sun disc (0 elsewhere and without a sun).
+vec3 environment_sun_radiance(vec3 dir) {
+    return dot(dir, environment.sun.xyz) >= environment.sun.w ? environment.sun_radiance.rgb : vec3(0.0);
+}
+
+// Radiance arriving from direction `dir` (unit, world, pointing away from
+// the scene): what an escaping ray sees. 0 without an environment.
+vec3 environment_radiance(vec3 dir) {
+    if (!environment_present()) return vec3(0.0);
+    return environment_table_radiance(dir) + environment_sun_radiance(dir);
+}
+
+// Index k with cdf[base + k] <= u < cdf[base + k + 1], k in [0, n).
+uint environment_cdf_search(uint base, uint n, float u) {
+    uint lo = 0u, hi = n;
+    while (hi - lo > 1u) {
+        uint mid = (lo + hi) / 2u;
+        if (environment_cdf[base + mid] <= u) lo = mid;
+        else hi = mid;
+    }
+    return lo;
+}
+
+// Samples a direction of the tabulated part by its luminance (times texel
+// solid angle; src/environment.rs sampling_tables): a row by the marginal
+// CDF, a column by the row's CDF, a uniform point in the texel. `pdf` is per
+// unit solid angle: p(u, v) / (2 pi^2 sin theta), the equirectangular
+// Jacobian (d omega = 2 pi^2 sin theta du dv).
+vec3 sample_environment_table(vec2 u, out float pdf) {
+    uint w = uint(environment.table.x), h = uint(environment.table.y);
+    uint j = environment_cdf_search(0u, h, u.x);
+    float r0 = environment_cdf[j], p_row = environment_cdf[j + 1u] - r0;
+    uint base = h + 1u + j * (w + 1u);
+    uint i = environment_cdf_search(base, w, u.y);
+    float c0 = environment_cdf[base + i], p_col = environment_cdf[base + i + 1u] - c0;
+    vec2 within = clamp(vec2((u.y - c0) / max(p_col, 1e-30), (u.x - r0) / max(p_row, 1e-30)), 0.0, 1.0);
+    vec2 uv = (vec2(float(i), float(j)) + within) / vec2(float(w), float(h));
+    float sin_theta = max(sin(PI * uv.y), 1e-7);
+    pdf = p_row * p_col * float(w) * float(h) / (2.0 * PI * PI * sin_theta);
+    return environment_to_world(equirect_dir(uv));
+}
+
+// Unoccluded irradiance at x (normal n) from rect area light `em`:
+// Lambert's polygon formula, E = L/2 |sum_i Theta_i (n . gamma_i)| with
+// Theta_i the angle edge i subtends at x and gamma_i the unit normal of the
+// plane through x and that edge (Arvo 1995, "Applications of Irradiance
+// Tensors to the Simulation of Non-Lambertian Phenomena", Sect. 3), after
+// clipping the rect to the receiver's upper half-space; 0 behind the
+// emitting side. Exact.
+vec3 rect_irradiance(Emitter em, vec3 x, vec3 n) {
+    vec3 c = em.position.xyz, nr = em.normal.xyz, t = em.tangent.xyz;
+    if (dot(x - c, nr) <= 0.0) return vec3(0.0);
+    vec3 hu = t * (0.5 * em.normal.w), hv = cross(nr, t) * (0.5 * em.tangent.w);
+    vec3 q[4] = vec3[4](c - hu - hv - x, c + hu - hv - x, c + hu + hv - x, c - hu + hv - x);
+    vec3 p[8];
+    int m = 0;
+    for (int i = 0; i < 4; ++i) {
+        vec3 a = q[i], b = q[(i + 1) % 4];
+        float da = dot(a, n), db = dot(b, n);
+        if (da >= 0.0) p[m++] = a;
+        if ((da >= 0.0) != (db >= 0.0)) p[m++] = a + (b - a) * (da / (da - db));
+    }
+    float sum = 0.0;
+    for (int i = 0; i < m; ++i) {
+        vec3 a = normalize(p[i]), b = normalize(p[(i + 1) % m]);
+        vec3 g = cross(a, b);
+        float len = length(g);
+        if (len < 1e-12) continue;
+        sum += atan(len, dot(a, b)) * dot(g / len, n);
+    }
+    return em.radiance.rgb * (0.5 * abs(sum));
+}
+
+// Unoccluded irradiance at x (normal n) from sphere light `em`: a
+// Lambertian sphere of radiance L seen whole above the receiver's horizon
+// gives exactly E = pi L (r/d)^2 cos(omega) (it acts as a point of
+// intensity pi r^2 L); where the sphere dips below the horizon (within r of
+// the receiver's plane) this clamped form is an approximation.
+vec3 sphere_irradiance(Emitter em, vec3 x, vec3 n) {
+    vec3 v = em.position.xyz - x;
+    float d2 = dot(v, v);
+    float r = em.normal.w;
+    if (d2 <= r * r) return vec3(0.0);
+    return em.radiance.rgb * (PI * r * r / d2) * max(dot(n, v * inversesqrt(d2)), 0.0);
+}
+
+// The unoccluded irradiance from area light e, the direction toward the
+// point its shadow is taken from (its centre) and how far a shadow ray may
+// go before it would meet the light's own geometry.
+vec3 emitter_irradiance(uint e, vec3 x, vec3 n, out vec3 to_light, out float reach) {
+    Emitter em = emitters[e];
+    vec3 v = em.position.xyz - x;
+    float d = length(v);
+    to_light = v / max(d, 1e-30);
+    if (floatBitsToUint(em.position.w) == EMITTER_RECT) {
+        reach = d * (1.0 - 1e-3);
+        return rect_irradiance(em, x, n);
+    }
+    reach = d - em.normal.w * 1.001; // short of the inscribed tessellation
+    return sphere_irradiance(em, x, n);
+}
+
+// The environment's sun as a directional light: a sky's sun, E = L 2 pi
+// (1 - cos alpha), or the sun found in an image (src/environment.rs
+// extract_sun; the reference samples it as part of the table). `to_sun`:
+// toward it. For techniques that need a directional light (`direct`).
+vec3 environment_sun_irradiance(out vec3 to_sun) {
+    to_sun = environment.sun.xyz;
+    if (!environment_present()) return vec3(0.0);
+    if (environment.sun.w <= 1.0) return environment.sun_radiance.rgb * (2.0 * PI * (1.0 - environment.sun.w));
+    to_sun = environment.image_sun_direction.xyz;
+    return environment.image_sun_peak.w <= 1.0 ? environment.image_sun_irradiance.rgb : vec3(0.0);
+}
+
+// Whether an image texel (direction d, world; radiance l) belongs to the
+// image's sun, which `direct` takes as a directional light instead.
+bool environment_image_sun_texel(vec3 d, vec3 l) {
+    return environment.image_sun_peak.w <= 1.0 && dot(d, environment.image_sun_peak.xyz) >= environment.image_sun_peak.w
+        && luminance(l) > environment.image_sun_direction.w;
 }
 
 #endif

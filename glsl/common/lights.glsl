@@ -6,7 +6,10 @@
 
 // Spot falloff: smoothstep in cos(theta) from the cone edge (cos_outer) to
 // cos_inner; mirrors src/radiometry.rs spot_falloff.
+// cos_inner > 1 marks the cosine profile of a rect light's stand-in
+// (src/environment.rs stand_in_lights): max(cos theta, 0).
 float spot_falloff(float cos_theta, float cos_outer, float cos_inner) {
+    if (cos_inner > 1.5) return max(cos_theta, 0.0);
     if (cos_inner <= cos_outer) return cos_theta >= cos_outer ? 1.0 : 0.0;
     return smoothstep(cos_outer, cos_inner, cos_theta);
 }

@@ -36,6 +36,28 @@ struct Material {
     vec4 color;          // rgb albedo/reflectance; w: kind (uint bits)
     vec4 absorption_ior; // rgb absorption 1/m; w: ior
     vec4 albedo_texture; // x: texture array layer (int bits, -1: none); yz: uv_scale; w: alpha cutoff
+    vec4 emission;       // rgb radiance emitted from front faces (area lights)
+};
+
+// An area light (src/gpu.rs GpuEmitter); its geometry is ordinary
+// triangles whose material emits.
+struct Emitter {
+    vec4 position; // xyz centre; w: kind EMITTER_* (uint bits)
+    vec4 normal;   // xyz unit normal (rect); w: width (rect) or radius (sphere)
+    vec4 tangent;  // xyz unit direction of the width (rect); w: height (rect)
+    vec4 radiance; // rgb W m^-2 sr^-1; w: luminance power for light selection
+};
+
+// The environment light (src/gpu.rs GpuEnvironment).
+struct EnvironmentInfo {
+    vec4 params;       // x: 1 when present; zw: cos, sin of the rotation about +y
+    vec4 sun;          // xyz toward the sun (world); w: cos of its angular radius (2: none)
+    vec4 sun_radiance; // rgb; w: luminance power for light selection
+    vec4 table;        // x width, y height of the radiance table; z: its luminance power
+    // The sun found in an image (src/environment.rs extract_sun), for direct:
+    vec4 image_sun_peak;       // xyz peak texel's direction; w: cos of the search cone (2: none)
+    vec4 image_sun_direction;  // xyz mean direction toward it; w: luminance threshold
+    vec4 image_sun_irradiance; // rgb irradiance facing it
 };
 
 struct Light {
@@ -63,7 +85,7 @@ layout(set = SCENE_SET, binding = BINDING_FRAME, std140) uniform FrameBlock {
     vec4 viewport;     // width, height, aspect, time
     vec4 scene_sphere; // centre, radius
     uvec4 counts;      // lights, triangles, materials, frame index
-    uvec4 components;  // x: bit mask of the components drawn (1 << COMPONENT_*)
+    uvec4 components;  // x: bit mask of the components drawn (1 << COMPONENT_*); y: area lights
 } frame;
 
 // 1.0 when the path-type component `c` (COMPONENT_*) is drawn this frame,
@@ -80,6 +102,15 @@ layout(set = SCENE_SET, binding = BINDING_DENSITY_GRID, std430) readonly buffer 
 layout(set = SCENE_SET, binding = BINDING_TRIANGLE_UVS, std430) readonly buffer TriangleUvBlock { TriangleUv triangle_uvs[]; };
 // Every albedo texture, one layer each (src/frame/textures.rs): trilinear, repeat wrap.
 layout(set = SCENE_SET, binding = BINDING_ALBEDO_TEXTURES) uniform sampler2DArray albedo_textures;
+layout(set = SCENE_SET, binding = BINDING_EMITTERS, std430) readonly buffer EmitterBlock { Emitter emitters[]; };
+// The environment's equirectangular radiance (linear, bilinear; glsl/common/emitters.glsl).
+layout(set = SCENE_SET, binding = BINDING_ENVIRONMENT) uniform sampler2DArray environment_map;
+// Its constants, then the sampling tables: the marginal CDF over rows
+// (height + 1 values), then each row's CDF over columns (width + 1 each).
+layout(set = SCENE_SET, binding = BINDING_ENVIRONMENT_DATA, std430) readonly buffer EnvironmentBlock {
+    EnvironmentInfo environment;
+    float environment_cdf[];
+};
 
 uint triangle_material(uint tri) { return floatBitsToUint(triangles[tri].p0.w); }
 uint material_kind(uint m) { return floatBitsToUint(materials[m].color.w); }

@@ -3,8 +3,10 @@
 // L = albedo / pi * sum_l E_l * V_l for diffuse surfaces, where E_l is the
 // light's irradiance (glsl/common/lights.glsl: I cos / r^2 with the spot
 // falloff, or E cos for directional light) and V_l the shadow-map visibility.
-// Specular surfaces seen directly and the background get 0: the ground
-// truth follows specular chains, which later techniques add.
+// Specular surfaces seen directly get 0: the ground truth follows specular
+// chains, which later techniques add. The background is the environment
+// (glsl/common/emitters.glsl) and an area light's front face its radiance:
+// both the emitted component.
 // In a participating medium (Hu et al. 2010 Sect. 5.3, Fig. 2 C) each
 // light's irradiance is attenuated by the transmittance tau(s, x) from the
 // light to x, and the surface radiance by tau(x, v) toward the eye, both
@@ -15,6 +17,9 @@
 #include "optics.glsl"
 #include "random.glsl"
 #include "medium.glsl"
+#include "emitters.glsl"
+#include "bvh.glsl"
+#include "sh.glsl"
 
 #define SHADOW_SET 1
 #define SHADOW_BINDING_LIGHTS DIRECT_BINDING_SHADOW_LIGHTS
@@ -27,19 +32,70 @@ layout(set = 1, binding = DIRECT_BINDING_POSITION, rgba32f) uniform readonly ima
 layout(set = 1, binding = DIRECT_BINDING_NORMAL, rgba32f) uniform readonly image2D g_normal;
 layout(set = 1, binding = DIRECT_BINDING_ALBEDO, rgba32f) uniform readonly image2D g_albedo;
 layout(set = 1, binding = DIRECT_BINDING_RADIANCE, rgba32f) uniform writeonly image2D radiance;
-
 layout(push_constant) uniform Push {
     uint light_count; // lights with shadow maps (<= MAX_LIGHTS)
     int pcf_radius;   // PCF window half-width in texels
     uint medium_steps; // midpoint steps of inhomogeneous transmittance
 } pc;
 
+// A_l L_lm of the environment's table (environment_sh.comp).
+layout(set = 1, binding = DIRECT_BINDING_ENVIRONMENT_SH, std430) readonly buffer ShBlock { vec4 sh[9]; };
+
+// Offsets a shadow ray's origin off the surface, scaled with |x| to
+// survive float rounding.
+vec3 shadow_origin(vec3 x, vec3 n) {
+    return x + n * (1e-4 * (1.0 + max(abs(x.x), max(abs(x.y), abs(x.z)))));
+}
+
+// Irradiance at x (normal n, facing the camera) from the environment and the
+// area lights (docs/ARCHITECTURE.md, "Environment and area lights in
+// direct"): the environment's table by its order-2 spherical-harmonic
+// irradiance, unoccluded; the environment's sun (a sky's, or the one found in
+// an image) as a directional light with a BVH shadow ray toward its centre; each area light's exact unoccluded
+// irradiance (emitters.glsl) times one BVH shadow ray toward its centre.
+vec3 extended_irradiance(vec3 x, vec3 n) {
+    vec3 e = vec3(0.0);
+    if (environment_present()) {
+        float y[9];
+        sh_basis(n, y);
+        vec3 sky = vec3(0.0);
+        for (int k = 0; k < 9; ++k) sky += sh[k].rgb * y[k];
+        e += max(sky, vec3(0.0));
+        vec3 to_sun;
+        vec3 sun = environment_sun_irradiance(to_sun);
+        float cos_sun = dot(n, to_sun);
+        if (cos_sun > 0.0 && any(greaterThan(sun, vec3(0.0)))
+                && !trace_any(shadow_origin(x, n), to_sun, 0.0, 1e30)) {
+            e += sun * cos_sun * medium_transmittance_steps(x, to_sun, light_travel(1e30, x), pc.medium_steps);
+        }
+    }
+    for (uint i = 0u; i < frame.components.y; ++i) {
+        vec3 to_light;
+        float reach;
+        vec3 ei = emitter_irradiance(i, x, n, to_light, reach);
+        if (all(equal(ei, vec3(0.0)))) continue;
+        if (trace_any(shadow_origin(x, n), to_light, 0.0, reach)) continue;
+        e += ei * medium_transmittance_steps(x, to_light, reach, pc.medium_steps);
+    }
+    return e;
+}
+
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(p, imageSize(radiance)))) return;
     vec4 position = imageLoad(g_position, p);
     if (position.w == 0.0) {
-        imageStore(radiance, p, vec4(0.0));
+        // The background: the environment along the pixel centre's ray
+        // (through the medium's bounds), the emitted component.
+        vec2 ndc = (vec2(p) + 0.5) / frame.viewport.xy * 2.0 - 1.0;
+        vec4 far = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
+        vec3 dir = normalize(far.xyz / far.w - frame.eye.xyz);
+        vec3 background = environment_radiance(dir);
+        if (environment_present()) {
+            float travel = 2.0 * frame.scene_sphere.w + length(frame.eye.xyz - frame.scene_sphere.xyz);
+            background *= medium_transmittance_steps(frame.eye.xyz, dir, travel, pc.medium_steps);
+        }
+        imageStore(radiance, p, vec4(component_weight(COMPONENT_EMITTED) * background, 0.0));
         return;
     }
     vec4 nm = imageLoad(g_normal, p);
@@ -60,9 +116,14 @@ void main() {
         if (v == 0.0) continue;
         e_sum += e * v * medium_transmittance_steps(x, to_light, light_travel(dist, x), pc.medium_steps);
     }
-    vec3 albedo = imageLoad(g_albedo, p).rgb;
+    e_sum += extended_irradiance(x, n);
+    vec4 albedo = imageLoad(g_albedo, p);
+    // An area light's front face (albedo.a: the camera sees the front).
+    vec3 emission = albedo.a > 0.5 ? materials[material].emission.rgb : vec3(0.0);
     vec3 to_eye = frame.eye.xyz - x;
     float eye_dist = length(to_eye);
     vec3 tau_eye = medium_transmittance_steps(x, to_eye / eye_dist, eye_dist, pc.medium_steps);
-    imageStore(radiance, p, vec4(component_weight(COMPONENT_DIRECT) * albedo / PI * e_sum * tau_eye, 1.0));
+    vec3 l = component_weight(COMPONENT_DIRECT) * albedo.rgb / PI * e_sum
+        + component_weight(COMPONENT_EMITTED) * emission;
+    imageStore(radiance, p, vec4(l * tau_eye, 1.0));
 }

@@ -27,11 +27,13 @@
 // medium around the receiver being the refractor's.
 // Mirror at p1: L = reflectance * L(p1, R).
 // L(o, d): the image-space search of the opaque frame (below); a ray that
-// leaves the view or the scene's bounding sphere reads the environment,
-// which is black: scene files have no background, and the reference
-// tracer and `direct` give escaping rays 0 too.
+// leaves the view or the scene's bounding sphere reads the environment
+// (glsl/common/emitters.glsl, the emitted component): exact for a ray that
+// leaves the bounding sphere, an approximation for one that leaves the view
+// (an off-screen surface may lie ahead; the search cannot see it).
 #include "scene.glsl"
 #include "optics.glsl"
+#include "emitters.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -50,7 +52,6 @@ layout(push_constant) uniform Push {
     uint pad;
 } pc;
 
-const vec3 ENVIRONMENT = vec3(0.0);
 const int BISECTIONS = 10;
 
 // The pixel x projects to and its view depth (clip w); false behind the
@@ -139,16 +140,16 @@ vec3 search_opaque_hit(vec3 o, vec3 d, out float t_hit) {
     vec3 oc = o - frame.scene_sphere.xyz;
     float b = dot(oc, d);
     float disc = b * b - (dot(oc, oc) - frame.scene_sphere.w * frame.scene_sphere.w);
-    if (disc <= 0.0) return ENVIRONMENT;
+    if (disc <= 0.0) return component_weight(COMPONENT_EMITTED) * environment_radiance(d);
     float t_max = min(-b + sqrt(disc), frustum_exit(o, d));
-    if (t_max <= 0.0) return ENVIRONMENT;
+    if (t_max <= 0.0) return component_weight(COMPONENT_EMITTED) * environment_radiance(d);
     float step = t_max / float(max(pc.search_steps, 1u));
     float t_prev = 0.0;
     for (uint i = 1u; i <= pc.search_steps; ++i) {
         float t = step * float(i);
         ivec2 q;
         float gap, z;
-        if (!project(o + t * d, q, z)) return ENVIRONMENT;
+        if (!project(o + t * d, q, z)) return component_weight(COMPONENT_EMITTED) * environment_radiance(d);
         if (behind_opaque(o + t * d, q, gap)) {
             float lo = t_prev, hi = t;
             for (int k = 0; k < BISECTIONS; ++k) {
@@ -165,7 +166,7 @@ vec3 search_opaque_hit(vec3 o, vec3 d, out float t_hit) {
         }
         t_prev = t;
     }
-    return ENVIRONMENT;
+    return component_weight(COMPONENT_EMITTED) * environment_radiance(d);
 }
 
 vec3 search_opaque(vec3 o, vec3 d) {

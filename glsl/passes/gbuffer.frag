@@ -1,7 +1,7 @@
 #version 460
 // Camera G-buffer, fragment stage: world position (w = 1: covered) and the
 // smooth normal turned toward the camera (two-sided surfaces) with the
-// material index in w, and the albedo (glsl/common/scene.glsl
+// material index in w, and the albedo (alpha: front face seen; glsl/common/scene.glsl
 // `material_albedo_grad`: colour times texture, mip level from the UV's
 // screen-space derivatives). With `opaque_only` the specular surfaces are left
 // out (image_space refracts and reflects them in a later pass).
@@ -27,8 +27,11 @@ void main() {
     if (pc.opaque_only != 0u && material_kind(v_material) != MATERIAL_DIFFUSE) discard;
     if (material_cut_out_grad(v_material, v_uv, duv_dx, duv_dy)) discard;
     vec3 n = normalize(v_normal);
-    if (dot(n, frame.eye.xyz - v_position) < 0.0) n = -n;
+    // alpha of the albedo: 1 where the camera sees the front face (the side
+    // an area light emits to; lighting.comp adds the emission there).
+    bool front = dot(n, frame.eye.xyz - v_position) >= 0.0;
+    if (!front) n = -n;
     out_position = vec4(v_position, 1.0);
     out_normal = vec4(n, float(v_material));
-    out_albedo = vec4(material_albedo_grad(v_material, v_uv, duv_dx, duv_dy), 1.0);
+    out_albedo = vec4(material_albedo_grad(v_material, v_uv, duv_dx, duv_dy), front ? 1.0 : 0.0);
 }

@@ -13,7 +13,7 @@
 #include "common.glsl"
 #include "optics.glsl"
 #include "lights.glsl"
-#include "emitters.glsl"
+#include "punctual_emitters.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -23,7 +23,7 @@ layout(set = 1, binding = PINHOLE_BINDING_LIGHT_MAP_LEVEL0, rgba32f) uniform wri
 
 // Radiance of emitter slot `slot` seen from `origin` along `dir`.
 // THE place where emitters enter the cube maps: slots 0 .. lights-1 are the
-// scene's point, spot and directional lights (glsl/common/emitters.glsl).
+// scene's point, spot and directional lights (glsl/common/punctual_emitters.glsl).
 // Environment and area lights (the `lights` branch) become further slots
 // here, each one call of its glsl/common radiance function.
 vec3 emitter_radiance(uint slot, vec3 origin, vec3 dir) {

@@ -12,6 +12,10 @@
 //     follows adds every photon landing within r of it on the side the
 //     camera sees, except photons straight from the light (those are the
 //     direct light above): L S+ D S+ E, L D+ D S+ E, L V D S+ E (trace.comp).
+// Emitters (L S* E, the emitted component): a camera path that escapes adds
+// the environment's radiance, one that meets an area light's front face
+// adds its radiance, whether directly (depth 0: the background, a lamp) or
+// after specular bounces (in a mirror, through glass and water).
 // How the path space splits: a pixel sample whose first hit is diffuse is
 // the light tracer's (its camera connections, trace.comp); one whose first
 // hit is specular is this pass's. So no path is counted twice.
@@ -49,17 +53,31 @@ void main() {
 
     for (uint depth = 0u; depth < pc.max_depth; ++depth) {
         Hit hit;
-        if (!trace_closest(s.origin, s.dir, 0.0, 1e30, hit)) break;
+        if (!trace_closest(s.origin, s.dir, 0.0, 1e30, hit)) {
+            // Escaped: the environment, seen directly or through the chain
+            // (L S* E, the emitted component).
+            if (environment_present() && !s.inside) {
+                float travel = 2.0 * frame.scene_sphere.w + length(s.origin - frame.scene_sphere.xyz);
+                vec3 tr = medium_transmittance(s.origin, s.dir, travel, rng);
+                add_pass(index, COMPONENT_EMITTED, s.weight * tr * environment_radiance(s.dir));
+            }
+            break;
+        }
         Material m = materials[hit_material(hit)];
         bool diffuse = floatBitsToUint(m.color.w) == MATERIAL_DIFFUSE;
+        vec3 ng = hit_geometric_normal(hit);
+        bool front = dot(s.dir, ng) < 0.0;
+        // An area light's front face, seen directly or through the chain.
+        if (diffuse && front && any(greaterThan(m.emission.rgb, vec3(0.0)))) {
+            vec3 tr = s.inside ? exp(-s.inside_absorption * hit.t) : medium_transmittance(s.origin, s.dir, hit.t, rng);
+            add_pass(index, COMPONENT_EMITTED, s.weight * tr * m.emission.rgb);
+        }
         // The first hit is diffuse: the light tracer covers this sample.
         if (diffuse && depth == 0u) break;
         vec3 x = s.origin + hit.t * s.dir;
         // Every segment's attenuation: absorption inside glass, the medium outside.
         if (s.inside) s.weight *= exp(-s.inside_absorption * hit.t);
         else s.weight *= medium_transmittance(s.origin, s.dir, hit.t, rng);
-        vec3 ng = hit_geometric_normal(hit);
-        bool front = dot(s.dir, ng) < 0.0;
         if (diffuse) {
             vec3 seen_side = front ? ng : -ng;
             vec3 albedo = hit_albedo(hit);

@@ -12,6 +12,7 @@
 #include "optics.glsl"
 #include "lights.glsl"
 #include "medium.glsl"
+#include "emitters.glsl"
 
 // Every estimate of one pass is radiance (W m^-2 sr^-1) added into `pass_accum`
 // (COMPONENT_COUNT images of width*height rgb floats, float atomics); the fold

@@ -52,26 +52,102 @@ uint tag_for(uint specular_bounces, bool scattered_or_bounced, bool at_medium) {
     return specular_bounces == 0u ? COMPONENT_DIRECT : COMPONENT_SURFACE_CAUSTICS;
 }
 
-// Picks a light with probability proportional to its power.
+// Light sources in one list: the point/spot/directional lights (0 ..
+// L-1), the area lights (L .. L+A-1), the environment's table (L+A) and its
+// sun (L+A+1), each with its luminance power (W).
+uint source_count() { return frame.counts.x + frame.components.y + 2u; }
+float source_power(uint s) {
+    uint l = frame.counts.x, a = frame.components.y;
+    if (s < l) return lights[s].power.x;
+    if (s < l + a) return emitters[s - l].radiance.w;
+    if (!environment_present()) return 0.0;
+    return s == l + a ? environment.table.z : environment.sun_radiance.w;
+}
+
+// Picks a light source with probability proportional to its power.
 uint pick_light(float u, out float probability) {
-    uint count = frame.counts.x;
+    uint count = source_count();
     float total = 0.0;
-    for (uint l = 0u; l < count; ++l) total += lights[l].power.x;
+    for (uint l = 0u; l < count; ++l) total += source_power(l);
     if (total <= 0.0) {
         probability = 0.0;
         return 0u;
     }
     float target = u * total;
     float running = 0.0;
+    uint last = 0u;
     for (uint l = 0u; l < count; ++l) {
-        running += lights[l].power.x;
-        if (target < running || l + 1u == count) {
-            probability = lights[l].power.x / total;
+        float p = source_power(l);
+        if (p <= 0.0) continue;
+        last = l;
+        running += p;
+        if (target < running) {
+            probability = p / total;
             return l;
         }
     }
-    probability = 1.0;
-    return 0u;
+    probability = source_power(last) / total;
+    return last;
+}
+
+// Emits a photon from area light `e`: a point uniform over its area (pdf
+// 1/A) and a cosine-weighted direction about its normal there (pdf
+// cos/pi), so every photon carries the power pi L A (rect: one-sided;
+// sphere: A = 4 pi r^2, outward at every point).
+void emit_area(uint e, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) {
+    Emitter em = emitters[e];
+    vec2 u = vec2(rng_next(rng), rng_next(rng));
+    vec2 v = vec2(rng_next(rng), rng_next(rng));
+    vec3 n;
+    float area;
+    if (floatBitsToUint(em.position.w) == EMITTER_RECT) {
+        n = em.normal.xyz;
+        vec3 t = em.tangent.xyz;
+        vec3 b = cross(n, t);
+        origin = em.position.xyz + t * ((u.x - 0.5) * em.normal.w) + b * ((u.y - 0.5) * em.tangent.w);
+        area = em.normal.w * em.tangent.w;
+    } else {
+        n = uniform_sphere(u);
+        float r = em.normal.w;
+        // On the exact sphere: outside its inscribed tessellation, which an
+        // outward ray cannot meet.
+        origin = em.position.xyz + n * r;
+        area = 4.0 * PI * r * r;
+    }
+    origin = offset_origin(origin, n);
+    dir = cosine_hemisphere(v, n);
+    flux = em.radiance.rgb * PI * area;
+}
+
+// Emits a photon from the environment: an incoming direction w (table:
+// importance-sampled by luminance, emitters.glsl; sun: uniform over its
+// disc) and a point uniform on the disc of the scene's bounding radius R
+// perpendicular to w, just outside the scene, travelling along -w:
+// flux = L(w) pi R^2 / p(w).
+void emit_environment(bool sun, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) {
+    vec2 u = vec2(rng_next(rng), rng_next(rng));
+    vec3 w;
+    float pdf;
+    vec3 radiance;
+    if (sun) {
+        float cos_max = environment.sun.w;
+        w = uniform_cone(u, environment.sun.xyz, cos_max);
+        pdf = 1.0 / (2.0 * PI * (1.0 - cos_max));
+        radiance = environment.sun_radiance.rgb;
+    } else {
+        w = sample_environment_table(u, pdf);
+        radiance = environment_table_radiance(w);
+    }
+    vec3 c = frame.scene_sphere.xyz;
+    float r = frame.scene_sphere.w;
+    vec3 t, b;
+    basis(w, t, b);
+    vec2 v = vec2(rng_next(rng), rng_next(rng));
+    float rr = r * sqrt(v.x);
+    float phi = 2.0 * PI * v.y;
+    origin = c + w * (r * 1.01) + t * (rr * cos(phi)) + b * (rr * sin(phi));
+    dir = -w;
+    flux = pdf > 0.0 ? radiance * (PI * r * r) / pdf : vec3(0.0);
 }
 
 // Emits a photon from light l: origin, direction, and flux / pdf (W, per
@@ -219,12 +295,18 @@ void store_volume_photon(vec3 x, vec3 d, vec3 flux, uint tag) {
 
 void main() {
     uint rng = rng_seed(gl_GlobalInvocationID.x, pc.seed);
-    if (frame.counts.x == 0u) return;
     float light_probability;
     uint l = pick_light(rng_next(rng), light_probability);
     if (light_probability <= 0.0) return; // every light is black
     SpecularState s;
-    emit(l, rng, s.origin, s.dir, s.weight);
+    // Area lights and the environment have no shadow rays at the visible
+    // points (camera.comp samples only the punctual lights there), so their
+    // photons are gathered there from the first hit on.
+    bool extended = l >= frame.counts.x;
+    uint areas_end = frame.counts.x + frame.components.y;
+    if (!extended) emit(l, rng, s.origin, s.dir, s.weight);
+    else if (l < areas_end) emit_area(l - frame.counts.x, rng, s.origin, s.dir, s.weight);
+    else emit_environment(l > areas_end, rng, s.origin, s.dir, s.weight);
     s.weight /= light_probability;
     s.inside = false; // lights are outside objects
     s.inside_absorption = vec3(0.0);
@@ -293,9 +375,10 @@ void main() {
             uint tag = tag_for(specular, scattered_or_bounced, false);
             vec3 albedo = hit_albedo(hit);
             connect_surface(x, ng_in, s.weight, albedo, tag, rng);
-            // A photon straight from the light is the visible points' direct
-            // light (camera.comp samples it): every other one is gathered.
-            if (pc.gather != 0u && (specular > 0u || scattered_or_bounced)) {
+            // A photon straight from a point, spot or directional light is
+            // the visible points' direct light (camera.comp samples it):
+            // every other one is gathered.
+            if (pc.gather != 0u && (specular > 0u || scattered_or_bounced || extended)) {
                 gather_surface(x, ng_in, s.weight, tag);
             }
             if (diffuse_left == 0u) return;

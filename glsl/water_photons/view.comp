@@ -46,6 +46,7 @@
 #include "scene.glsl"
 #include "optics.glsl"
 #include "lights.glsl"
+#include "emitters.glsl"
 #include "bvh.glsl"
 #include "common.glsl"
 #include "kernel.glsl"
@@ -171,7 +172,8 @@ vec3 gather(vec3 x, vec3 nx) {
 vec3 radiance_along(vec3 o, vec3 d, out float t_hit) {
     t_hit = 0.0;
     Hit h;
-    if (!trace_closest(o, d, 0.0, 1e30, h)) return vec3(0.0);
+    // Escaped: the environment (the emitted component).
+    if (!trace_closest(o, d, 0.0, 1e30, h)) return component_weight(COMPONENT_EMITTED) * environment_radiance(d);
     t_hit = h.t;
     uint m = hit_material(h);
     if (material_kind(m) != MATERIAL_DIFFUSE) return vec3(0.0);

@@ -2,13 +2,15 @@
 //! the scene on the GPU (descriptor set 0) and the frame's targets.
 //!
 //! Layer rule: `frame` sits below `passes`; it imports `vk`, `scene`, `bvh`,
-//! `gpu`, `radiometry` and `shader_bindings`, never `passes`, `techniques`,
+//! `gpu`, `radiometry`, `environment` and `shader_bindings`, never `passes`, `techniques`,
 //! `renderer` or `reference` (docs/ARCHITECTURE.md, "Layers").
 
+mod environment;
 mod scene_gpu;
 mod targets;
 mod textures;
 
+pub use environment::EnvironmentGpu;
 pub use scene_gpu::{camera_matrices, GeometryStats, SceneGpu};
 pub use targets::FrameTargets;
 pub use textures::AlbedoTextures;

@@ -2,9 +2,11 @@
 //! materials, lights, medium and the per-frame uniform block, bound as
 //! descriptor set 0 (glsl/common/scene.glsl) by every pass that reads them.
 
-use super::AlbedoTextures;
+use super::{AlbedoTextures, EnvironmentGpu};
 use crate::bvh::Bvh;
-use crate::gpu::{GpuFrame, GpuLight, GpuMaterial, GpuMedium, GpuTriangle, GpuTriangleUv};
+use crate::gpu::{
+    GpuEmitter, GpuFrame, GpuLight, GpuMaterial, GpuMedium, GpuTriangle, GpuTriangleUv,
+};
 use crate::radiometry::Component;
 use crate::scene::{Camera, Density, MaterialKind, Scene, Triangle};
 use crate::shader_bindings as b;
@@ -33,6 +35,10 @@ pub struct SceneGpu {
     /// the motions keep every triangle's UVs.
     pub triangle_uvs: Buffer,
     pub albedo_textures: AlbedoTextures,
+    /// Area lights (`GpuEmitter`; one zeroed record when there are none).
+    pub emitters: Buffer,
+    emitter_count: u32,
+    pub environment: EnvironmentGpu,
     pub bvh_nodes: Buffer,
     pub materials: Buffer,
     pub lights: Buffer,
@@ -107,6 +113,9 @@ impl SceneGpu {
                 (b::BINDING_DENSITY_GRID, BindingKind::Storage),
                 (b::BINDING_TRIANGLE_UVS, BindingKind::Storage),
                 (b::BINDING_ALBEDO_TEXTURES, BindingKind::Sampled),
+                (b::BINDING_EMITTERS, BindingKind::Storage),
+                (b::BINDING_ENVIRONMENT, BindingKind::Sampled),
+                (b::BINDING_ENVIRONMENT_DATA, BindingKind::Storage),
             ],
         )
     }
@@ -130,11 +139,16 @@ impl SceneGpu {
         };
         let sphere = scene.bounding_sphere(time);
         let materials: Vec<GpuMaterial> = scene.materials.iter().map(GpuMaterial::new).collect();
-        let lights: Vec<GpuLight> = scene
-            .lights
+        // The scene's lights, then the stand-ins of its sun and rect lights
+        // (`environment::caustic_lights`): the reference and `direct` use
+        // only the first `frame.counts.x`, the caustic techniques all.
+        let mut lights: Vec<GpuLight> = crate::environment::caustic_lights(scene)
             .iter()
             .map(|l| GpuLight::new(l, sphere.1))
             .collect();
+        if lights.is_empty() {
+            lights.push(bytemuck::Zeroable::zeroed());
+        }
         let medium = gpu_medium(scene);
         let grid: Vec<f32> = match scene.medium.as_ref().map(|m| &m.density) {
             Some(Density::Grid { values, .. }) => values.clone(),
@@ -160,6 +174,13 @@ impl SceneGpu {
         let albedo_textures = AlbedoTextures::new(ctx, &scene.textures)?;
         let nodes_buf = Buffer::with_data(ctx, "bvh nodes", &bvh.nodes, storage)?;
         let materials_buf = Buffer::with_data(ctx, "materials", &materials, storage)?;
+        let mut emitters: Vec<GpuEmitter> = scene.emitters.iter().map(GpuEmitter::new).collect();
+        let emitter_count = emitters.len() as u32;
+        if emitters.is_empty() {
+            emitters.push(bytemuck::Zeroable::zeroed());
+        }
+        let emitters_buf = Buffer::with_data(ctx, "area lights", &emitters, storage)?;
+        let environment = EnvironmentGpu::new(ctx, scene.environment.as_ref(), sphere.1)?;
         let lights_buf = Buffer::with_data(ctx, "lights", &lights, storage)?;
         let medium_buf = Buffer::with_data(ctx, "medium", &[medium], storage)?;
         let grid_buf = Buffer::with_data(ctx, "density grid", &grid, storage)?;
@@ -184,7 +205,15 @@ impl SceneGpu {
                 &albedo_textures.image,
                 &albedo_textures.sampler,
                 vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            );
+            )
+            .write_buffer(b::BINDING_EMITTERS, &emitters_buf)
+            .write_sampled_image(
+                b::BINDING_ENVIRONMENT,
+                &environment.image,
+                &environment.sampler,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            )
+            .write_buffer(b::BINDING_ENVIRONMENT_DATA, &environment.data);
         // The load phases' costs (RUST_LOG=info): scripts/gltf-bench.sh reads them.
         log::info!(
             "scene on the device: world-space triangles {world_ms:.1} ms, BVH build {:.1} ms, upload {:.1} ms",
@@ -196,6 +225,9 @@ impl SceneGpu {
             triangles: triangles_buf,
             triangle_uvs: uvs_buf,
             albedo_textures,
+            emitters: emitters_buf,
+            emitter_count,
+            environment,
             bvh_nodes: nodes_buf,
             materials: materials_buf,
             lights: lights_buf,
@@ -251,8 +283,7 @@ impl SceneGpu {
     /// Re-uploads moved lights (same count). The caller has waited for every
     /// frame that read the old ones.
     pub fn update_lights(&self, scene: &Scene) -> VkResult<()> {
-        let lights: Vec<GpuLight> = scene
-            .lights
+        let lights: Vec<GpuLight> = crate::environment::caustic_lights(scene)
             .iter()
             .map(|l| GpuLight::new(l, self.sphere.1))
             .collect();
@@ -327,7 +358,7 @@ impl SceneGpu {
                 scene.materials.len() as u32,
                 frame_index,
             ],
-            components: [self.components, 0, 0, 0],
+            components: [self.components, self.emitter_count, 0, 0],
         };
         self.frame_constants.set(data);
         data

@@ -10,7 +10,18 @@
 //! 3. "direct lighting" (glsl/direct/lighting.comp): per pixel, into the
 //!    frame's radiance image.
 //!
-//! Specular surfaces seen directly and the background read 0.
+//! Specular surfaces seen directly read 0; the background reads the
+//! environment and an area light's front face its radiance (the emitted
+//! component).
+//!
+//! Environment and area lights (docs/ARCHITECTURE.md, "Environment and
+//! area lights in direct"): 0. "environment irradiance"
+//! (glsl/direct/environment_sh.comp, recorded on the first frame only: the
+//! environment is fixed while the scene is on the GPU) projects the
+//! environment's table onto order-2 spherical harmonics (Ramamoorthi &
+//! Hanrahan 2001); the lighting adds their irradiance, unoccluded, the
+//! sky's sun as a directional light with one BVH shadow ray, and each area
+//! light's exact unoccluded irradiance times one BVH shadow ray to its centre.
 //!
 //! In a scene with a medium the surface radiance is attenuated as the
 //! ground truth attenuates it (Hu et al. 2010 Sect. 5.3, Fig. 2 C): each
@@ -27,8 +38,9 @@ use crate::passes::shadow::ShadowMaps;
 use crate::scene::Scene;
 use crate::shader_bindings as b;
 use crate::vk::{
-    barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
-    FrameRecorder, ImageAccess, Sampler, TargetBinding, VkResult,
+    barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline, Context,
+    DescriptorSet, DescriptorSetLayout, FrameRecorder, ImageAccess, Sampler, TargetBinding,
+    VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -63,6 +75,13 @@ pub struct DirectLight {
     medium_steps: u32,
     light_count: u32,
     lighting: ComputePipeline,
+    /// Projects the environment onto spherical harmonics (glsl/direct/environment_sh.comp).
+    environment_sh: ComputePipeline,
+    /// 9 rgb coefficients (vec4 each) of the environment's irradiance.
+    sh: Buffer,
+    /// Whether `sh` holds this scene's environment (computed on the first
+    /// frame: the environment is fixed while the scene is on the GPU).
+    sh_done: bool,
     set: DescriptorSet,
     /// The radiance image the set's output binding points at: the frame
     /// targets are not known at construction, so the binding is written on
@@ -119,7 +138,14 @@ impl DirectLight {
                 (b::DIRECT_BINDING_RADIANCE, BindingKind::StorageImage),
                 (b::DIRECT_BINDING_SHADOW_MAP, BindingKind::Sampled),
                 (b::DIRECT_BINDING_SHADOW_LIGHTS, BindingKind::Uniform),
+                (b::DIRECT_BINDING_ENVIRONMENT_SH, BindingKind::Storage),
             ],
+        )?;
+        let sh = Buffer::new(
+            ctx,
+            "environment irradiance SH",
+            9 * 16,
+            BufferUsage::Storage,
         )?;
         // Nearest: the shader fetches single texels and compares them itself.
         let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
@@ -135,7 +161,14 @@ impl DirectLight {
                 &sampler,
                 vk::ImageLayout::GENERAL,
             )
-            .write_buffer(b::DIRECT_BINDING_SHADOW_LIGHTS, &shadows.lights);
+            .write_buffer(b::DIRECT_BINDING_SHADOW_LIGHTS, &shadows.lights)
+            .write_buffer(b::DIRECT_BINDING_ENVIRONMENT_SH, &sh);
+        let environment_sh = ComputePipeline::new(
+            ctx,
+            "direct/environment_sh.comp",
+            &[&scene_gpu.layout, &layout],
+            0,
+        )?;
         let lighting = ComputePipeline::new(
             ctx,
             "direct/lighting.comp",
@@ -149,6 +182,9 @@ impl DirectLight {
             pcf_radius: params.pcf_radius,
             medium_steps: params.medium_steps,
             lighting,
+            environment_sh,
+            sh,
+            sh_done: false,
             set,
             bound_radiance: TargetBinding::new(b::DIRECT_BINDING_RADIANCE),
             _layout: layout,
@@ -178,6 +214,19 @@ impl DirectLight {
             pcf_radius: self.pcf_radius,
             medium_steps: self.medium_steps,
         };
+        if !self.sh_done {
+            rec.pass("environment irradiance", |cmd| {
+                barrier(
+                    &ctx,
+                    cmd,
+                    &[],
+                    &[BufferAccess::new(&self.sh, Access::ComputeWrite)],
+                );
+                self.environment_sh
+                    .dispatch(cmd, &[&scene.set, &self.set], &[], [1, 1, 1]);
+            });
+            self.sh_done = true;
+        }
         rec.pass("direct lighting", |cmd| {
             // The G-buffer's and shadow maps' attachment writes must be
             // visible to the compute reads (and move to GENERAL); the
@@ -193,7 +242,7 @@ impl DirectLight {
                     ImageAccess::new(&self.shadows.map, Access::ComputeRead),
                     ImageAccess::discard(&targets.radiance, Access::ComputeWrite),
                 ],
-                &[],
+                &[BufferAccess::new(&self.sh, Access::ComputeRead)],
             );
             let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
             self.lighting.dispatch(

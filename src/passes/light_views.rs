@@ -165,7 +165,8 @@ pub struct LightViews {
 }
 
 impl LightViews {
-    /// Views of `size`^2 texels of the scene's first `MAX_LIGHTS` lights.
+    /// Views of `size`^2 texels of the scene's first `MAX_LIGHTS` lights,
+    /// stand-ins included.
     pub fn new(
         ctx: &Arc<Context>,
         scene: &Scene,
@@ -175,12 +176,9 @@ impl LightViews {
         Ok(Self {
             gbuffer: SpecularGBuffer::new(ctx, &scene_gpu.layout, size, size)?,
             size,
-            lights: scene
-                .lights
-                .iter()
-                .take(b::MAX_LIGHTS as usize)
-                .copied()
-                .collect(),
+            // With the stand-ins of the environment's sun and the rect
+            // lights (`environment::caustic_lights`, the GPU light buffer's order).
+            lights: crate::environment::caustic_lights(scene),
             specular: specular_bounds(scene),
         })
     }

@@ -54,6 +54,7 @@ pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
             ior: m.optical_density.unwrap_or(1.5),
             absorption: Vec3::ZERO,
             texture: None,
+            emission: Vec3::ZERO,
         }
     } else if m.illumination_model == Some(3) {
         Material {
@@ -63,6 +64,7 @@ pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
             ior: 1.0,
             absorption: Vec3::ZERO,
             texture: None,
+            emission: Vec3::ZERO,
         }
     } else {
         Material {
@@ -72,6 +74,7 @@ pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
             ior: 1.0,
             absorption: Vec3::ZERO,
             texture: None,
+            emission: Vec3::ZERO,
         }
     }
 }

@@ -16,6 +16,13 @@ pub struct Scene {
     pub objects: Vec<Object>,
     pub medium: Option<Medium>,
     pub output: Output,
+    /// The environment light (`kind = "environment"`), at most one.
+    pub environment: Option<Environment>,
+    /// Area lights (`kind = "rect"`, `"sphere"`), in file order. Each also
+    /// has an object (its geometry, so it is seen and casts shadows) and a
+    /// material (black, emitting `radiance` from its front faces) appended
+    /// after the file's: `Emitter::object` and `Emitter::material`.
+    pub emitters: Vec<Emitter>,
     /// Decoded albedo textures (`AlbedoTexture::index` points here), one per
     /// distinct file.
     pub textures: Vec<Texture>,
@@ -74,6 +81,73 @@ pub struct Material {
     /// Diffuse only: the albedo is `color` times this texture at the
     /// surface's UV (docs/SCENES.md, "Albedo textures").
     pub texture: Option<AlbedoTexture>,
+    /// Radiance (W m^-2 sr^-1) emitted from the front faces (the side the
+    /// geometric normal points to): non-zero only on an area light's own
+    /// material (black diffuse, `Emitter`).
+    pub emission: Vec3,
+}
+
+/// An environment light: radiance arriving from every direction at
+/// infinity (docs/SCENES.md, "Environment light").
+#[derive(Clone, Debug, PartialEq)]
+pub struct Environment {
+    pub kind: EnvironmentKind,
+    /// Radiance multiplier.
+    pub scale: f32,
+    /// Rotation about +y in degrees (right-handed) from the image's frame to
+    /// the world. A sky's sun direction is stored already rotated.
+    pub rotate_deg: f32,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum EnvironmentKind {
+    /// An equirectangular image of linear radiance (`Texture::texels`):
+    /// u = φ / 2π (φ from +x toward +z), v = θ / π (θ from +y), row 0 at +y.
+    Image(Texture),
+    Sky(Sky),
+}
+
+/// A sun disc plus a sky gradient (docs/SCENES.md).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sky {
+    /// Unit vector from the scene toward the sun's centre, world space
+    /// (after `rotate`).
+    pub sun_direction: Vec3,
+    /// Angular radius α of the sun disc, degrees.
+    pub sun_radius_deg: f32,
+    /// Radiance of the disc, W m^-2 sr^-1.
+    pub sun_radiance: Vec3,
+    /// Sky radiance straight up and at (and below) the horizon; in between
+    /// linear in the sine of the elevation.
+    pub zenith: Vec3,
+    pub horizon: Vec3,
+}
+
+/// An area light's shape.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EmitterShape {
+    /// A one-sided Lambertian rectangle emitting to the side of `normal`;
+    /// `tangent` (unit, perpendicular to `normal`) is the direction of the
+    /// `size[0]` side.
+    Rect {
+        center: Vec3,
+        normal: Vec3,
+        tangent: Vec3,
+        size: [f32; 2],
+    },
+    /// A Lambertian sphere emitting outward from every point.
+    Sphere { center: Vec3, radius: f32 },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Emitter {
+    pub shape: EmitterShape,
+    /// W m^-2 sr^-1.
+    pub radiance: Vec3,
+    /// Index of its geometry in `Scene::objects`.
+    pub object: u32,
+    /// Index of its material in `Scene::materials`.
+    pub material: u32,
 }
 
 /// A diffuse material's albedo texture: which one and how often it repeats.

@@ -20,7 +20,7 @@ impl TechniqueBuild for Direct {
     const NAME: &'static str = "direct";
     const DESCRIPTION: &'static str =
         "direct light with shadow maps (the base frame every technique adds to)";
-    const COMPONENTS: &'static [Component] = &[Component::Direct];
+    const COMPONENTS: &'static [Component] = &[Component::Direct, Component::Emitted];
     type Params = DirectParams;
 
     fn build(

@@ -45,6 +45,7 @@ pub fn diffuse(name: &str, albedo: f32) -> Material {
         ior: 1.0,
         absorption: Vec3::ZERO,
         texture: None,
+        emission: glam::Vec3::ZERO,
     }
 }
 
@@ -56,6 +57,7 @@ pub fn dielectric(name: &str, ior: f32) -> Material {
         ior,
         absorption: Vec3::ZERO,
         texture: None,
+        emission: glam::Vec3::ZERO,
     }
 }
 
@@ -236,6 +238,8 @@ pub fn scene(
         objects,
         medium: None,
         output: Output { exposure: 1.0 },
+        environment: None,
+        emitters: Vec::new(),
         textures: Vec::new(),
     }
 }

@@ -1,6 +1,7 @@
 //! The scene file schema: reading the spanned TOML tree into the resolved
 //! model, validating every value (docs/SCENES.md lists the fields).
 
+mod emitters;
 mod materials;
 mod medium;
 mod objects;
@@ -51,18 +52,43 @@ pub(crate) fn parse(text: &str, path: &Path) -> R<Scene> {
     if light_tables.is_empty() {
         return Err(root.err("light", "at least one [[light]] is required"));
     }
-    if light_tables.len() > MAX_LIGHTS as usize {
-        let extra = &light_tables[MAX_LIGHTS as usize];
-        return Err(src.err(
-            &extra.span,
-            &extra.path,
-            format!(
-                "too many lights: {}, at most {MAX_LIGHTS} are supported",
-                light_tables.len()
-            ),
-        ));
+    let mut lights = Vec::new();
+    let mut environment: Option<Environment> = None;
+    let mut emitter_shapes = Vec::new();
+    for t in &light_tables {
+        match t.str("kind")? {
+            "environment" => {
+                if environment.is_some() {
+                    return Err(t.err("kind", "a second environment light: at most one per scene"));
+                }
+                environment = Some(emitters::environment(t, dir)?);
+            }
+            "rect" | "sphere" => {
+                if emitter_shapes.len() == emitters::MAX_EMITTERS {
+                    return Err(t.err(
+                        "kind",
+                        format!(
+                            "too many area lights, at most {} are supported",
+                            emitters::MAX_EMITTERS
+                        ),
+                    ));
+                }
+                emitter_shapes.push(emitters::area_light(t)?);
+            }
+            _ => {
+                if lights.len() == MAX_LIGHTS as usize {
+                    return Err(src.err(
+                        &t.span,
+                        &t.path,
+                        format!(
+                            "too many lights: at most {MAX_LIGHTS} point, spot and directional lights are supported"
+                        ),
+                    ));
+                }
+                lights.push(light(t)?);
+            }
+        }
     }
-    let lights = light_tables.iter().map(light).collect::<R<Vec<_>>>()?;
 
     let mut materials = Materials::default();
     for t in root.tables("material")? {
@@ -101,7 +127,8 @@ pub(crate) fn parse(text: &str, path: &Path) -> R<Scene> {
         None => Output { exposure: 1.0 },
     };
 
-    let (materials, textures) = materials.into_parts();
+    let (mut materials, textures) = materials.into_parts();
+    let emitters = emitters::add_geometry(emitter_shapes, &mut materials, &mut objects);
     Ok(Scene {
         source: path.to_path_buf(),
         camera,
@@ -111,6 +138,8 @@ pub(crate) fn parse(text: &str, path: &Path) -> R<Scene> {
         objects,
         medium,
         output,
+        environment,
+        emitters,
     })
 }
 
@@ -215,7 +244,7 @@ fn light(t: &Tbl) -> R<Light> {
         other => {
             return Err(t.err(
                 "kind",
-                format!("unknown light kind `{other}`; expected point, spot or directional"),
+                format!("unknown light kind `{other}`; expected point, spot, directional, environment, rect or sphere"),
             ))
         }
     }
@@ -235,6 +264,7 @@ fn material(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Material> {
         ior: 1.0,
         absorption: Vec3::ZERO,
         texture: None,
+        emission: Vec3::ZERO,
     };
     match kind {
         "diffuse" => {

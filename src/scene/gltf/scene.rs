@@ -85,6 +85,7 @@ pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError
         let material = materials.len() as u32;
         materials.push(Material {
             texture: None,
+            emission: Vec3::ZERO,
             name: "floor".into(),
             kind: MaterialKind::Diffuse,
             color: Vec3::splat(FLOOR_ALBEDO),
@@ -141,5 +142,7 @@ pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError
         objects,
         medium: None,
         output: Output { exposure },
+        environment: None,
+        emitters: Vec::new(),
     })
 }

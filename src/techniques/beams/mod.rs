@@ -136,6 +136,7 @@ impl TechniqueBuild for Beams {
         Component::SurfaceCaustics,
         Component::Airlight,
         Component::VolumeCaustics,
+        Component::Emitted,
     ];
     type Params = BeamsParams;
 

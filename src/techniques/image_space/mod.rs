@@ -107,7 +107,11 @@ impl ImageSpace {
 impl TechniqueBuild for ImageSpace {
     const NAME: &'static str = "image_space";
     const DESCRIPTION: &'static str = "Wyman 2005-06: two-sided image-space refraction of what the camera sees through glass (and in mirrors), and caustic maps (photons through the specular objects, Gaussian splats, projected onto diffuse receivers)";
-    const COMPONENTS: &'static [Component] = &[Component::Direct, Component::SurfaceCaustics];
+    const COMPONENTS: &'static [Component] = &[
+        Component::Direct,
+        Component::SurfaceCaustics,
+        Component::Emitted,
+    ];
     type Params = ImageSpaceParams;
 
     fn build(
@@ -118,6 +122,7 @@ impl TechniqueBuild for ImageSpace {
         width: u32,
         height: u32,
     ) -> anyhow::Result<Self> {
+        crate::environment::check_stand_ins(scene, Self::NAME).map_err(anyhow::Error::msg)?;
         Ok(Self::new(ctx, params, scene, scene_gpu, width, height)?)
     }
 }

@@ -23,7 +23,7 @@
 //!    cluster's centre: point and spot lights as spheres of radius
 //!    `light_radius` with L = I / (pi r^2), a directional light as a sun
 //!    disc of `sun_radius` with L = E / (pi sin^2 alpha)
-//!    (glsl/common/emitters.glsl), with their mip chains. Environment and
+//!    (glsl/common/punctual_emitters.glsl), with their mip chains. Environment and
 //!    area lights come with the `lights` branch: each will be one more
 //!    emitter slot, rendered in `emitter_radiance` of light_maps.comp by its
 //!    glsl/common function.
@@ -428,7 +428,11 @@ impl Pinhole {
 impl TechniqueBuild for Pinhole {
     const NAME: &'static str = "pinhole";
     const DESCRIPTION: &'static str = "Wand & Straßer 2003: reflector sample points as pinhole cameras projecting cube maps of the lights onto the diffuse receivers, filtered by the normal gradient (surface caustics of one mirror bounce)";
-    const COMPONENTS: &'static [Component] = &[Component::Direct, Component::SurfaceCaustics];
+    const COMPONENTS: &'static [Component] = &[
+        Component::Direct,
+        Component::SurfaceCaustics,
+        Component::Emitted,
+    ];
     type Params = PinholeParams;
 
     fn build(

@@ -225,6 +225,7 @@ impl TechniqueBuild for VolumeLines {
         Component::SurfaceCaustics,
         Component::Airlight,
         Component::VolumeCaustics,
+        Component::Emitted,
     ];
     type Params = VolumeLinesParams;
 
@@ -236,6 +237,7 @@ impl TechniqueBuild for VolumeLines {
         width: u32,
         height: u32,
     ) -> anyhow::Result<Self> {
+        crate::environment::check_stand_ins(scene, Self::NAME).map_err(anyhow::Error::msg)?;
         Self::new(ctx, params, scene, scene_gpu, width, height)
     }
 }

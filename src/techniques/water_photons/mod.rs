@@ -84,7 +84,8 @@
 //! stretched by a along the projected ray); 2, fixed splats: that rectangle
 //! with σ = s^c, no differentials (the paper's comparison).
 //!
-//! Light: the scene's first directional light (the paper's sun); a scene
+//! Light: the scene's first directional light (the paper's sun), else the
+//! environment's sun as a directional light (`environment::sun_irradiance`); a scene
 //! without one, or without a water object, is refused. The first water
 //! object is the one traced. The light range (`light_range` 0) is derived
 //! so that the outermost cascade covers the whole water seen from Eq. 1's
@@ -193,6 +194,9 @@ pub struct WaterPhotons {
     /// Eq. 1's origin o: the camera position the cascades were placed for.
     camera_origin: Vec3,
     light: Light,
+    /// The environment's sun as a directional light: the light when the
+    /// scene has no directional one.
+    env_sun: Option<Light>,
     range_param: f32,
     water: Water,
     /// The last completed frame's photon counts (`after_frame`).
@@ -201,6 +205,28 @@ pub struct WaterPhotons {
 
 fn first_directional(lights: &[Light]) -> Option<&Light> {
     lights.iter().find(|l| l.kind == LightKind::Directional)
+}
+
+/// The environment's sun (a sky's, or one found in an image) as the
+/// directional light it stands for (docs/SCENES.md), if it has one.
+fn environment_sun(scene: &Scene) -> Option<Light> {
+    let (direction, irradiance) = scene
+        .environment
+        .as_ref()
+        .and_then(crate::environment::sun_irradiance)?;
+    Some(Light {
+        kind: LightKind::Directional,
+        position: glam::Vec3::ZERO,
+        direction,
+        intensity: irradiance,
+        cone_angle_deg: 0.0,
+        cone_falloff_deg: 0.0,
+    })
+}
+
+/// `lights` and the environment's sun.
+fn with_sun(lights: &[Light], sun: Option<Light>) -> Vec<Light> {
+    lights.iter().copied().chain(sun).collect()
 }
 
 impl WaterPhotons {
@@ -217,8 +243,13 @@ impl WaterPhotons {
             .iter()
             .find_map(|o| o.water.clone())
             .context("water_photons needs a `water` object in the scene")?;
-        let light = *first_directional(&scene.lights)
-            .context("water_photons needs a directional light (the paper's sun)")?;
+        let env_sun = environment_sun(scene);
+        let light = first_directional(&scene.lights)
+            .copied()
+            .or(env_sun)
+            .context(
+                "water_photons needs a directional light (the paper's sun) or an environment with a sun",
+            )?;
         let levels = params.cascades;
         let scale = params.cascade_scale;
         let range_param = params.light_range;
@@ -365,7 +396,12 @@ impl WaterPhotons {
             trace,
             splat,
             denoiser,
-            l_min: denoise::lights_l_min(&scene.lights, scene_sphere.0, scene_sphere.1),
+            l_min: denoise::lights_l_min(
+                &with_sun(&scene.lights, env_sun),
+                scene_sphere.0,
+                scene_sphere.1,
+            ),
+            env_sun,
             scene_sphere,
             composite,
             view,
@@ -410,7 +446,11 @@ impl WaterPhotons {
 impl TechniqueBuild for WaterPhotons {
     const NAME: &'static str = "water_photons";
     const DESCRIPTION: &'static str = "Kougianos & Moustakas 2021: cascaded caustic maps of the water from the sun, photon differentials traced through the BVH, splats drawn indirect into a screen-space caustic buffer";
-    const COMPONENTS: &'static [Component] = &[Component::Direct, Component::SurfaceCaustics];
+    const COMPONENTS: &'static [Component] = &[
+        Component::Direct,
+        Component::SurfaceCaustics,
+        Component::Emitted,
+    ];
     type Params = WaterPhotonsParams;
 
     fn build(
@@ -548,11 +588,15 @@ impl Technique for WaterPhotons {
     }
 
     fn set_lights(&mut self, lights: &[Light]) -> bool {
-        let Some(light) = first_directional(lights).copied() else {
+        let Some(light) = first_directional(lights).copied().or(self.env_sun) else {
             return false;
         };
         self.set_light(&light);
-        self.l_min = denoise::lights_l_min(lights, self.scene_sphere.0, self.scene_sphere.1);
+        self.l_min = denoise::lights_l_min(
+            &with_sun(lights, self.env_sun),
+            self.scene_sphere.0,
+            self.scene_sphere.1,
+        );
         self.surface.set_lights(lights)
     }
 }
