@@ -141,22 +141,22 @@ vec3 material_albedo(uint m, vec2 uv) {
 }
 
 // Whether material m is cut out at `uv` (glTF alphaMode MASK, docs/SCENES.md
-// "Cut-outs"): its texture's alpha below the material's cutoff. Every pass
-// asks the same question, rasterised (with the pixel's footprint) or traced
-// (finest level), so a cut-out is absent from the camera, the shadow maps
-// and every ray alike.
-bool material_cut_out_grad(uint m, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
+// "Cut-outs"): its texture's alpha below the material's cutoff, read at the
+// finest level (bilinear) by every pass, rasterised or traced, so a
+// cut-out has one shape for the camera, the shadow maps and every ray at
+// any distance (a coarser, box-filtered alpha level would thin it).
+bool material_cut_out(uint m, vec2 uv) {
     float cutoff = materials[m].albedo_texture.w;
     if (cutoff <= 0.0) return false;
     int layer = floatBitsToInt(materials[m].albedo_texture.x);
     vec2 s = materials[m].albedo_texture.yz;
-    return textureGrad(albedo_textures, vec3(uv * s, float(layer)), duv_dx * s, duv_dy * s).a < cutoff;
+    return textureLod(albedo_textures, vec3(uv * s, float(layer)), 0.0).a < cutoff;
 }
 
 bool triangle_cut_out(uint tri, vec2 b) {
     uint m = triangle_material(tri);
     if (materials[m].albedo_texture.w <= 0.0) return false;
-    return material_cut_out_grad(m, triangle_uv(tri, b), vec2(0.0), vec2(0.0));
+    return material_cut_out(m, triangle_uv(tri, b));
 }
 
 #endif

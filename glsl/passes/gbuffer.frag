@@ -25,7 +25,7 @@ void main() {
     vec2 duv_dx = dFdx(v_uv);
     vec2 duv_dy = dFdy(v_uv);
     if (pc.opaque_only != 0u && material_kind(v_material) != MATERIAL_DIFFUSE) discard;
-    if (material_cut_out_grad(v_material, v_uv, duv_dx, duv_dy)) discard;
+    if (material_cut_out(v_material, v_uv)) discard;
     vec3 n = normalize(v_normal);
     // alpha of the albedo: 1 where the camera sees the front face (the side
     // an area light emits to; lighting.comp adds the emission there).

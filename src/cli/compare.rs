@@ -13,8 +13,8 @@ use super::{check_size, check_validation, context, load_scene, CompareArgs};
 use anyhow::Context as _;
 use caustics::compare::metrics::{self, FlipMap};
 use caustics::compare::report::{
-    pass_stats, CompareReport, ComponentResult, ReferenceInfo, RunInfo, Skipped, TechniqueResult,
-    Timing, SCHEMA,
+    pass_stats, signed_percent, CompareReport, ComponentResult, ReferenceInfo, RunInfo, Skipped,
+    TechniqueResult, Timing, SCHEMA,
 };
 use caustics::compare::sheet::{self, Tile};
 use caustics::compare::{cache_key, ReferenceKey};
@@ -159,7 +159,7 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
                 let label = vec![
                     name.to_string(),
                     format!("FLIP {:.4}", result.full.flip),
-                    format!("E {:+.1}%", 100.0 * result.full.energy),
+                    format!("E {}", signed_percent(result.full.energy)),
                     format!("{:.1} ms", result.timing.frame_ms),
                 ];
                 tiles.push(vec![
@@ -207,10 +207,10 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
     let moved = staging.commit()?;
     for t in &report.techniques {
         println!(
-            "{:<16} FLIP {:.4}  energy {:+.2}%  {:.2} ms/frame",
+            "{:<16} FLIP {:.4}  energy {}  {:.2} ms/frame",
             t.technique,
             t.full.flip,
-            100.0 * t.full.energy,
+            signed_percent(t.full.energy),
             t.timing.frame_ms
         );
     }
@@ -226,10 +226,14 @@ fn technique_names(list: &str) -> anyhow::Result<Vec<&'static str>> {
     if list == "all" {
         return Ok(TECHNIQUES.iter().map(|t| t.name).collect());
     }
-    list.split(',')
-        .map(|n| techniques::find(n.trim()).map(|t| t.name))
-        .collect::<anyhow::Result<Vec<_>>>()
-        .context("--techniques")
+    let mut names: Vec<&'static str> = Vec::new();
+    for n in list.split(',') {
+        let name = techniques::find(n.trim()).context("--techniques")?.name;
+        if !names.contains(&name) {
+            names.push(name);
+        }
+    }
+    Ok(names)
 }
 
 /// The cache folder for references: $XDG_CACHE_HOME/caustics/references,
@@ -250,8 +254,12 @@ fn reference_images(
 ) -> anyhow::Result<ReferenceImages> {
     let (width, height) = (args.scene.width, args.scene.height);
     let budget = match args.reference_time {
-        Some(s) => format!("seconds {s}"),
+        Some(s) => format!("seconds {s} on {}", ctx.info.name),
         None => format!("photons {}", args.photons.unwrap_or(DEFAULT_PHOTONS)),
+    };
+    let settings = ReferenceSettings {
+        diffuse_bounces: args.diffuse_bounces,
+        ..Default::default()
     };
     let key = ReferenceKey {
         width,
@@ -259,6 +267,7 @@ fn reference_images(
         time: args.scene.time,
         diffuse_bounces: args.diffuse_bounces,
         budget,
+        settings: format!("{settings:?}"),
     };
     let folder = (!args.no_cache)
         .then(cache_root)
@@ -270,10 +279,6 @@ fn reference_images(
             return Ok(images);
         }
     }
-    let settings = ReferenceSettings {
-        diffuse_bounces: args.diffuse_bounces,
-        ..Default::default()
-    };
     let mut r =
         ReferenceRenderer::new(ctx, scene.clone(), width, height, args.scene.time, settings)?;
     // Two equal half-runs: whole passes, so the second stops at exactly
@@ -396,10 +401,12 @@ fn run_technique(
     let exposure = scene.output.exposure;
     let info = techniques::find(name)?;
     let params = Params::resolve(name, info.params(), &[])?;
-    let mut r = match Renderer::new(ctx, scene.clone(), name, &params, width, height, time) {
-        Ok(r) => r,
-        Err(e) => return Ok(Err(format!("{e:#}"))),
-    };
+    // A technique that does not take the scene is skipped; any other
+    // failure is the comparison's.
+    if let Err(e) = (info.check_scene)(scene) {
+        return Ok(Err(format!("{e:#}")));
+    }
+    let mut r = Renderer::new(ctx, scene.clone(), name, &params, width, height, time)?;
     r.set_frame_options(FrameOptions::default())?;
     *timing_source = Some(r.frames.source.describe().to_string());
     // Warm-up (pipeline compilation), then the timed frames, all at the

@@ -71,13 +71,14 @@ pub fn energy(rgba: &[f32]) -> f64 {
 }
 
 /// (energy(test) − energy(reference)) / energy(reference): signed, 0 for
-/// equal totals; 0 when both are black, infinite when only the reference is.
-pub fn relative_energy(test: &[f32], reference: &[f32]) -> f64 {
+/// equal totals; 0 when both are black, None (undefined) when only the
+/// reference is.
+pub fn relative_energy(test: &[f32], reference: &[f32]) -> Option<f64> {
     let (t, r) = (energy(test), energy(reference));
     if r == 0.0 {
-        return if t == 0.0 { 0.0 } else { f64::INFINITY };
+        return (t == 0.0).then_some(0.0);
     }
-    (t - r) / r
+    Some((t - r) / r)
 }
 
 /// Root mean square of the rgb differences, in radiance units.
@@ -102,8 +103,9 @@ pub fn rmse(test: &[f32], reference: &[f32]) -> f64 {
 pub struct Metrics {
     /// LDR-FLIP mean at the scene's exposure (module docs).
     pub flip: f32,
-    /// `relative_energy`: signed.
-    pub energy: f64,
+    /// `relative_energy`: signed; None (JSON null) when the reference is
+    /// black and the test image is not.
+    pub energy: Option<f64>,
     pub rmse: f64,
 }
 
@@ -153,14 +155,16 @@ mod tests {
     fn an_image_against_itself_scores_zero() {
         let img: Vec<f32> = (0..16 * 16 * 4).map(|i| (i % 7) as f32 * 0.1).collect();
         let (m, _) = compare(&img, &img, 16, 16, 1.0);
-        assert_eq!((m.flip, m.energy, m.rmse), (0.0, 0.0, 0.0));
+        assert_eq!((m.flip, m.energy, m.rmse), (0.0, Some(0.0), 0.0));
     }
 
     #[test]
     fn energy_and_rmse_measure_what_they_say() {
         let reference = vec![1.0f32; 4 * 4];
         let brighter: Vec<f32> = reference.iter().map(|v| v * 1.5).collect();
-        assert!((relative_energy(&brighter, &reference) - 0.5).abs() < 1e-12);
+        assert!((relative_energy(&brighter, &reference).unwrap() - 0.5).abs() < 1e-12);
+        assert_eq!(relative_energy(&brighter, &[0.0; 16]), None);
+        assert_eq!(relative_energy(&[0.0; 16], &[0.0; 16]), Some(0.0));
         assert!((rmse(&brighter, &reference) - 0.5).abs() < 1e-12);
         let (m, _) = compare(&brighter, &reference, 2, 2, 1.0);
         assert!(m.flip > 0.0);

@@ -22,12 +22,18 @@ impl Fnv1a {
     }
 }
 
-impl std::fmt::Write for Fnv1a {
-    fn write_str(&mut self, s: &str) -> std::fmt::Result {
-        for b in s.bytes() {
+impl Fnv1a {
+    fn bytes(&mut self, bytes: &[u8]) {
+        for &b in bytes {
             self.0 ^= b as u64;
             self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
         }
+    }
+}
+
+impl std::fmt::Write for Fnv1a {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        self.bytes(s.as_bytes());
         Ok(())
     }
 }
@@ -39,19 +45,26 @@ pub struct ReferenceKey {
     pub height: u32,
     pub time: f32,
     pub diffuse_bounces: u32,
-    /// "photons N" or "seconds S".
+    /// "photons N", or "seconds S on DEVICE" (what S seconds trace
+    /// depends on the device).
     pub budget: String,
+    /// The reference's settings (`ReferenceSettings`, Debug form).
+    pub settings: String,
 }
 
 /// The reference cache's key: a hash of the loaded scene (every value the
 /// scene file and the files it references resolve to: meshes, textures,
 /// materials, lights, camera, so an edited OBJ or texture changes it even
-/// though the TOML did not), the render settings and the program's version.
-/// Hashing the resolved scene streams its `Debug` form through the hash
-/// without building the string.
+/// though the TOML did not), the render settings, the program's version and
+/// the compiled reference shaders (a changed estimator is traced anew even
+/// within one version). Hashing the resolved scene streams its `Debug` form
+/// through the hash without building the string.
 pub fn cache_key(scene: &Scene, key: &ReferenceKey) -> String {
     let mut h = Fnv1a::new();
     let _ = write!(h, "{}|{scene:?}|{key:?}", env!("CARGO_PKG_VERSION"));
+    for bytes in crate::shaders::compiled_under("reference/") {
+        h.bytes(bytes);
+    }
     format!("{:016x}", h.0)
 }
 
@@ -72,6 +85,7 @@ mod tests {
             time: 0.0,
             diffuse_bounces: 0,
             budget: "photons 1000".into(),
+            settings: String::new(),
         };
         let k = cache_key(&scene, &key);
         assert_eq!(k, cache_key(&scene, &key), "stable");

@@ -98,8 +98,9 @@ pub struct CompareReport {
     pub skipped: Vec<Skipped>,
 }
 
-fn signed_percent(x: f64) -> String {
-    format!("{:+.2}%", 100.0 * x)
+/// A relative energy as a signed percentage ("undefined" for None).
+pub fn signed_percent(x: Option<f64>) -> String {
+    x.map_or("undefined".into(), |x| format!("{:+.2}%", 100.0 * x))
 }
 
 impl CompareReport {

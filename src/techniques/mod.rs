@@ -96,6 +96,7 @@ fn create<T: TechniqueBuild>(
     height: u32,
 ) -> anyhow::Result<Box<dyn Technique>> {
     let params = T::Params::from_params(params)?;
+    T::check_scene(scene)?;
     Ok(Box::new(T::build(
         ctx, &params, scene, scene_gpu, width, height,
     )?))
@@ -159,20 +160,24 @@ registry! {
 }
 
 /// `--technique auto`: the technique that renders every component `scene`
-/// has. A participating medium needs airlight and volume caustics:
-/// `volume_lines` (`beams` renders them too; volume_lines is the closer to
-/// the reference on volume_cone, BENCHMARKS.md). Water lit by a sun:
-/// `water_photons`. Anything else: `image_space`, the surface caustics of
-/// mirrors and glass.
+/// has, among those that accept it (`check_scene`: e.g. image_space and
+/// volume_lines refuse sphere lights). A participating medium needs airlight
+/// and volume caustics: `volume_lines` (`beams` renders them too;
+/// volume_lines is the closer to the reference on volume_cone,
+/// BENCHMARKS.md). Water lit by a sun: `water_photons`. Otherwise
+/// `image_space`, the surface caustics of mirrors and glass; `direct` when
+/// none of them accepts the scene.
 pub fn auto(scene: &Scene) -> &'static str {
-    let water_photons = find("water_photons").expect("registered");
-    if scene.medium.is_some() {
-        "volume_lines"
-    } else if (water_photons.check_scene)(scene).is_ok() {
-        "water_photons"
+    let candidates: &[&'static str] = if scene.medium.is_some() {
+        &["volume_lines", "beams", "direct"]
     } else {
-        "image_space"
-    }
+        &["water_photons", "image_space", "direct"]
+    };
+    candidates
+        .iter()
+        .copied()
+        .find(|name| find(name).is_ok_and(|t| (t.check_scene)(scene).is_ok()))
+        .unwrap_or("direct")
 }
 
 pub fn find(name: &str) -> anyhow::Result<&'static TechniqueInfo> {

@@ -237,8 +237,12 @@ impl TechniqueBuild for VolumeLines {
         width: u32,
         height: u32,
     ) -> anyhow::Result<Self> {
-        crate::environment::check_stand_ins(scene, Self::NAME).map_err(anyhow::Error::msg)?;
         Self::new(ctx, params, scene, scene_gpu, width, height)
+    }
+
+    /// Area lights become point stand-ins, within their size limit.
+    fn check_scene(scene: &Scene) -> anyhow::Result<()> {
+        crate::environment::check_stand_ins(scene, Self::NAME).map_err(anyhow::Error::msg)
     }
 }
 
