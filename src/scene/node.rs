@@ -348,8 +348,17 @@ pub const MAX_MAGNITUDE: f64 = 1e6;
 /// small enough that power and photon flux stay far from the f32 range.
 pub const MAX_RADIOMETRIC: f64 = 1e10;
 
-/// Fields (by their last key) that hold radiometric values.
-const RADIOMETRIC_KEYS: [&str; 3] = ["intensity", "irradiance", "radiance"];
+/// Fields (by their last key) that hold radiometric values: lights'
+/// intensity and irradiance, area lights' radiance, and an environment
+/// sky's sun, zenith and horizon radiances.
+const RADIOMETRIC_KEYS: [&str; 6] = [
+    "intensity",
+    "irradiance",
+    "radiance",
+    "sun_radiance",
+    "zenith",
+    "horizon",
+];
 
 /// The bound on |value| for `field` (a dotted path such as
 /// `light[0].intensity[1]`): by its last key.

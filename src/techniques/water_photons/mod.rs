@@ -473,9 +473,9 @@ impl TechniqueBuild for WaterPhotons {
                 "{file}: object: water_photons needs a `water` object (shape = \"water\"); the scene has none"
             );
         }
-        if first_directional(&scene.lights).is_none() {
+        if first_directional(&scene.lights).is_none() && environment_sun(scene).is_none() {
             anyhow::bail!(
-                "{file}: light: water_photons needs a directional light (the paper's sun, kind = \"directional\"); the scene has none"
+                "{file}: light: water_photons needs a directional light (the paper's sun, kind = \"directional\") or an environment with a sun; the scene has neither"
             );
         }
         Ok(())
