@@ -241,15 +241,15 @@ impl Sampler {
 }
 
 impl Sampler {
-    /// Trilinear filtering with repeat wrap over every mip level (tiling
-    /// textures).
-    pub fn repeat_mipmapped(ctx: &Arc<Context>) -> VkResult<Self> {
+    /// Trilinear filtering over every mip level with `address` in u and v
+    /// (clamped in w).
+    fn trilinear(ctx: &Arc<Context>, address: vk::SamplerAddressMode) -> VkResult<Self> {
         let info = vk::SamplerCreateInfo::default()
             .mag_filter(vk::Filter::LINEAR)
             .min_filter(vk::Filter::LINEAR)
             .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
-            .address_mode_u(vk::SamplerAddressMode::REPEAT)
-            .address_mode_v(vk::SamplerAddressMode::REPEAT)
+            .address_mode_u(address)
+            .address_mode_v(address)
             .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
             .max_lod(vk::LOD_CLAMP_NONE);
         Ok(Self {
@@ -257,24 +257,17 @@ impl Sampler {
             raw: unsafe { ctx.device.create_sampler(&info, None) }?,
         })
     }
-}
 
-impl Sampler {
+    /// Trilinear filtering with repeat wrap over every mip level (tiling
+    /// textures).
+    pub fn repeat_mipmapped(ctx: &Arc<Context>) -> VkResult<Self> {
+        Self::trilinear(ctx, vk::SamplerAddressMode::REPEAT)
+    }
+
     /// Trilinear filtering, clamped to the edge, over every mip level: for
     /// `textureGrad` lookups with explicit footprints.
     pub fn trilinear_clamp(ctx: &Arc<Context>) -> VkResult<Self> {
-        let info = vk::SamplerCreateInfo::default()
-            .mag_filter(vk::Filter::LINEAR)
-            .min_filter(vk::Filter::LINEAR)
-            .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
-            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .max_lod(vk::LOD_CLAMP_NONE);
-        Ok(Self {
-            ctx: ctx.clone(),
-            raw: unsafe { ctx.device.create_sampler(&info, None) }?,
-        })
+        Self::trilinear(ctx, vk::SamplerAddressMode::CLAMP_TO_EDGE)
     }
 }
 
