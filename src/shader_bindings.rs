@@ -111,6 +111,11 @@ pub const CAUSTIC_BINDING_ALBEDO: u32 = 10;
 pub const PHOTON_MODE_TRACED: u32 = 0;
 pub const PHOTON_MODE_IMAGE_SPACE: u32 = 1;
 pub const PHOTON_MODE_BACK_MARCH: u32 = 2;
+/// Specialisation constant ids of caustic_map/photons.comp: its rebuild
+/// parameters, so each pipeline compiles only the chosen path code.
+pub const CAUSTIC_SPEC_PHOTON_MODE: u32 = 0;
+pub const CAUSTIC_SPEC_TIR_REMEDY: u32 = 1;
+pub const CAUSTIC_SPEC_EQ632: u32 = 2;
 /// Specular G-buffer passes (src/passes/specular_gbuffer.rs): nearest front
 /// faces, farthest back faces.
 pub const SPECULAR_GBUFFER_FRONT: u32 = 0;

@@ -25,8 +25,8 @@ use caustics::gpu::GpuTriangle;
 use caustics::scene::Scene;
 use caustics::shader_bindings as b;
 use caustics::vk::{
-    barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline,
-    DescriptorSet, DescriptorSetLayout,
+    step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, DescriptorSet,
+    DescriptorSetLayout,
 };
 use common::*;
 use glam::Vec3;
@@ -169,16 +169,11 @@ fn check(path: &str, scene: Scene, seed: u64) {
     scene_gpu.update_frame(&scene, 128, 128, 0.0, 0).unwrap();
     let start = std::time::Instant::now();
     ctx.submit_and_wait(|cmd| {
-        barrier(
-            &ctx,
-            cmd,
-            &[],
-            &[
-                BufferAccess::new(&ray_buf, Access::ComputeRead),
-                BufferAccess::new(&results, Access::ComputeWrite),
-                BufferAccess::new(&any, Access::ComputeWrite),
-            ],
-        );
+        step(&ctx, cmd)
+            .read(&ray_buf, Access::ComputeRead)
+            .write(&results, Access::ComputeWrite)
+            .write(&any, Access::ComputeWrite)
+            .emit();
         pipeline.dispatch(
             cmd,
             &[&scene_gpu.set, &set],

@@ -13,8 +13,7 @@ use caustics::techniques::water_photons::denoise::{
     adaptive_vs_fixed, c_scene, DenoiseConfig, DenoiseKind, Denoiser,
 };
 use caustics::vk::{
-    barrier, copy_image, vk, Access, Buffer, BufferUsage, Context, Image, ImageAccess, ImageDesc,
-    Profiler,
+    copy_image, step, vk, Access, Buffer, BufferUsage, Context, Image, ImageDesc, Profiler,
 };
 use common::{assert_validation_clean, validated_context};
 use glam::Vec3;
@@ -52,12 +51,9 @@ fn upload_sized(ctx: &Arc<Context>, name: &str, data: &[f32], size: u32) -> Imag
     .unwrap();
     let staging = Buffer::with_data(ctx, "staging", data, BufferUsage::Upload).unwrap();
     ctx.submit_and_wait(|cmd| {
-        barrier(
-            ctx,
-            cmd,
-            &[ImageAccess::discard(&image, Access::TransferWrite)],
-            &[],
-        );
+        step(ctx, cmd)
+            .overwrite(&image, Access::TransferWrite)
+            .emit();
         let region = vk::BufferImageCopy::default()
             .image_subresource(vk::ImageSubresourceLayers {
                 aspect_mask: vk::ImageAspectFlags::COLOR,
@@ -619,9 +615,8 @@ fn real_gbuffer_edges() {
         profiler
             .frame(|rec| {
                 let ctx = rec.ctx().clone();
-                rec.pass("copy", |cmd| {
-                    copy_image(&ctx, cmd, &staged, &caustics);
-                });
+                rec.pass("copy")
+                    .record(|cmd| copy_image(&ctx, cmd, &staged, &caustics));
                 denoiser.record(
                     rec,
                     &caustics,

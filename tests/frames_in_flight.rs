@@ -155,3 +155,44 @@ fn a_rebuild_with_frames_in_flight_keeps_read_backs_with_their_technique() {
     drop(r);
     common::assert_validation_clean(&ctx);
 }
+
+/// A host write that bypasses the frame's upload ring is refused while
+/// frames are in flight: re-uploading the scene's lights straight into the
+/// buffer every frame reads (as an animation would if it skipped
+/// `FrameRecorder::upload`) panics naming the ring; once the frames are
+/// complete the same write is allowed (the demo's light edits wait first).
+#[test]
+fn a_host_write_bypassing_the_ring_is_refused_while_frames_are_in_flight() {
+    let ctx = common::validated_context();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/ball_lens.toml");
+    let scene = Scene::load(&path).expect("scene");
+    let info = techniques::find("direct").expect("technique");
+    let params = Params::resolve("direct", info.params(), &[]).expect("params");
+    let mut r =
+        Renderer::new(&ctx, scene.clone(), "direct", &params, 32, 32, 0.0).expect("renderer");
+    r.set_frame_options(FrameOptions {
+        frames_in_flight: 2,
+        ..FrameOptions::default()
+    })
+    .expect("frames");
+    r.submit_frame(0.0).expect("frame");
+    assert_eq!(r.frames.pending(), 1);
+    let bypass = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        r.scene_gpu.update_lights(&scene)
+    }));
+    let message = bypass
+        .expect_err("a direct write under a frame in flight must be refused")
+        .downcast::<String>()
+        .map(|s| *s)
+        .unwrap_or_default();
+    assert!(
+        message.contains("FrameRecorder::upload"),
+        "the refusal names the ring: {message}"
+    );
+    r.finish().expect("frames");
+    r.scene_gpu
+        .update_lights(&scene)
+        .expect("allowed with no frame in flight");
+    drop(r);
+    common::assert_validation_clean(&ctx);
+}

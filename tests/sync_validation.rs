@@ -46,12 +46,10 @@ fn a_missing_barrier_between_passes_is_reported() {
         .frame(|rec| {
             // Each pass alone is fine; the second lacks the barrier that
             // orders it after the first.
-            rec.pass("first write", |cmd| unsafe {
-                ctx.device.cmd_fill_buffer(cmd, buffer.raw, 0, 256, 1)
-            });
-            rec.pass("second write", |cmd| unsafe {
-                ctx.device.cmd_fill_buffer(cmd, buffer.raw, 0, 256, 2)
-            });
+            rec.pass("first write")
+                .record(|cmd| unsafe { ctx.device.cmd_fill_buffer(cmd, buffer.raw, 0, 256, 1) });
+            rec.pass("second write")
+                .record(|cmd| unsafe { ctx.device.cmd_fill_buffer(cmd, buffer.raw, 0, 256, 2) });
             Ok(())
         })
         .unwrap();

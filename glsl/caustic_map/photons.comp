@@ -12,7 +12,7 @@
 //                dOmega = du dv / (1 + u^2 + v^2)^(3/2) over the texel in
 //                the tan plane: error O(h^4), below float rounding);
 //   directional: Phi = E * A_texel (texel area perpendicular to the light).
-// Three ways to find the refracted path (push constant `mode`):
+// Three ways to find the refracted path (specialisation constant PHOTON_MODE):
 // - PHOTON_MODE_TRACED (default): interfaces and landing point by tracing
 //   the BVH; exact in expectation, any number of interfaces (see below).
 // - PHOTON_MODE_IMAGE_SPACE: Wyman 2005's two-sided refraction from the
@@ -43,7 +43,7 @@
 // In a participating medium (Hu et al. 2010 Sect. 5.3) the flux is
 // attenuated along every segment through air, light -> first specular
 // surface, between interfaces outside the objects, exit -> receiver, by the
-// deterministic transmittance of glsl/common/medium.glsl (`mode.w` midpoint
+// deterministic transmittance of glsl/common/medium.glsl (`steps.x` midpoint
 // steps for noise/grid densities); inside solid objects there is no medium
 // (as in the reference). The camera side (receiver -> eye) is apply.comp's.
 #include "scene.glsl"
@@ -63,12 +63,18 @@ layout(push_constant) uniform Push {
     vec4 right;   // xyz; w: light index (uint bits)
     vec4 up;      // xyz; w: photon view size N (uint bits)
     vec4 forward; // xyz; w: SHADOW_RADIAL (perspective) or SHADOW_PLANAR (ortho) (uint bits)
-    uvec4 mode;   // x: PHOTON_MODE_*; y: TIR_* remedy; z: 1 = Eq. 6.3.2 on; w: medium steps
+    uvec4 steps;  // x: midpoint steps of the medium transmittance
 } pc;
+
+// The rebuild parameters, as specialisation constants: a pipeline holds only
+// its mode's path code (the traced mode none of the image-space search).
+layout(constant_id = CAUSTIC_SPEC_PHOTON_MODE) const uint PHOTON_MODE = PHOTON_MODE_TRACED;
+layout(constant_id = CAUSTIC_SPEC_TIR_REMEDY) const uint TIR_REMEDY = TIR_CLAMP_CRITICAL;
+layout(constant_id = CAUSTIC_SPEC_EQ632) const bool USE_EQ632 = true;
 
 // Transmittance of the medium over the air segment o + t d, t in [0, dist].
 vec3 air_transmittance(vec3 o, vec3 d, float dist) {
-    return medium_transmittance_steps(o, d, dist, pc.mode.w);
+    return medium_transmittance_steps(o, d, dist, pc.steps.x);
 }
 
 // tau(s, x) of the first leg, from the light to the first hit x along d
@@ -270,9 +276,9 @@ bool image_space_refraction(uvec2 id, vec3 p1, vec3 n1, vec3 d, uint m, float d_
         return true;
     }
     float d_v = length(bp.xyz - p1);
-    if (pc.mode.x == PHOTON_MODE_IMAGE_SPACE) {
+    if (PHOTON_MODE == PHOTON_MODE_IMAGE_SPACE) {
         TwoSidedExit e;
-        if (!two_sided_refraction(d, p1, n1, ior, d_v, d_n, pc.mode.y, pc.mode.z != 0u, e)) return false;
+        if (!two_sided_refraction(d, p1, n1, ior, d_v, d_n, TIR_REMEDY, USE_EQ632, e)) return false;
         w *= e.transmit * exp(-materials[m].absorption_ior.rgb * e.dist);
         dir = e.dir;
         return land_through_air(e.p2, e.dir, w, p3);
@@ -345,7 +351,7 @@ void main() {
     // The first surface: only photons meeting a specular object first make
     // caustics. Traced: the BVH; image space: the front-face G-buffer (its
     // position lies on this texel's centre ray).
-    bool image_space = pc.mode.x != PHOTON_MODE_TRACED;
+    bool image_space = PHOTON_MODE != PHOTON_MODE_TRACED;
     uint m;
     vec3 x, ng, ns;
     float d_n = 0.0;

@@ -6,8 +6,8 @@ use super::overlay::{Action, MediumValues, Overlay, UiData};
 use super::slots::ImageSemaphores;
 use crate::renderer::Renderer;
 use crate::vk::{
-    barrier, begin_rendering, end_rendering, Access, Acquired, Context, FrameSync, ImageAccess,
-    PassTiming, Surface, Swapchain,
+    begin_rendering, end_rendering, step, Access, Acquired, Context, FrameSync, PassTiming,
+    Surface, Swapchain,
 };
 use ash::vk;
 use std::collections::{HashSet, VecDeque};
@@ -260,12 +260,7 @@ impl State {
                 // The tonemap's compute writes -> transfer read. The next frame's
                 // tonemap pass orders its write after this read through the
                 // display image's tracked state (write-after-read).
-                barrier(
-                    &ctx,
-                    cmd,
-                    &[ImageAccess::new(display, Access::TransferRead)],
-                    &[],
-                );
+                step(&ctx, cmd).read(display, Access::TransferRead).emit();
                 let draw_overlay = overlay.visible();
                 swapchain.blit_to_image(cmd, index, display.raw, display.extent(), draw_overlay);
                 if draw_overlay {

@@ -14,7 +14,6 @@ use crate::vk::{
     BindingKind, Buffer, BufferUsage, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder,
     VkResult,
 };
-use ash::vk;
 use glam::{Mat4, Vec3};
 use std::cell::Cell;
 use std::sync::Arc;
@@ -200,18 +199,16 @@ impl SceneGpu {
             .write_buffer(b::BINDING_MEDIUM, &medium_buf)
             .write_buffer(b::BINDING_DENSITY_GRID, &grid_buf)
             .write_buffer(b::BINDING_TRIANGLE_UVS, &uvs_buf)
-            .write_sampled_image(
+            .write_static_texture(
                 b::BINDING_ALBEDO_TEXTURES,
                 &albedo_textures.image,
                 &albedo_textures.sampler,
-                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
             )
             .write_buffer(b::BINDING_EMITTERS, &emitters_buf)
-            .write_sampled_image(
+            .write_static_texture(
                 b::BINDING_ENVIRONMENT,
                 &environment.image,
                 &environment.sampler,
-                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
             )
             .write_buffer(b::BINDING_ENVIRONMENT_DATA, &environment.data);
         // The load phases' costs (RUST_LOG=info): scripts/gltf-bench.sh reads them.

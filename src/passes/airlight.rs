@@ -31,8 +31,8 @@ use crate::passes::shadow::ShadowMaps;
 use crate::scene::Scene;
 use crate::shader_bindings as b;
 use crate::vk::{
-    barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
-    FrameRecorder, Image, ImageAccess, Sampler, TargetBinding, VkResult,
+    Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    FrameRecorder, Image, Sampler, VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -63,11 +63,8 @@ pub struct Airlight {
     push: AirlightPush,
     pipeline: ComputePipeline,
     set: DescriptorSet,
-    /// The image the output binding points at (written on the first
-    /// `record`, again when the target changes).
-    bound_out: TargetBinding,
     _layout: DescriptorSetLayout,
-    _sampler: Sampler,
+    sampler: Sampler,
 }
 
 impl Airlight {
@@ -93,13 +90,7 @@ impl Airlight {
         // Nearest: shadow.glsl fetches single texels and compares them itself.
         let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
         let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_sampled_image(
-            b::AIRLIGHT_BINDING_SHADOW_MAP,
-            &shadows.map,
-            &sampler,
-            vk::ImageLayout::GENERAL,
-        )
-        .write_buffer(b::AIRLIGHT_BINDING_SHADOW_LIGHTS, &shadows.lights);
+        set.write_buffer(b::AIRLIGHT_BINDING_SHADOW_LIGHTS, &shadows.lights);
         let pipeline = ComputePipeline::new(
             ctx,
             "passes/airlight.comp",
@@ -115,9 +106,8 @@ impl Airlight {
             },
             pipeline,
             set,
-            bound_out: TargetBinding::new(b::AIRLIGHT_BINDING_RADIANCE),
             _layout: layout,
-            _sampler: sampler,
+            sampler,
         })
     }
 
@@ -137,29 +127,32 @@ impl Airlight {
         shadows: &ShadowMaps,
         out: &Image,
     ) {
-        self.bound_out.bind(rec, &self.set, out);
-        let ctx = rec.ctx().clone();
         let (width, height) = (out.extent().width, out.extent().height);
-        rec.pass("airlight", |cmd| {
-            // The shadow maps' attachment writes must be visible to the
-            // compute reads (GENERAL layout); `out` is read-modify-written
-            // after the pass that wrote the surface radiance.
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(&shadows.map, Access::ComputeRead),
-                    ImageAccess::new(out, Access::ComputeWrite),
-                ],
-                &[],
-            );
-            let groups = [width.div_ceil(8), height.div_ceil(8), 1];
-            self.pipeline.dispatch(
-                cmd,
-                &[&scene.set, &self.set],
-                bytemuck::bytes_of(&self.push),
-                groups,
-            );
-        });
+        // The shadow maps' attachment writes must be visible to the
+        // compute reads (GENERAL layout); `out` is read-modify-written
+        // after the pass that wrote the surface radiance.
+        rec.pass("airlight")
+            .sampled(
+                &self.set,
+                b::AIRLIGHT_BINDING_SHADOW_MAP,
+                &shadows.map,
+                &self.sampler,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                &self.set,
+                b::AIRLIGHT_BINDING_RADIANCE,
+                out,
+                Access::ComputeWrite,
+            )
+            .record(|cmd| {
+                let groups = [width.div_ceil(8), height.div_ceil(8), 1];
+                self.pipeline.dispatch(
+                    cmd,
+                    &[&scene.set, &self.set],
+                    bytemuck::bytes_of(&self.push),
+                    groups,
+                );
+            });
     }
 }

@@ -12,8 +12,8 @@ use crate::passes::gbuffer::GBuffer;
 use crate::passes::specular_gbuffer::{SpecularGBuffer, Viewpoint};
 use crate::shader_bindings as b;
 use crate::vk::{
-    barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
-    FrameRecorder, Image, ImageAccess, TargetBinding, VkResult,
+    Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    FrameRecorder, Image, VkResult,
 };
 use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
@@ -36,7 +36,6 @@ pub struct CameraRefraction {
     push: RefractionPush,
     pipeline: ComputePipeline,
     set: DescriptorSet,
-    bound_radiance: TargetBinding,
     _layout: DescriptorSetLayout,
 }
 
@@ -46,16 +45,13 @@ impl CameraRefraction {
         self.push.search_steps = steps;
     }
 
-    /// `opaque` is the frame of the scene without its specular surfaces and
-    /// `opaque_gbuffer` its G-buffer (positions: the depth image searched).
+    /// A refraction pass for frames of `extent`.
     pub fn new(
         ctx: &Arc<Context>,
         scene_gpu: &SceneGpu,
-        opaque: &Image,
-        opaque_gbuffer: &GBuffer,
+        extent: ash::vk::Extent2D,
         push: RefractionPush,
     ) -> VkResult<Self> {
-        let extent = opaque.extent();
         let gbuffer = SpecularGBuffer::new(ctx, &scene_gpu.layout, extent.width, extent.height)?;
         let layout = DescriptorSetLayout::new(
             ctx,
@@ -85,18 +81,6 @@ impl CameraRefraction {
             ],
         )?;
         let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_storage_image(b::REFRACTION_BINDING_OPAQUE_RADIANCE, opaque)
-            .write_storage_image(
-                b::REFRACTION_BINDING_OPAQUE_POSITION,
-                &opaque_gbuffer.position,
-            )
-            .write_storage_image(
-                b::REFRACTION_BINDING_FRONT_POSITION,
-                &gbuffer.front_position,
-            )
-            .write_storage_image(b::REFRACTION_BINDING_FRONT_NORMAL, &gbuffer.front_normal)
-            .write_storage_image(b::REFRACTION_BINDING_BACK_POSITION, &gbuffer.back_position)
-            .write_storage_image(b::REFRACTION_BINDING_BACK_NORMAL, &gbuffer.back_normal);
         let pipeline = ComputePipeline::new(
             ctx,
             "passes/camera_refraction.comp",
@@ -108,7 +92,6 @@ impl CameraRefraction {
             push,
             pipeline,
             set,
-            bound_radiance: TargetBinding::new(b::REFRACTION_BINDING_RADIANCE),
             _layout: layout,
         })
     }
@@ -116,10 +99,8 @@ impl CameraRefraction {
     /// Records "refractor gbuffer": the camera's specular G-buffer, which
     /// `record` reads (and techniques may read before it).
     pub fn draw_gbuffer(&self, rec: &mut FrameRecorder, scene: &SceneGpu) {
-        let ctx = rec.ctx().clone();
-        rec.pass("refractor gbuffer", |cmd| {
-            self.gbuffer.draw(&ctx, cmd, scene, &Viewpoint::Camera);
-        });
+        self.gbuffer
+            .record(rec, "refractor gbuffer", scene, &Viewpoint::Camera);
     }
 
     /// Records "refraction" (after `draw_gbuffer`): reads `opaque` (all of
@@ -133,31 +114,44 @@ impl CameraRefraction {
         opaque_gbuffer: &GBuffer,
         targets: &FrameTargets,
     ) {
-        self.bound_radiance.bind(rec, &self.set, &targets.radiance);
-        let ctx = rec.ctx().clone();
-        rec.pass("refraction", |cmd| {
-            // The specular G-buffer's attachment writes and the opaque
-            // frame's compute writes (caustic apply) must be visible; the
-            // output is overwritten entirely after last frame's readers.
-            let [a, b_, c, d] = self.gbuffer.compute_reads();
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    a,
-                    b_,
-                    c,
-                    d,
-                    ImageAccess::new(opaque, Access::ComputeRead),
-                    ImageAccess::new(&opaque_gbuffer.position, Access::ComputeRead),
-                    ImageAccess::discard(&targets.radiance, Access::ComputeWrite),
-                ],
-                &[],
-            );
+        // The specular G-buffer's attachment writes and the opaque frame's
+        // compute writes (caustic apply) become visible; the output is
+        // overwritten entirely after last frame's readers.
+        let set = &self.set;
+        let pass = rec.pass("refraction");
+        let pass = self.gbuffer.bind_reads(
+            pass,
+            set,
+            [
+                b::REFRACTION_BINDING_FRONT_POSITION,
+                b::REFRACTION_BINDING_FRONT_NORMAL,
+                b::REFRACTION_BINDING_BACK_POSITION,
+                b::REFRACTION_BINDING_BACK_NORMAL,
+            ],
+        );
+        pass.storage_image(
+            set,
+            b::REFRACTION_BINDING_OPAQUE_RADIANCE,
+            opaque,
+            Access::ComputeRead,
+        )
+        .storage_image(
+            set,
+            b::REFRACTION_BINDING_OPAQUE_POSITION,
+            &opaque_gbuffer.position,
+            Access::ComputeRead,
+        )
+        .overwrite_storage_image(
+            set,
+            b::REFRACTION_BINDING_RADIANCE,
+            &targets.radiance,
+            Access::ComputeWrite,
+        )
+        .record(|cmd| {
             let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
             self.pipeline.dispatch(
                 cmd,
-                &[&scene.set, &self.set],
+                &[&scene.set, set],
                 bytemuck::bytes_of(&self.push),
                 groups,
             );

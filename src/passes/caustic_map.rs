@@ -73,13 +73,12 @@ use crate::passes::gbuffer::GBuffer;
 use crate::passes::light_views::{LightView, LightViewConsumer, LightViews};
 use crate::passes::shadow::{shadow_views, GpuShadowLight};
 use crate::passes::specular_gbuffer::SpecularGBuffer;
-use crate::passes::surface_frame::SurfaceFrame;
 use crate::scene::{Light, LightKind};
 use crate::shader_bindings as b;
 use crate::vk::{
-    barrier, begin_rendering, end_rendering, Access, BindingKind, Buffer, BufferAccess,
-    BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder,
-    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageAccess, ImageDesc, Sampler, VkResult,
+    begin_rendering, end_rendering, Access, BindingKind, Buffer, BufferUsage, ComputePipeline,
+    Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
+    GraphicsPipelineDesc, Image, ImageDesc, Sampler, Specialization, VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -111,11 +110,10 @@ pub struct PhotonViewPush {
     pub right: [f32; 4],
     pub up: [f32; 4],
     pub forward: [f32; 4],
-    /// x: `PHOTON_MODE_*`; y: TIR remedy (`TIR_*`); z: 1 to use Eq. 6.3.2
-    /// where the back-face texel holds no normal (see image_space PARAMS);
-    /// w: midpoint steps of the medium transmittance along the photon's
-    /// paths through air (`medium_steps`).
-    pub mode: [u32; 4],
+    /// x: midpoint steps of the medium transmittance along the photon's
+    /// paths through air (`medium_steps`). The path mode, TIR remedy and
+    /// Eq. 6.3.2 switch are specialisation constants of the pipeline.
+    pub steps: [u32; 4],
 }
 
 #[repr(C)]
@@ -163,14 +161,12 @@ impl ImageSpaceParams {
         }
     }
 
-    /// The caustic map of these parameters over `surface`'s opaque frame,
-    /// its photons from `light_views`.
+    /// The caustic map of these parameters, its photons from `light_views`.
     pub fn caustic_map(
         &self,
         ctx: &Arc<Context>,
         scene_gpu: &SceneGpu,
         light_views: &LightViews,
-        surface: &SurfaceFrame,
     ) -> VkResult<CausticMap> {
         CausticMap::new(
             ctx,
@@ -185,8 +181,6 @@ impl ImageSpaceParams {
                 medium_steps: self.direct.medium_steps,
                 on_change: self.caustics_on_change,
             },
-            surface.gbuffer(),
-            surface.opaque(),
         )
     }
 }
@@ -241,7 +235,7 @@ pub struct CausticMap {
     /// be recomputed (never computed, or a light moved).
     geometry_time: Option<f32>,
     _apply_layout: DescriptorSetLayout,
-    _sampler: Sampler,
+    sampler: Sampler,
 }
 
 impl CausticMap {
@@ -256,8 +250,6 @@ impl CausticMap {
         map_size: u32,
         splat_size: u32,
         paths: PhotonPaths,
-        gbuffer: &GBuffer,
-        radiance: &Image,
     ) -> VkResult<Self> {
         let photon_size = light_views.size;
         let layers = b::SHADOW_LAYERS_PER_LIGHT * (light_views.lights().len() as u32).max(1);
@@ -298,20 +290,15 @@ impl CausticMap {
                 (b::CAUSTIC_BINDING_BACK_NORMAL, BindingKind::StorageImage),
             ],
         )?;
-        let light_view = &light_views.gbuffer;
         let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_buffer(b::CAUSTIC_BINDING_PHOTONS, &photons)
-            .write_buffer(b::CAUSTIC_BINDING_VIEWS, &views)
-            .write_storage_image(
-                b::CAUSTIC_BINDING_FRONT_POSITION,
-                &light_view.front_position,
-            )
-            .write_storage_image(b::CAUSTIC_BINDING_FRONT_NORMAL, &light_view.front_normal)
-            .write_storage_image(b::CAUSTIC_BINDING_BACK_POSITION, &light_view.back_position)
-            .write_storage_image(b::CAUSTIC_BINDING_BACK_NORMAL, &light_view.back_normal);
-        let photon_pipeline = ComputePipeline::new(
+        set.write_buffer(b::CAUSTIC_BINDING_VIEWS, &views);
+        let photon_pipeline = ComputePipeline::specialized(
             ctx,
             "caustic_map/photons.comp",
+            &Specialization::new()
+                .u32(b::CAUSTIC_SPEC_PHOTON_MODE, paths.mode)
+                .u32(b::CAUSTIC_SPEC_TIR_REMEDY, paths.tir_remedy)
+                .bool(b::CAUSTIC_SPEC_EQ632, paths.use_eq632),
             &[&scene_gpu.layout, &layout],
             size_of::<PhotonViewPush>() as u32,
         )?;
@@ -335,18 +322,7 @@ impl CausticMap {
         )?;
         let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
         let apply_set = DescriptorSet::new(ctx, &apply_layout)?;
-        apply_set
-            .write_buffer(b::CAUSTIC_BINDING_VIEWS, &views)
-            .write_sampled_image(
-                b::CAUSTIC_BINDING_MAP,
-                &map,
-                &sampler,
-                vk::ImageLayout::GENERAL,
-            )
-            .write_storage_image(b::CAUSTIC_BINDING_POSITION, &gbuffer.position)
-            .write_storage_image(b::CAUSTIC_BINDING_NORMAL, &gbuffer.normal)
-            .write_storage_image(b::CAUSTIC_BINDING_ALBEDO, &gbuffer.albedo)
-            .write_storage_image(b::CAUSTIC_BINDING_RADIANCE, radiance);
+        apply_set.write_buffer(b::CAUSTIC_BINDING_VIEWS, &views);
         let apply = ComputePipeline::new(
             ctx,
             "caustic_map/apply.comp",
@@ -374,7 +350,7 @@ impl CausticMap {
             on_change: paths.on_change,
             geometry_time: None,
             _apply_layout: apply_layout,
-            _sampler: sampler,
+            sampler,
         })
     }
 
@@ -432,12 +408,7 @@ impl CausticMap {
             right: view.right,
             up: view.up,
             forward: view.forward,
-            mode: [
-                self.mode,
-                self.refraction[0],
-                self.refraction[1],
-                self.medium_steps,
-            ],
+            steps: [self.medium_steps, 0, 0, 0],
         }
     }
 
@@ -456,19 +427,15 @@ impl CausticMap {
         self.frame_views = views;
         self.geometry_time = Some(scene.geometry_time);
         let ctx = rec.ctx().clone();
-        rec.pass("caustic map clear", |cmd| {
-            barrier(
-                &ctx,
-                cmd,
-                &[ImageAccess::discard(&self.map, Access::ColorAttachment)],
-                &[],
-            );
-            let extent = self.map.extent();
-            for &view in &self.map.layer_views {
-                begin_rendering(&ctx, cmd, extent, &[(view, Some([0.0; 4]))], None);
-                end_rendering(&ctx, cmd);
-            }
-        });
+        rec.pass("caustic map clear")
+            .overwrite(&self.map, Access::ColorAttachment)
+            .record(|cmd| {
+                let extent = self.map.extent();
+                for &view in &self.map.layer_views {
+                    begin_rendering(&ctx, cmd, extent, &[(view, Some([0.0; 4]))], None);
+                    end_rendering(&ctx, cmd);
+                }
+            });
         Ok(())
     }
 
@@ -481,33 +448,53 @@ impl CausticMap {
         gbuffer: &GBuffer,
         radiance: &Image,
     ) {
-        let ctx = rec.ctx().clone();
         // apply.comp's push constants: light count, medium steps.
         let push = [self.light_count, self.medium_steps];
         let extent = radiance.extent();
-        rec.pass("caustic apply", |cmd| {
-            // The splats' attachment writes and the direct pass's radiance
-            // writes must be visible to this read-modify-write.
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(&self.map, Access::ComputeRead),
-                    ImageAccess::new(&gbuffer.position, Access::ComputeRead),
-                    ImageAccess::new(&gbuffer.normal, Access::ComputeRead),
-                    ImageAccess::new(&gbuffer.albedo, Access::ComputeRead),
-                    ImageAccess::new(radiance, Access::ComputeWrite),
-                ],
-                &[],
-            );
-            let groups = [extent.width.div_ceil(8), extent.height.div_ceil(8), 1];
-            self.apply.dispatch(
-                cmd,
-                &[&scene.set, &self.apply_set],
-                bytemuck::bytes_of(&push),
-                groups,
-            );
-        });
+        // The splats' attachment writes and the direct pass's radiance
+        // writes must be visible to this read-modify-write.
+        let set = &self.apply_set;
+        rec.pass("caustic apply")
+            .sampled(
+                set,
+                b::CAUSTIC_BINDING_MAP,
+                &self.map,
+                &self.sampler,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                b::CAUSTIC_BINDING_POSITION,
+                &gbuffer.position,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                b::CAUSTIC_BINDING_NORMAL,
+                &gbuffer.normal,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                b::CAUSTIC_BINDING_ALBEDO,
+                &gbuffer.albedo,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                b::CAUSTIC_BINDING_RADIANCE,
+                radiance,
+                Access::ComputeWrite,
+            )
+            .record(|cmd| {
+                let groups = [extent.width.div_ceil(8), extent.height.div_ceil(8), 1];
+                self.apply.dispatch(
+                    cmd,
+                    &[&scene.set, &self.apply_set],
+                    bytemuck::bytes_of(&push),
+                    groups,
+                );
+            });
     }
 }
 
@@ -530,69 +517,80 @@ impl LightViewConsumer for CausticMap {
         let ctx = rec.ctx().clone();
         let push = self.photon_push(view);
         let v = self.frame_views[l];
-        rec.pass("caustic photons", |cmd| {
-            // Write-after-read against the previous light's splat (or last frame's readers).
-            barrier(
-                &ctx,
-                cmd,
-                &[],
-                &[
-                    BufferAccess::new(&self.photons, Access::ComputeWrite),
-                    BufferAccess::new(&scene.triangles, Access::ComputeRead),
+        // Write-after-read against the previous light's splat (or last
+        // frame's readers). The light-view attachments are read as storage
+        // images (in GENERAL layout even in traced mode: the shader declares
+        // them, so they must be in the bound layout).
+        let set = &self.set;
+        let pass = rec
+            .pass("caustic photons")
+            .buffer(
+                set,
+                b::CAUSTIC_BINDING_PHOTONS,
+                &self.photons,
+                Access::ComputeWrite,
+            )
+            .read(&scene.triangles, Access::ComputeRead);
+        light_view
+            .bind_reads(
+                pass,
+                set,
+                [
+                    b::CAUSTIC_BINDING_FRONT_POSITION,
+                    b::CAUSTIC_BINDING_FRONT_NORMAL,
+                    b::CAUSTIC_BINDING_BACK_POSITION,
+                    b::CAUSTIC_BINDING_BACK_NORMAL,
                 ],
-            );
-            {
-                // The light-view attachments, read as storage images
-                // (in GENERAL layout even in traced mode: the shader
-                // declares them, so they must be in the bound layout).
-                barrier(&ctx, cmd, &light_view.compute_reads(), &[]);
-            }
-            let groups = [
-                self.photon_size.div_ceil(8),
-                self.photon_size.div_ceil(8),
-                1,
-            ];
-            self.photon_pipeline.dispatch(
-                cmd,
-                &[&scene.set, &self.set],
-                bytemuck::bytes_of(&push),
-                groups,
-            );
-        });
-        rec.pass("caustic splat", |cmd| {
-            // The photons written by compute are pulled by the vertex shader.
-            barrier(
-                &ctx,
-                cmd,
-                &[ImageAccess::new(&self.map, Access::ColorAttachment)],
-                &[BufferAccess::new(&self.photons, Access::VertexRead)],
-            );
-            let extent = self.map.extent();
-            let count = 2 * self.photon_size * self.photon_size;
-            for face in 0..v.info[1] {
-                let layer = (v.info[2] + face) as usize;
-                begin_rendering(
-                    &ctx,
-                    cmd,
-                    extent,
-                    &[(self.map.layer_views[layer], None)],
-                    None,
-                );
-                let push = SplatPush {
-                    light: l as u32,
-                    view: face,
-                    size: self.map_size,
-                    splat_size: self.splat_size,
-                };
-                self.splat_pipeline.bind(
+            )
+            .record(|cmd| {
+                let groups = [
+                    self.photon_size.div_ceil(8),
+                    self.photon_size.div_ceil(8),
+                    1,
+                ];
+                self.photon_pipeline.dispatch(
                     cmd,
                     &[&scene.set, &self.set],
                     bytemuck::bytes_of(&push),
-                    extent,
+                    groups,
                 );
-                unsafe { ctx.device.cmd_draw(cmd, count, 1, 0, 0) };
-                end_rendering(&ctx, cmd);
-            }
-        });
+            });
+        // The photons written by compute are pulled by the vertex shader.
+        rec.pass("caustic splat")
+            .write(&self.map, Access::ColorAttachment)
+            .buffer(
+                &self.set,
+                b::CAUSTIC_BINDING_PHOTONS,
+                &self.photons,
+                Access::VertexRead,
+            )
+            .record(|cmd| {
+                let extent = self.map.extent();
+                let count = 2 * self.photon_size * self.photon_size;
+                for face in 0..v.info[1] {
+                    let layer = (v.info[2] + face) as usize;
+                    begin_rendering(
+                        &ctx,
+                        cmd,
+                        extent,
+                        &[(self.map.layer_views[layer], None)],
+                        None,
+                    );
+                    let push = SplatPush {
+                        light: l as u32,
+                        view: face,
+                        size: self.map_size,
+                        splat_size: self.splat_size,
+                    };
+                    self.splat_pipeline.bind(
+                        cmd,
+                        &[&scene.set, &self.set],
+                        bytemuck::bytes_of(&push),
+                        extent,
+                    );
+                    unsafe { ctx.device.cmd_draw(cmd, count, 1, 0, 0) };
+                    end_rendering(&ctx, cmd);
+                }
+            });
     }
 }

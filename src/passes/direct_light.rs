@@ -38,9 +38,8 @@ use crate::passes::shadow::ShadowMaps;
 use crate::scene::Scene;
 use crate::shader_bindings as b;
 use crate::vk::{
-    barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline, Context,
-    DescriptorSet, DescriptorSetLayout, FrameRecorder, ImageAccess, Sampler, TargetBinding,
-    VkResult,
+    Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    DescriptorSetLayout, FrameRecorder, Sampler, VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -83,12 +82,10 @@ pub struct DirectLight {
     /// frame: the environment is fixed while the scene is on the GPU).
     sh_done: bool,
     set: DescriptorSet,
-    /// The radiance image the set's output binding points at: the frame
-    /// targets are not known at construction, so the binding is written on
-    /// the first `record` (and again if the targets change).
-    bound_radiance: TargetBinding,
-    _layout: DescriptorSetLayout,
-    _sampler: Sampler,
+    /// "environment irradiance"'s set (the SH alone).
+    sh_set: DescriptorSet,
+    _layouts: [DescriptorSetLayout; 2],
+    sampler: Sampler,
 }
 
 impl DirectLight {
@@ -129,18 +126,21 @@ impl DirectLight {
             params.shadow_map_size,
         )?;
         let gbuffer = GBuffer::new(ctx, &scene_gpu.layout, width, height, contents)?;
-        let layout = DescriptorSetLayout::new(
-            ctx,
-            &[
-                (b::DIRECT_BINDING_POSITION, BindingKind::StorageImage),
-                (b::DIRECT_BINDING_NORMAL, BindingKind::StorageImage),
-                (b::DIRECT_BINDING_ALBEDO, BindingKind::StorageImage),
-                (b::DIRECT_BINDING_RADIANCE, BindingKind::StorageImage),
-                (b::DIRECT_BINDING_SHADOW_MAP, BindingKind::Sampled),
-                (b::DIRECT_BINDING_SHADOW_LIGHTS, BindingKind::Uniform),
-                (b::DIRECT_BINDING_ENVIRONMENT_SH, BindingKind::Storage),
-            ],
-        )?;
+        let bindings = [
+            (b::DIRECT_BINDING_POSITION, BindingKind::StorageImage),
+            (b::DIRECT_BINDING_NORMAL, BindingKind::StorageImage),
+            (b::DIRECT_BINDING_ALBEDO, BindingKind::StorageImage),
+            (b::DIRECT_BINDING_RADIANCE, BindingKind::StorageImage),
+            (b::DIRECT_BINDING_SHADOW_MAP, BindingKind::Sampled),
+            (b::DIRECT_BINDING_SHADOW_LIGHTS, BindingKind::Uniform),
+            (b::DIRECT_BINDING_ENVIRONMENT_SH, BindingKind::Storage),
+        ];
+        let layout = DescriptorSetLayout::new(ctx, &bindings)?;
+        // The environment projection's own set: the lighting set's image
+        // bindings are declared by the lighting pass, which must be the
+        // first to bind it in a frame.
+        let sh_layout =
+            DescriptorSetLayout::of(ctx, &bindings, &[b::DIRECT_BINDING_ENVIRONMENT_SH])?;
         let sh = Buffer::new(
             ctx,
             "environment irradiance SH",
@@ -150,23 +150,12 @@ impl DirectLight {
         // Nearest: the shader fetches single texels and compares them itself.
         let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
         let set = DescriptorSet::new(ctx, &layout)?;
-        // The shadow maps are read in compute, where `Access::ComputeRead`
-        // puts them in GENERAL layout.
-        set.write_storage_image(b::DIRECT_BINDING_POSITION, &gbuffer.position)
-            .write_storage_image(b::DIRECT_BINDING_NORMAL, &gbuffer.normal)
-            .write_storage_image(b::DIRECT_BINDING_ALBEDO, &gbuffer.albedo)
-            .write_sampled_image(
-                b::DIRECT_BINDING_SHADOW_MAP,
-                &shadows.map,
-                &sampler,
-                vk::ImageLayout::GENERAL,
-            )
-            .write_buffer(b::DIRECT_BINDING_SHADOW_LIGHTS, &shadows.lights)
-            .write_buffer(b::DIRECT_BINDING_ENVIRONMENT_SH, &sh);
+        set.write_buffer(b::DIRECT_BINDING_SHADOW_LIGHTS, &shadows.lights);
+        let sh_set = DescriptorSet::new(ctx, &sh_layout)?;
         let environment_sh = ComputePipeline::new(
             ctx,
             "direct/environment_sh.comp",
-            &[&scene_gpu.layout, &layout],
+            &[&scene_gpu.layout, &sh_layout],
             0,
         )?;
         let lighting = ComputePipeline::new(
@@ -186,9 +175,9 @@ impl DirectLight {
             sh,
             sh_done: false,
             set,
-            bound_radiance: TargetBinding::new(b::DIRECT_BINDING_RADIANCE),
-            _layout: layout,
-            _sampler: sampler,
+            sh_set,
+            _layouts: [layout, sh_layout],
+            sampler,
         })
     }
 
@@ -205,53 +194,57 @@ impl DirectLight {
         scene: &SceneGpu,
         targets: &FrameTargets,
     ) -> VkResult<()> {
-        self.bound_radiance.bind(rec, &self.set, &targets.radiance);
         self.shadows.record(rec, scene)?;
         self.gbuffer.record(rec, scene);
-        let ctx = rec.ctx().clone();
         let push = LightingPush {
             light_count: self.light_count,
             pcf_radius: self.pcf_radius,
             medium_steps: self.medium_steps,
         };
         if !self.sh_done {
-            rec.pass("environment irradiance", |cmd| {
-                barrier(
-                    &ctx,
-                    cmd,
-                    &[],
-                    &[BufferAccess::new(&self.sh, Access::ComputeWrite)],
-                );
-                self.environment_sh
-                    .dispatch(cmd, &[&scene.set, &self.set], &[], [1, 1, 1]);
-            });
+            let set = &self.sh_set;
+            rec.pass("environment irradiance")
+                .buffer(
+                    set,
+                    b::DIRECT_BINDING_ENVIRONMENT_SH,
+                    &self.sh,
+                    Access::ComputeWrite,
+                )
+                .record(|cmd| {
+                    self.environment_sh
+                        .dispatch(cmd, &[&scene.set, set], &[], [1, 1, 1])
+                });
             self.sh_done = true;
         }
-        rec.pass("direct lighting", |cmd| {
-            // The G-buffer's and shadow maps' attachment writes must be
-            // visible to the compute reads (and move to GENERAL); the
-            // radiance image is overwritten entirely, after waiting for last
-            // frame's readers (tonemap, readback).
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(&self.gbuffer.position, Access::ComputeRead),
-                    ImageAccess::new(&self.gbuffer.normal, Access::ComputeRead),
-                    ImageAccess::new(&self.gbuffer.albedo, Access::ComputeRead),
-                    ImageAccess::new(&self.shadows.map, Access::ComputeRead),
-                    ImageAccess::discard(&targets.radiance, Access::ComputeWrite),
-                ],
-                &[BufferAccess::new(&self.sh, Access::ComputeRead)],
-            );
-            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
-            self.lighting.dispatch(
-                cmd,
-                &[&scene.set, &self.set],
-                bytemuck::bytes_of(&push),
-                groups,
-            );
-        });
+        // The G-buffer's and shadow maps' attachment writes must be
+        // visible to the compute reads (and move to GENERAL); the
+        // radiance image is overwritten entirely, after waiting for last
+        // frame's readers (tonemap, readback).
+        let set = &self.set;
+        let r = Access::ComputeRead;
+        rec.pass("direct lighting")
+            .storage_image(set, b::DIRECT_BINDING_POSITION, &self.gbuffer.position, r)
+            .storage_image(set, b::DIRECT_BINDING_NORMAL, &self.gbuffer.normal, r)
+            .storage_image(set, b::DIRECT_BINDING_ALBEDO, &self.gbuffer.albedo, r)
+            .sampled(
+                set,
+                b::DIRECT_BINDING_SHADOW_MAP,
+                &self.shadows.map,
+                &self.sampler,
+                r,
+            )
+            .buffer(set, b::DIRECT_BINDING_ENVIRONMENT_SH, &self.sh, r)
+            .overwrite_storage_image(
+                set,
+                b::DIRECT_BINDING_RADIANCE,
+                &targets.radiance,
+                Access::ComputeWrite,
+            )
+            .record(|cmd| {
+                let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
+                self.lighting
+                    .dispatch(cmd, &[&scene.set, set], bytemuck::bytes_of(&push), groups);
+            });
         Ok(())
     }
 

@@ -19,8 +19,8 @@
 
 use crate::frame::SceneGpu;
 use crate::vk::{
-    barrier, begin_rendering, end_rendering, Access, BufferAccess, Context, DescriptorSetLayout,
-    FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageAccess, ImageDesc, VkResult,
+    begin_rendering, end_rendering, Access, Context, DescriptorSetLayout, FrameRecorder,
+    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, VkResult,
 };
 use ash::vk;
 use std::sync::Arc;
@@ -113,44 +113,41 @@ impl GBuffer {
     /// `ColorAttachment`/`DepthAttachment`; readers declare theirs with `barrier`.
     pub fn record(&self, rec: &mut FrameRecorder, scene: &SceneGpu) {
         let ctx = rec.ctx().clone();
-        rec.pass("gbuffer", |cmd| {
-            // Every target is cleared and redrawn, so earlier contents are
-            // discarded; the barrier still waits for last frame's readers
-            // (write-after-read). The triangle buffer is read by the vertex
-            // shader: any earlier write to it (upload, refit) must be visible.
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::discard(&self.position, Access::ColorAttachment),
-                    ImageAccess::discard(&self.normal, Access::ColorAttachment),
-                    ImageAccess::discard(&self.albedo, Access::ColorAttachment),
-                    ImageAccess::discard(&self.depth, Access::DepthAttachment),
-                ],
-                &[
-                    BufferAccess::new(&scene.triangles, Access::VertexRead),
-                    BufferAccess::new(&scene.triangle_uvs, Access::VertexRead),
-                ],
-            );
-            let extent = self.extent();
-            begin_rendering(
-                &ctx,
-                cmd,
-                extent,
-                &[
-                    (self.position.view, Some([0.0; 4])),
-                    (self.normal.view, Some([0.0; 4])),
-                    (self.albedo.view, Some([0.0; 4])),
-                ],
-                Some(self.depth.view),
-            );
-            if scene.triangle_count > 0 {
-                let opaque_only = u32::from(self.contents == GBufferContents::Opaque);
-                self.pipeline
-                    .bind(cmd, &[&scene.set], bytemuck::bytes_of(&opaque_only), extent);
-                unsafe { ctx.device.cmd_draw(cmd, 3 * scene.triangle_count, 1, 0, 0) };
-            }
-            end_rendering(&ctx, cmd);
-        });
+        // Every target is cleared and redrawn, so earlier contents are
+        // discarded; the barrier still waits for last frame's readers
+        // (write-after-read). The triangle buffer is read by the vertex
+        // shader: any earlier write to it (upload, refit) must be visible.
+        rec.pass("gbuffer")
+            .overwrite(&self.position, Access::ColorAttachment)
+            .overwrite(&self.normal, Access::ColorAttachment)
+            .overwrite(&self.albedo, Access::ColorAttachment)
+            .overwrite(&self.depth, Access::DepthAttachment)
+            .read(&scene.triangles, Access::VertexRead)
+            .read(&scene.triangle_uvs, Access::VertexRead)
+            .record(|cmd| {
+                let extent = self.extent();
+                begin_rendering(
+                    &ctx,
+                    cmd,
+                    extent,
+                    &[
+                        (self.position.view, Some([0.0; 4])),
+                        (self.normal.view, Some([0.0; 4])),
+                        (self.albedo.view, Some([0.0; 4])),
+                    ],
+                    Some(self.depth.view),
+                );
+                if scene.triangle_count > 0 {
+                    let opaque_only = u32::from(self.contents == GBufferContents::Opaque);
+                    self.pipeline.bind(
+                        cmd,
+                        &[&scene.set],
+                        bytemuck::bytes_of(&opaque_only),
+                        extent,
+                    );
+                    unsafe { ctx.device.cmd_draw(cmd, 3 * scene.triangle_count, 1, 0, 0) };
+                }
+                end_rendering(&ctx, cmd);
+            });
     }
 }

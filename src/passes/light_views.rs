@@ -224,7 +224,6 @@ impl LightViews {
         consumers: &mut [&mut dyn LightViewConsumer],
     ) {
         let draw = consumers.iter().any(|c| c.reads_gbuffer());
-        let ctx = rec.ctx().clone();
         for l in 0..self.lights.len() {
             let Some(view) = self.view(l) else {
                 if self.specular.is_some() {
@@ -236,11 +235,9 @@ impl LightViews {
             };
             if draw {
                 let viewpoint = view.viewpoint(self.specular.unwrap_or_default());
-                rec.pass("light view", |cmd| {
-                    // Overwritten entirely; the barriers inside wait for the
-                    // previous light's readers.
-                    self.gbuffer.draw(&ctx, cmd, scene, &viewpoint);
-                });
+                // Overwritten entirely; the barriers wait for the previous
+                // light's readers.
+                self.gbuffer.record(rec, "light view", scene, &viewpoint);
             }
             for c in consumers.iter_mut() {
                 c.record_light(rec, scene, l, &view, &self.gbuffer);

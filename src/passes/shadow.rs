@@ -23,9 +23,9 @@ use crate::frame::SceneGpu;
 use crate::scene::{Light, LightKind};
 use crate::shader_bindings as b;
 use crate::vk::{
-    barrier, begin_rendering, end_rendering, Access, Buffer, BufferAccess, BufferUsage, Context,
-    DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageAccess,
-    ImageDesc, VkResult,
+    begin_rendering, end_rendering, step, Access, Buffer, BufferUsage, Context,
+    DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
+    VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -276,51 +276,49 @@ impl ShadowMaps {
         // Through the frame's upload ring: earlier frames may still read the buffer.
         rec.upload(&self.lights, bytemuck::cast_slice(&views));
         let ctx = rec.ctx().clone();
-        rec.pass("shadow maps", |cmd| {
-            // Every used layer is cleared and redrawn: discard the contents,
-            // but wait for last frame's readers (write-after-read). The
-            // triangle buffer is pulled by the vertex shader.
-            barrier(
-                &ctx,
-                cmd,
-                &[ImageAccess::discard(&self.map, Access::ColorAttachment)],
-                &[BufferAccess::new(&scene.triangles, Access::VertexRead)],
-            );
-            let extent = self.map.extent();
-            for v in &views {
-                let mode = f32::from_bits(v.info[0]);
-                for face in 0..v.info[1] {
-                    // One depth image serves every view: each view's clear
-                    // and tests must wait for the previous view's depth
-                    // writes (write-after-write), which this barrier orders.
-                    barrier(
-                        &ctx,
-                        cmd,
-                        &[ImageAccess::discard(&self.depth, Access::DepthAttachment)],
-                        &[],
-                    );
-                    let layer = (v.info[2] + face) as usize;
-                    begin_rendering(
-                        &ctx,
-                        cmd,
-                        extent,
-                        &[(self.map.layer_views[layer], Some([SHADOW_CLEAR; 4]))],
-                        Some(self.depth.view),
-                    );
-                    if scene.triangle_count > 0 {
-                        let push = ShadowPush {
-                            view_proj: v.view_proj[face as usize],
-                            origin: [v.origin[0], v.origin[1], v.origin[2], mode],
-                            direction: v.direction,
-                        };
-                        self.pipeline
-                            .bind(cmd, &[&scene.set], bytemuck::bytes_of(&push), extent);
-                        unsafe { ctx.device.cmd_draw(cmd, 3 * scene.triangle_count, 1, 0, 0) };
+        // Every used layer is cleared and redrawn: discard the contents,
+        // but wait for last frame's readers (write-after-read). The
+        // triangle buffer is pulled by the vertex shader.
+        rec.pass("shadow maps")
+            .overwrite(&self.map, Access::ColorAttachment)
+            .read(&scene.triangles, Access::VertexRead)
+            .record(|cmd| {
+                let extent = self.map.extent();
+                for v in &views {
+                    let mode = f32::from_bits(v.info[0]);
+                    for face in 0..v.info[1] {
+                        // One depth image serves every view: each view's clear
+                        // and tests must wait for the previous view's depth
+                        // writes (write-after-write), which this barrier orders.
+                        step(&ctx, cmd)
+                            .overwrite(&self.depth, Access::DepthAttachment)
+                            .emit();
+                        let layer = (v.info[2] + face) as usize;
+                        begin_rendering(
+                            &ctx,
+                            cmd,
+                            extent,
+                            &[(self.map.layer_views[layer], Some([SHADOW_CLEAR; 4]))],
+                            Some(self.depth.view),
+                        );
+                        if scene.triangle_count > 0 {
+                            let push = ShadowPush {
+                                view_proj: v.view_proj[face as usize],
+                                origin: [v.origin[0], v.origin[1], v.origin[2], mode],
+                                direction: v.direction,
+                            };
+                            self.pipeline.bind(
+                                cmd,
+                                &[&scene.set],
+                                bytemuck::bytes_of(&push),
+                                extent,
+                            );
+                            unsafe { ctx.device.cmd_draw(cmd, 3 * scene.triangle_count, 1, 0, 0) };
+                        }
+                        end_rendering(&ctx, cmd);
                     }
-                    end_rendering(&ctx, cmd);
                 }
-            }
-        });
+            });
         Ok(())
     }
 }

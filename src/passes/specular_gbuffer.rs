@@ -20,8 +20,8 @@
 use crate::frame::SceneGpu;
 use crate::shader_bindings as b;
 use crate::vk::{
-    barrier, begin_rendering, end_rendering, Access, BufferAccess, Context, DescriptorSetLayout,
-    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageAccess, ImageDesc, VkResult,
+    begin_rendering, end_rendering, step, Access, Context, DescriptorSet, DescriptorSetLayout,
+    FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, Pass, VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -124,10 +124,22 @@ impl SpecularGBuffer {
         })
     }
 
-    /// Records the front and back passes into `cmd` (inside the caller's
-    /// `rec.pass`). Every target is overwritten; the barriers wait for the
-    /// previous readers (write-after-read) and for writes to the triangles.
-    pub fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer, scene: &SceneGpu, view: &Viewpoint) {
+    /// Records the pass `name`: the front and back draws. Every target is
+    /// overwritten; the barriers wait for the previous readers
+    /// (write-after-read) and for writes to the triangles.
+    pub fn record(&self, rec: &mut FrameRecorder, name: &str, scene: &SceneGpu, view: &Viewpoint) {
+        let ctx = rec.ctx().clone();
+        rec.pass(name)
+            .overwrite(&self.front_position, Access::ColorAttachment)
+            .overwrite(&self.front_normal, Access::ColorAttachment)
+            .overwrite(&self.back_position, Access::ColorAttachment)
+            .overwrite(&self.back_normal, Access::ColorAttachment)
+            .overwrite(&self.depth, Access::DepthAttachment)
+            .read(&scene.triangles, Access::VertexRead)
+            .record(|cmd| self.draw(&ctx, cmd, scene, view));
+    }
+
+    fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer, scene: &SceneGpu, view: &Viewpoint) {
         let extent = self.front_position.extent();
         let (view_proj, origin, forward, kind) = match *view {
             Viewpoint::Camera => (
@@ -164,17 +176,12 @@ impl SpecularGBuffer {
                 &self.back_normal,
             ),
         ] {
-            // The depth image is shared by both passes (write-after-write).
-            barrier(
-                ctx,
-                cmd,
-                &[
-                    ImageAccess::discard(position, Access::ColorAttachment),
-                    ImageAccess::discard(normal, Access::ColorAttachment),
-                    ImageAccess::discard(&self.depth, Access::DepthAttachment),
-                ],
-                &[BufferAccess::new(&scene.triangles, Access::VertexRead)],
-            );
+            if pass == b::SPECULAR_GBUFFER_BACK {
+                // The depth image is shared by both draws (write-after-write).
+                step(ctx, cmd)
+                    .overwrite(&self.depth, Access::DepthAttachment)
+                    .emit();
+            }
             begin_rendering(
                 ctx,
                 cmd,
@@ -199,13 +206,18 @@ impl SpecularGBuffer {
         }
     }
 
-    /// Declares the compute reads of all four targets (storage images, GENERAL).
-    pub fn compute_reads(&self) -> [ImageAccess<'_>; 4] {
-        [
-            ImageAccess::new(&self.front_position, Access::ComputeRead),
-            ImageAccess::new(&self.front_normal, Access::ComputeRead),
-            ImageAccess::new(&self.back_position, Access::ComputeRead),
-            ImageAccess::new(&self.back_normal, Access::ComputeRead),
-        ]
+    /// Declares the compute reads of all four targets by `pass` through
+    /// `set`'s storage-image `bindings` (front position, front normal, back
+    /// position, back normal).
+    pub fn bind_reads<'r, 'f, 'a>(
+        &'a self,
+        pass: Pass<'r, 'f, 'a>,
+        set: &'a DescriptorSet,
+        bindings: [u32; 4],
+    ) -> Pass<'r, 'f, 'a> {
+        pass.storage_image(set, bindings[0], &self.front_position, Access::ComputeRead)
+            .storage_image(set, bindings[1], &self.front_normal, Access::ComputeRead)
+            .storage_image(set, bindings[2], &self.back_position, Access::ComputeRead)
+            .storage_image(set, bindings[3], &self.back_normal, Access::ComputeRead)
     }
 }

@@ -60,13 +60,8 @@ impl SurfaceFrame {
             GBufferContents::Opaque,
         )?;
         let opaque = FrameTargets::new(ctx, width, height)?;
-        let refraction = CameraRefraction::new(
-            ctx,
-            scene_gpu,
-            &opaque.radiance,
-            &direct.gbuffer,
-            refraction,
-        )?;
+        let refraction =
+            CameraRefraction::new(ctx, scene_gpu, opaque.radiance.extent(), refraction)?;
         Ok(Self {
             direct,
             opaque,

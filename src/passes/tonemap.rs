@@ -1,8 +1,8 @@
 //! Tonemap: the frame's linear radiance to 8-bit sRGB for PNG and display.
 
 use crate::vk::{
-    barrier, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
-    FrameRecorder, Image, ImageAccess, ImageDesc, VkResult,
+    Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    FrameRecorder, Image, ImageDesc, VkResult,
 };
 use ash::vk;
 use std::sync::Arc;
@@ -35,8 +35,6 @@ impl Tonemap {
             ),
         )?;
         let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_storage_image(0, radiance)
-            .write_storage_image(1, &display);
         Ok(Self {
             pipeline,
             _layout: layout,
@@ -46,24 +44,17 @@ impl Tonemap {
     }
 
     pub fn record(&self, rec: &mut FrameRecorder, radiance: &Image, exposure: f32) {
-        let ctx = rec.ctx().clone();
-        rec.pass("tonemap", |cmd| {
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(radiance, Access::ComputeRead),
-                    ImageAccess::discard(&self.display, Access::ComputeWrite),
-                ],
-                &[],
-            );
-            let groups = [
-                radiance.desc.width.div_ceil(8),
-                radiance.desc.height.div_ceil(8),
-                1,
-            ];
-            self.pipeline
-                .dispatch(cmd, &[&self.set], bytemuck::bytes_of(&exposure), groups);
-        });
+        rec.pass("tonemap")
+            .storage_image(&self.set, 0, radiance, Access::ComputeRead)
+            .overwrite_storage_image(&self.set, 1, &self.display, Access::ComputeWrite)
+            .record(|cmd| {
+                let groups = [
+                    radiance.desc.width.div_ceil(8),
+                    radiance.desc.height.div_ceil(8),
+                    1,
+                ];
+                self.pipeline
+                    .dispatch(cmd, &[&self.set], bytemuck::bytes_of(&exposure), groups);
+            });
     }
 }

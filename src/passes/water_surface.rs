@@ -11,8 +11,8 @@ use crate::gpu::{GpuWaterVertex, GpuWave};
 use crate::scene::Water;
 use crate::shader_bindings as b;
 use crate::vk::{
-    barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline, Context,
-    DescriptorSet, DescriptorSetLayout, FrameRecorder, VkResult,
+    Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    DescriptorSetLayout, FrameRecorder, VkResult,
 };
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
@@ -98,20 +98,15 @@ impl WaterSurface {
 
     /// Records the evaluation of the surface at `time` seconds into `vertices`.
     pub fn record(&self, rec: &mut FrameRecorder, time: f32) {
-        let ctx = rec.ctx().clone();
         let mut push = self.push;
         push.time_base_height[0] = time;
-        rec.pass("water surface", |cmd| {
-            // Every vertex is rewritten: the previous contents (and readers of
-            // them, e.g. last frame's raster) only need to be ordered before.
-            barrier(
-                &ctx,
-                cmd,
-                &[],
-                &[BufferAccess::new(&self.vertices, Access::ComputeWrite)],
-            );
-            self.pipeline
-                .dispatch(cmd, &[&self.set], bytemuck::bytes_of(&push), self.groups);
-        });
+        // Every vertex is rewritten: the previous contents (and readers of
+        // them, e.g. last frame's raster) only need to be ordered before.
+        rec.pass("water surface")
+            .write(&self.vertices, Access::ComputeWrite)
+            .record(|cmd| {
+                self.pipeline
+                    .dispatch(cmd, &[&self.set], bytemuck::bytes_of(&push), self.groups);
+            });
     }
 }

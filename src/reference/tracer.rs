@@ -7,8 +7,8 @@ use crate::frame::{FrameTargets, SceneGpu};
 use crate::radiometry::Component;
 use crate::shader_bindings as b;
 use crate::vk::{
-    barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline, Context,
-    DescriptorSet, DescriptorSetLayout, FrameRecorder, ImageAccess, VkResult,
+    step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    DescriptorSetLayout, FrameRecorder, VkResult,
 };
 use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
@@ -53,6 +53,10 @@ pub struct Reference {
     resolve: ComputePipeline,
     _layout: DescriptorSetLayout,
     set: DescriptorSet,
+    /// The resolve's own set: the same buffers plus the frame's radiance
+    /// image, which its pass declares (the main set is bound by every
+    /// other pass of the frame before it).
+    resolve_set: DescriptorSet,
     total: Buffer,
     pass_sums: Buffer,
     moments: Buffer,
@@ -163,6 +167,7 @@ impl Reference {
             volume_next: buffer("reference volume links", volume_capacity as u64 * 4)?,
             stats: buffer("reference counters", 16)?,
             set: DescriptorSet::new(ctx, &layout)?,
+            resolve_set: DescriptorSet::new(ctx, &layout)?,
             _layout: layout,
             settings,
             surface_table,
@@ -179,25 +184,24 @@ impl Reference {
             width: targets.width,
             height: targets.height,
         };
-        reference
-            .set
-            .write_buffer(b::REFERENCE_BINDING_TOTAL, &reference.total)
-            .write_buffer(b::REFERENCE_BINDING_PASS, &reference.pass_sums)
-            .write_storage_image(b::REFERENCE_BINDING_RADIANCE, &targets.radiance)
-            .write_buffer(b::REFERENCE_BINDING_MOMENTS, &reference.moments)
-            .write_buffer(
-                b::REFERENCE_BINDING_VISIBLE_POINTS,
-                &reference.visible_points,
-            )
-            .write_buffer(b::REFERENCE_BINDING_SURFACE_HEADS, &reference.surface_heads)
-            .write_buffer(b::REFERENCE_BINDING_SURFACE_NEXT, &reference.surface_next)
-            .write_buffer(
-                b::REFERENCE_BINDING_VOLUME_PHOTONS,
-                &reference.volume_photons,
-            )
-            .write_buffer(b::REFERENCE_BINDING_VOLUME_HEADS, &reference.volume_heads)
-            .write_buffer(b::REFERENCE_BINDING_VOLUME_NEXT, &reference.volume_next)
-            .write_buffer(b::REFERENCE_BINDING_STATS, &reference.stats);
+        for set in [&reference.set, &reference.resolve_set] {
+            set.write_buffer(b::REFERENCE_BINDING_TOTAL, &reference.total)
+                .write_buffer(b::REFERENCE_BINDING_PASS, &reference.pass_sums)
+                .write_buffer(b::REFERENCE_BINDING_MOMENTS, &reference.moments)
+                .write_buffer(
+                    b::REFERENCE_BINDING_VISIBLE_POINTS,
+                    &reference.visible_points,
+                )
+                .write_buffer(b::REFERENCE_BINDING_SURFACE_HEADS, &reference.surface_heads)
+                .write_buffer(b::REFERENCE_BINDING_SURFACE_NEXT, &reference.surface_next)
+                .write_buffer(
+                    b::REFERENCE_BINDING_VOLUME_PHOTONS,
+                    &reference.volume_photons,
+                )
+                .write_buffer(b::REFERENCE_BINDING_VOLUME_HEADS, &reference.volume_heads)
+                .write_buffer(b::REFERENCE_BINDING_VOLUME_NEXT, &reference.volume_next)
+                .write_buffer(b::REFERENCE_BINDING_STATS, &reference.stats);
+        }
         Ok(reference)
     }
 
@@ -229,7 +233,7 @@ impl Reference {
     pub fn record_clear(&mut self, rec: &mut FrameRecorder) {
         let ctx = rec.ctx().clone();
         let cleared = [&self.total, &self.pass_sums, &self.moments];
-        rec.pass("reference clear", |cmd| {
+        rec.pass("reference clear").record(|cmd| {
             fill(&ctx, cmd, &cleared, 0);
         });
         self.photons = 0;
@@ -251,74 +255,52 @@ impl Reference {
         let push = bytemuck::bytes_of(&push);
         let sets = [&scene_gpu.set, &self.set];
         let pixel_groups = [self.width.div_ceil(8), self.height.div_ceil(8), 1];
-        rec.pass("reference visible points", |cmd| {
+        rec.pass("reference visible points").record(|cmd| {
             fill(&ctx, cmd, &[&self.surface_heads], b::REFERENCE_GRID_NONE);
-            barrier(
-                &ctx,
-                cmd,
-                &[],
-                &[
-                    BufferAccess::new(&self.pass_sums, Access::ComputeWrite),
-                    BufferAccess::new(&self.visible_points, Access::ComputeWrite),
-                    BufferAccess::new(&self.surface_heads, Access::ComputeWrite),
-                    BufferAccess::new(&self.surface_next, Access::ComputeWrite),
-                ],
-            );
+            step(&ctx, cmd)
+                .write(&self.pass_sums, Access::ComputeWrite)
+                .write(&self.visible_points, Access::ComputeWrite)
+                .write(&self.surface_heads, Access::ComputeWrite)
+                .write(&self.surface_next, Access::ComputeWrite)
+                .emit();
             self.camera.dispatch(cmd, &sets, push, pixel_groups);
         });
-        rec.pass("reference photons", |cmd| {
+        rec.pass("reference photons").record(|cmd| {
             fill(&ctx, cmd, &[&self.volume_heads], b::REFERENCE_GRID_NONE);
             fill(&ctx, cmd, &[&self.stats], 0);
-            barrier(
-                &ctx,
-                cmd,
-                &[],
-                &[
-                    BufferAccess::new(&self.pass_sums, Access::ComputeWrite),
-                    BufferAccess::new(&self.visible_points, Access::ComputeRead),
-                    BufferAccess::new(&self.surface_heads, Access::ComputeRead),
-                    BufferAccess::new(&self.surface_next, Access::ComputeRead),
-                    BufferAccess::new(&self.volume_photons, Access::ComputeWrite),
-                    BufferAccess::new(&self.volume_heads, Access::ComputeWrite),
-                    BufferAccess::new(&self.volume_next, Access::ComputeWrite),
-                    BufferAccess::new(&self.stats, Access::ComputeWrite),
-                ],
-            );
+            step(&ctx, cmd)
+                .write(&self.pass_sums, Access::ComputeWrite)
+                .read(&self.visible_points, Access::ComputeRead)
+                .read(&self.surface_heads, Access::ComputeRead)
+                .read(&self.surface_next, Access::ComputeRead)
+                .write(&self.volume_photons, Access::ComputeWrite)
+                .write(&self.volume_heads, Access::ComputeWrite)
+                .write(&self.volume_next, Access::ComputeWrite)
+                .write(&self.stats, Access::ComputeWrite)
+                .emit();
             self.trace
                 .dispatch(cmd, &sets, push, [self.settings.batch.div_ceil(64), 1, 1]);
         });
         if self.volume_capacity > 0 {
-            rec.pass("reference volume gather", |cmd| {
-                barrier(
-                    &ctx,
-                    cmd,
-                    &[],
-                    &[
-                        BufferAccess::new(&self.pass_sums, Access::ComputeWrite),
-                        BufferAccess::new(&self.volume_photons, Access::ComputeRead),
-                        BufferAccess::new(&self.volume_heads, Access::ComputeRead),
-                        BufferAccess::new(&self.volume_next, Access::ComputeRead),
-                        BufferAccess::new(&self.stats, Access::ComputeRead),
-                    ],
-                );
-                self.camera_volume.dispatch(cmd, &sets, push, pixel_groups);
-            });
+            rec.pass("reference volume gather")
+                .write(&self.pass_sums, Access::ComputeWrite)
+                .read(&self.volume_photons, Access::ComputeRead)
+                .read(&self.volume_heads, Access::ComputeRead)
+                .read(&self.volume_next, Access::ComputeRead)
+                .read(&self.stats, Access::ComputeRead)
+                .record(|cmd| {
+                    self.camera_volume.dispatch(cmd, &sets, push, pixel_groups);
+                });
         }
-        rec.pass("reference fold", |cmd| {
-            barrier(
-                &ctx,
-                cmd,
-                &[],
-                &[
-                    BufferAccess::new(&self.pass_sums, Access::ComputeWrite),
-                    BufferAccess::new(&self.total, Access::ComputeWrite),
-                    BufferAccess::new(&self.moments, Access::ComputeWrite),
-                ],
-            );
-            let pixels = self.width * self.height;
-            self.fold
-                .dispatch(cmd, &sets, push, [pixels.div_ceil(64), 1, 1]);
-        });
+        rec.pass("reference fold")
+            .write(&self.pass_sums, Access::ComputeWrite)
+            .write(&self.total, Access::ComputeWrite)
+            .write(&self.moments, Access::ComputeWrite)
+            .record(|cmd| {
+                let pixels = self.width * self.height;
+                self.fold
+                    .dispatch(cmd, &sets, push, [pixels.div_ceil(64), 1, 1]);
+            });
         let report = PassReport {
             radius: self.radius,
             volume_radius: self.volume_radius,
@@ -337,17 +319,12 @@ impl Reference {
         let ctx = rec.ctx().clone();
         let push = self.push(0, Component::All);
         let sets = [&scene_gpu.set, &self.set];
-        rec.pass("reference noise", |cmd| {
+        rec.pass("reference noise").record(|cmd| {
             fill(&ctx, cmd, &[&self.stats], 0);
-            barrier(
-                &ctx,
-                cmd,
-                &[],
-                &[
-                    BufferAccess::new(&self.moments, Access::ComputeRead),
-                    BufferAccess::new(&self.stats, Access::ComputeWrite),
-                ],
-            );
+            step(&ctx, cmd)
+                .read(&self.moments, Access::ComputeRead)
+                .write(&self.stats, Access::ComputeWrite)
+                .emit();
             let pixels = self.width * self.height;
             self.noise.dispatch(
                 cmd,
@@ -366,26 +343,24 @@ impl Reference {
         targets: &FrameTargets,
         component: Component,
     ) {
-        let ctx = rec.ctx().clone();
         let push = self.push(0, component);
-        let sets = [&scene_gpu.set, &self.set];
-        rec.pass("reference resolve", |cmd| {
-            barrier(
-                &ctx,
-                cmd,
-                &[ImageAccess::discard(
-                    &targets.radiance,
-                    Access::ComputeWrite,
-                )],
-                &[BufferAccess::new(&self.total, Access::ComputeRead)],
-            );
-            self.resolve.dispatch(
-                cmd,
-                &sets,
-                bytemuck::bytes_of(&push),
-                [self.width.div_ceil(8), self.height.div_ceil(8), 1],
-            );
-        });
+        let sets = [&scene_gpu.set, &self.resolve_set];
+        rec.pass("reference resolve")
+            .overwrite_storage_image(
+                &self.resolve_set,
+                b::REFERENCE_BINDING_RADIANCE,
+                &targets.radiance,
+                Access::ComputeWrite,
+            )
+            .read(&self.total, Access::ComputeRead)
+            .record(|cmd| {
+                self.resolve.dispatch(
+                    cmd,
+                    &sets,
+                    bytemuck::bytes_of(&push),
+                    [self.width.div_ceil(8), self.height.div_ceil(8), 1],
+                );
+            });
     }
 
     /// The counters the last pass (or noise reduction) left: volume photons
@@ -408,11 +383,11 @@ impl Reference {
 
 /// Fills whole buffers with `value` before a compute pass writes them.
 fn fill(ctx: &Context, cmd: ash::vk::CommandBuffer, buffers: &[&Buffer], value: u32) {
-    let accesses: Vec<_> = buffers
-        .iter()
-        .map(|b| BufferAccess::new(b, Access::TransferWrite))
-        .collect();
-    barrier(ctx, cmd, &[], &accesses);
+    let mut fills = step(ctx, cmd);
+    for b in buffers {
+        fills = fills.write(*b, Access::TransferWrite);
+    }
+    fills.emit();
     for b in buffers {
         // SAFETY: the buffer is alive and its barrier above orders the fill.
         unsafe {

@@ -67,6 +67,13 @@ pub struct Context {
     command_pool: vk::CommandPool,
     /// Pipelines shared across rebuilds, and the driver's pipeline cache.
     pipelines: PipelineStore,
+    /// The serial of the frame being recorded (`Frames::begin_frame` counts
+    /// it up); descriptor sets bound into a command buffer remember it.
+    pub(super) frame_serial: std::sync::atomic::AtomicU64,
+    /// Frames submitted through a `Frames` and not yet seen complete: a
+    /// host write straight into a buffer the GPU may read is refused while
+    /// any is (`Buffer::upload`).
+    pub(super) frames_pending: std::sync::atomic::AtomicUsize,
     destroyed: bool,
 }
 
@@ -396,6 +403,8 @@ impl Context {
             counters,
             command_pool,
             pipelines,
+            frame_serial: std::sync::atomic::AtomicU64::new(0),
+            frames_pending: std::sync::atomic::AtomicUsize::new(0),
             destroyed: false,
         }))
     }

@@ -29,12 +29,14 @@
 //! (submit to observed completion), frames still overlap, and per-pass numbers
 //! come only on request (`per_pass`): one submission per pass, each waited for.
 
+use super::pass::Pass;
 use super::ring::Ring;
 use super::sync::ResourceState;
 use super::{Access, Buffer, Context, VkError, VkResult};
 use ash::vk;
 use std::any::Any;
 use std::collections::VecDeque;
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -272,7 +274,12 @@ impl Frames {
                     .cmd_reset_query_pool(slot.cmd, slot.queries, 0, self.max_passes * 2);
             }
         }
+        let serial = ctx
+            .frame_serial
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+            + 1;
         let recorder = FrameRecorder {
+            serial,
             frames: self,
             slot: index,
             names: Vec::new(),
@@ -291,6 +298,7 @@ impl Frames {
             ctx.device.wait_for_fences(&[slot.fence], true, u64::MAX)?;
             ctx.device.reset_fences(&[slot.fence])?;
         }
+        ctx.frames_pending.fetch_sub(1, Ordering::Relaxed);
         let waited = start.elapsed();
         self.host_wait += waited;
         let done = Instant::now();
@@ -385,12 +393,13 @@ pub struct FrameSync {
 pub struct FrameRecorder<'a> {
     frames: &'a mut Frames,
     slot: usize,
+    serial: u64,
     names: Vec<String>,
     wall_ms: Vec<f64>,
     error: Option<VkError>,
 }
 
-impl FrameRecorder<'_> {
+impl<'a> FrameRecorder<'a> {
     pub fn ctx(&self) -> &Arc<Context> {
         &self.frames.ctx
     }
@@ -415,8 +424,21 @@ impl FrameRecorder<'_> {
         self.frames.source == TimingSource::WallClock
     }
 
-    /// Records one named pass. Every pass of every technique goes through here.
-    pub fn pass(&mut self, name: &str, record: impl FnOnce(vk::CommandBuffer)) {
+    /// Starts declaring one named pass (`vk/pass.rs`): what it reads, writes
+    /// and binds; its `record` emits the barriers, writes the bindings and
+    /// records it. Every pass of every technique goes through here.
+    pub fn pass<'r, 'res>(&'r mut self, name: &str) -> Pass<'r, 'a, 'res> {
+        Pass::new(self, name)
+    }
+
+    /// The frame's serial number (the context's count of frames begun).
+    pub(super) fn serial(&self) -> u64 {
+        self.serial
+    }
+
+    /// Records one named pass (its barrier is the first command `record`
+    /// records).
+    pub(super) fn record_pass(&mut self, name: &str, record: impl FnOnce(vk::CommandBuffer)) {
         if self.error.is_some() {
             return;
         }
@@ -603,6 +625,7 @@ impl FrameRecorder<'_> {
             .signal_semaphore_infos(&signals);
         let start = Instant::now();
         unsafe { ctx.device.queue_submit2(ctx.queue, &[submit], slot.fence) }?;
+        ctx.frames_pending.fetch_add(1, Ordering::Relaxed);
         self.frames.host_submit += start.elapsed();
         slot.pending = Some(Pending {
             ticks,

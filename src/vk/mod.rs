@@ -15,6 +15,7 @@
 mod context;
 mod device;
 mod frame;
+mod pass;
 mod pipeline;
 mod pipeline_create;
 mod pipeline_store;
@@ -30,16 +31,16 @@ pub use frame::{
     FrameOptions, FrameRecorder, FrameSync, FrameTiming, Frames, PassTiming, TimingSource,
     MAX_FRAMES_IN_FLIGHT,
 };
+pub use pass::{step, Pass, Resource, Sync};
 pub use pipeline::{
     begin_rendering, begin_rendering_with_depth, end_rendering, BindingKind, ComputePipeline,
     DescriptorSet, DescriptorSetLayout, GraphicsPipeline, GraphicsPipelineDesc, Sampler,
-    TargetBinding,
 };
 pub use pipeline_store::{CacheLoad, PipelineCounts, PipelineStore, Specialization};
 pub use profiler::Profiler;
 pub use resources::{Buffer, BufferUsage, Image, ImageDesc};
 pub use swapchain::{Acquired, Surface, Swapchain};
-pub use sync::{barrier, copy_image, Access, BufferAccess, ImageAccess};
+pub use sync::{copy_image, Access, BufferAccess, ImageAccess};
 
 pub use ash::vk;
 

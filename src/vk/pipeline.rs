@@ -4,8 +4,9 @@
 
 use super::pipeline_create::{create_graphics, create_with_stages, pipeline_key};
 use super::pipeline_store::{SharedPipeline, Specialization, Stages};
-use super::{Buffer, Context, FrameRecorder, Image, VkResult};
+use super::{Buffer, Context, Image, VkResult};
 use ash::vk;
+use std::cell::{Cell, RefCell};
 use std::sync::Arc;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -58,6 +59,24 @@ impl DescriptorSetLayout {
     }
 }
 
+impl DescriptorSetLayout {
+    /// A layout of the bindings of `all` that `used` names: one pass's set.
+    /// A set's layout holds exactly what its pass's shaders use and its
+    /// declaration binds (lavapipe reads every binding of a bound set, so
+    /// an unwritten one would crash it).
+    pub fn of(ctx: &Arc<Context>, all: &[(u32, BindingKind)], used: &[u32]) -> VkResult<Self> {
+        let picked: Vec<_> = used
+            .iter()
+            .map(|&u| {
+                *all.iter()
+                    .find(|(b, _)| *b == u)
+                    .unwrap_or_else(|| panic!("binding {u} is not in the list"))
+            })
+            .collect();
+        Self::new(ctx, &picked)
+    }
+}
+
 impl Drop for DescriptorSetLayout {
     fn drop(&mut self) {
         unsafe {
@@ -68,36 +87,25 @@ impl Drop for DescriptorSetLayout {
     }
 }
 
-/// A storage-image binding of a set that points at the frame's targets,
-/// which a pass does not know when it is built: bound at its first `record`
-/// and again whenever the targets change.
-pub struct TargetBinding {
-    binding: u32,
-    view: vk::ImageView,
+/// What one binding of a set points at: the resource's unique id, the view
+/// (an image's whole view or one of its level views), the layout and the
+/// sampler. A pass's declaration writes a binding only when this changes.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(super) struct Bound {
+    pub id: u64,
+    pub view: vk::ImageView,
+    pub layout: vk::ImageLayout,
+    pub sampler: vk::Sampler,
 }
 
-impl TargetBinding {
-    pub fn new(binding: u32) -> Self {
-        Self {
-            binding,
+impl Bound {
+    pub(super) fn buffer(buffer: &Buffer) -> Bound {
+        Bound {
+            id: buffer.id,
             view: vk::ImageView::null(),
+            layout: vk::ImageLayout::UNDEFINED,
+            sampler: vk::Sampler::null(),
         }
-    }
-
-    /// Points `set`'s binding at `image` unless it already does. A set may
-    /// not be updated while a submitted frame can use it, so a *re*binding
-    /// first waits for the other frames in flight; the first binding waits
-    /// for none (no submitted frame has used the set yet: a technique just
-    /// built, e.g. after a rebuild parameter changed, starts at once).
-    pub fn bind(&mut self, rec: &mut FrameRecorder, set: &DescriptorSet, image: &Image) {
-        if self.view == image.view {
-            return;
-        }
-        if self.view != vk::ImageView::null() {
-            rec.wait_for_other_frames();
-        }
-        set.write_storage_image(self.binding, image);
-        self.view = image.view;
     }
 }
 
@@ -107,6 +115,12 @@ pub struct DescriptorSet {
     pool: vk::DescriptorPool,
     pub raw: vk::DescriptorSet,
     bindings: Vec<(u32, BindingKind)>,
+    /// What each written binding points at.
+    contents: RefCell<Vec<(u32, Bound)>>,
+    /// The serial of the last frame whose command buffer bound this set
+    /// (0: none): a binding may not change after the set was bound in the
+    /// frame being recorded (that would invalidate the command buffer).
+    pub(super) bound_in: Cell<u64>,
 }
 
 impl DescriptorSet {
@@ -139,6 +153,8 @@ impl DescriptorSet {
             pool,
             raw,
             bindings: layout.bindings.clone(),
+            contents: RefCell::new(Vec::new()),
+            bound_in: Cell::new(0),
         })
     }
 
@@ -150,7 +166,11 @@ impl DescriptorSet {
             .unwrap_or_else(|| panic!("binding {binding} is not in this set's layout"))
     }
 
+    /// Points a uniform or storage buffer binding at `buffer`. For buffers
+    /// bound once at construction (no layout to keep in step); a pass that
+    /// must also order its accesses declares the binding instead (`Pass::buffer`).
     pub fn write_buffer(&self, binding: u32, buffer: &Buffer) -> &Self {
+        buffer.bound.set(true);
         let info = [buffer.descriptor_info()];
         let write = vk::WriteDescriptorSet::default()
             .dst_set(self.raw)
@@ -158,57 +178,74 @@ impl DescriptorSet {
             .descriptor_type(self.kind_of(binding).descriptor_type())
             .buffer_info(&info);
         unsafe { self.ctx.device.update_descriptor_sets(&[write], &[]) };
+        self.remember(binding, Bound::buffer(buffer));
         self
     }
 
-    /// A storage image in GENERAL layout.
-    pub fn write_storage_image(&self, binding: u32, image: &Image) -> &Self {
-        let info = [vk::DescriptorImageInfo::default()
-            .image_view(image.view)
-            .image_layout(vk::ImageLayout::GENERAL)];
-        let write = vk::WriteDescriptorSet::default()
-            .dst_set(self.raw)
-            .dst_binding(binding)
-            .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
-            .image_info(&info);
-        unsafe { self.ctx.device.update_descriptor_sets(&[write], &[]) };
+    /// Points each binding of `buffers` that this set's layout has at its
+    /// buffer (sets of one technique's passes share the buffers).
+    pub fn write_buffers(&self, buffers: &[(u32, &Buffer)]) -> &Self {
+        for &(binding, buffer) in buffers {
+            if self.bindings.iter().any(|(b, _)| *b == binding) {
+                self.write_buffer(binding, buffer);
+            }
+        }
         self
     }
 
-    /// A storage image through one of its views (e.g. one mip level,
-    /// `Image::level_views`), in GENERAL layout.
-    pub fn write_storage_view(&self, binding: u32, view: vk::ImageView) -> &Self {
-        let info = [vk::DescriptorImageInfo::default()
-            .image_view(view)
-            .image_layout(vk::ImageLayout::GENERAL)];
-        let write = vk::WriteDescriptorSet::default()
-            .dst_set(self.raw)
-            .dst_binding(binding)
-            .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
-            .image_info(&info);
-        unsafe { self.ctx.device.update_descriptor_sets(&[write], &[]) };
+    /// Points a texture binding at an image that is never written again
+    /// after its upload (a scene's textures), in the layout the upload left
+    /// it in: read from the image's tracked state, so it cannot disagree.
+    pub fn write_static_texture(&self, binding: u32, image: &Image, sampler: &Sampler) -> &Self {
+        let layout = image.layout();
+        assert!(
+            layout == vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            "a static texture must be uploaded (and in SHADER_READ_ONLY_OPTIMAL) before it is bound"
+        );
+        self.write_image(
+            binding,
+            Bound {
+                id: image.id,
+                view: image.view,
+                layout,
+                sampler: sampler.raw,
+            },
+        );
         self
     }
 
-    /// A sampled image (all layers) read in the layout `Access::FragmentRead`/`ComputeRead` gives it.
-    pub fn write_sampled_image(
-        &self,
-        binding: u32,
-        image: &Image,
-        sampler: &Sampler,
-        layout: vk::ImageLayout,
-    ) -> &Self {
+    /// What `binding` points at now, if it was written.
+    pub(super) fn bound(&self, binding: u32) -> Option<Bound> {
+        self.contents
+            .borrow()
+            .iter()
+            .find(|(b, _)| *b == binding)
+            .map(|&(_, bound)| bound)
+    }
+
+    fn remember(&self, binding: u32, bound: Bound) {
+        let mut contents = self.contents.borrow_mut();
+        match contents.iter_mut().find(|(b, _)| *b == binding) {
+            Some(entry) => entry.1 = bound,
+            None => contents.push((binding, bound)),
+        }
+    }
+
+    /// Writes an image binding (storage image or combined image sampler, as
+    /// the layout says) and remembers it.
+    pub(super) fn write_image(&self, binding: u32, bound: Bound) {
+        let kind = self.kind_of(binding);
         let info = [vk::DescriptorImageInfo::default()
-            .image_view(image.view)
-            .sampler(sampler.raw)
-            .image_layout(layout)];
+            .image_view(bound.view)
+            .sampler(bound.sampler)
+            .image_layout(bound.layout)];
         let write = vk::WriteDescriptorSet::default()
             .dst_set(self.raw)
             .dst_binding(binding)
-            .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+            .descriptor_type(kind.descriptor_type())
             .image_info(&info);
         unsafe { self.ctx.device.update_descriptor_sets(&[write], &[]) };
-        self
+        self.remember(binding, bound);
     }
 }
 
@@ -285,6 +322,10 @@ fn bind_sets(
     sets: &[&DescriptorSet],
 ) {
     let raw: Vec<_> = sets.iter().map(|s| s.raw).collect();
+    let serial = ctx.frame_serial.load(std::sync::atomic::Ordering::Relaxed);
+    for set in sets {
+        set.bound_in.set(serial);
+    }
     unsafe {
         ctx.device
             .cmd_bind_descriptor_sets(cmd, point, layout, 0, &raw, &[])

@@ -33,7 +33,19 @@ pub struct Buffer {
     pub size: u64,
     pub usage: BufferUsage,
     pub(super) state: Cell<ResourceState>,
+    /// Unique for the process's lifetime (handles may be reused after a
+    /// destroy): what a descriptor set remembers it points at.
+    pub(super) id: u64,
+    /// Whether the buffer was ever bound into a descriptor set or declared
+    /// by a pass: from then on frames may read it.
+    pub(super) bound: Cell<bool>,
     allocation: Option<Allocation>,
+}
+
+/// The next resource id (`Buffer::id`, `Image::id`).
+fn next_id() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
 impl Buffer {
@@ -90,6 +102,8 @@ impl Buffer {
             size,
             usage,
             state: Cell::new(ResourceState::default()),
+            id: next_id(),
+            bound: Cell::new(false),
             allocation: Some(allocation),
         })
     }
@@ -108,11 +122,22 @@ impl Buffer {
     }
 
     /// Copies `bytes` to the start of the buffer: directly when host-visible,
-    /// else through a staging buffer and a blocking submission.
+    /// else through a staging buffer and a blocking submission. Only while
+    /// no frame that may read it is in flight: a buffer frames use is
+    /// written for a frame through `FrameRecorder::upload` (its ring).
     pub fn upload(&self, bytes: &[u8]) -> VkResult<()> {
         if bytes.is_empty() {
             return Ok(());
         }
+        let pending = self
+            .ctx
+            .frames_pending
+            .load(std::sync::atomic::Ordering::Relaxed);
+        assert!(
+            !(self.bound.get() && pending > 0),
+            "Buffer::upload of a buffer frames use while {pending} frame(s) are in flight: \
+             write it through FrameRecorder::upload (the frame's upload ring), or wait for the frames"
+        );
         if let Some(dst) = self.mapped() {
             // SAFETY: the mapping is at least `size` bytes and host-coherent (gpu-allocator CpuToGpu).
             unsafe {
@@ -279,6 +304,8 @@ pub struct Image {
     /// Mip levels (1 but for `Image::sampled_with_levels`).
     pub mip_levels: u32,
     pub(super) state: Cell<ResourceState>,
+    /// As `Buffer::id`.
+    pub(super) id: u64,
     allocation: Option<Allocation>,
 }
 
@@ -491,6 +518,7 @@ impl Image {
             desc,
             mip_levels,
             state: Cell::new(ResourceState::default()),
+            id: next_id(),
             allocation: Some(allocation),
         };
         image.view = make_view(0, desc.layers, ty, mip_levels)?;

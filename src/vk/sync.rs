@@ -110,6 +110,16 @@ impl Access {
         }
     }
 
+    /// Whether the access writes (a pass declares it as a write).
+    pub fn is_write(self) -> bool {
+        !self.writes().is_empty()
+    }
+
+    /// The layout this access puts `image` in (what a descriptor of it must say).
+    pub fn layout_of(self, image: &Image) -> vk::ImageLayout {
+        self.layout(image.aspect().contains(vk::ImageAspectFlags::DEPTH))
+    }
+
     /// Only the write part of the access: what a later barrier must make available.
     fn writes(self) -> vk::AccessFlags2 {
         use vk::AccessFlags2 as A;
@@ -224,6 +234,7 @@ pub fn barrier(
     }
     let mut buffer_barriers = Vec::new();
     for ba in buffers {
+        ba.buffer.bound.set(true);
         let prev = ba.buffer.state.get();
         if prev.current == ba.next && ba.next.writes().is_empty() {
             continue;

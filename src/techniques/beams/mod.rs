@@ -193,9 +193,7 @@ impl TechniqueBuild for Beams {
             },
             scene,
             scene_gpu,
-            &light_views.gbuffer,
             params.light_view_size,
-            &surface,
             width,
             height,
         )?;

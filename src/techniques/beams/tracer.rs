@@ -13,12 +13,7 @@ use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::passes::surface_frame::SurfaceFrame;
 use crate::passes::light_views::photon_view;
 use crate::scene::{Density, Light, LightKind, Scene};
-use crate::vk::{
-    barrier, begin_rendering, end_rendering, Access, BindingKind, Buffer, BufferAccess,
-    BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder,
-    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageAccess, ImageDesc, TargetBinding,
-    VkResult, MAX_FRAMES_IN_FLIGHT,
-};
+use crate::vk::{begin_rendering, end_rendering, step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, MAX_FRAMES_IN_FLIGHT, VkResult};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
@@ -173,6 +168,30 @@ pub struct TracerSettings {
     pub medium_steps: u32,
 }
 
+/// The layouts of `BeamSets`.
+struct BeamLayouts {
+    receivers: DescriptorSetLayout,
+    beams: DescriptorSetLayout,
+    filter: DescriptorSetLayout,
+    apply: DescriptorSetLayout,
+    composite: DescriptorSetLayout,
+}
+
+/// The tracer's descriptor sets, one per group of passes, each declaring
+/// its own image bindings.
+struct BeamSets {
+    /// "beam receivers".
+    receivers: DescriptorSet,
+    /// "beam refine" (with the level arguments) and "beam volumes".
+    beams: DescriptorSet,
+    /// "beam filter".
+    filter: DescriptorSet,
+    /// "beam apply".
+    apply: DescriptorSet,
+    /// "beam composite".
+    composite: DescriptorSet,
+}
+
 pub struct BeamTracer {
     /// The beams of the last light recorded.
     pub beams: Buffer,
@@ -203,9 +222,8 @@ pub struct BeamTracer {
     composite_pipeline: ComputePipeline,
     filter_pipeline: ComputePipeline,
     volume_pipeline: GraphicsPipeline,
-    set: DescriptorSet,
-    bound_radiance: TargetBinding,
-    _layout: DescriptorSetLayout,
+    sets: BeamSets,
+    _layouts: BeamLayouts,
 }
 
 fn luminance(c: glam::Vec3) -> f32 {
@@ -249,9 +267,7 @@ impl BeamTracer {
         settings: &TracerSettings,
         scene: &Scene,
         scene_gpu: &SceneGpu,
-        light_view: &SpecularGBuffer,
         light_view_size: u32,
-        surface: &SurfaceFrame,
         width: u32,
         height: u32,
     ) -> anyhow::Result<Self> {
@@ -317,9 +333,7 @@ impl BeamTracer {
         let surface_target = target("beam surface irradiance")?;
         let surface_filtered = target("beam surface irradiance, filtered in x")?;
         use BindingKind::{Storage, StorageImage};
-        let layout = DescriptorSetLayout::new(
-            ctx,
-            &[
+        let all = [
                 (bb::BEAMS_BINDING_TRIANGLES_A, Storage),
                 (bb::BEAMS_BINDING_TRIANGLES_B, Storage),
                 (bb::BEAMS_BINDING_BEAMS, Storage),
@@ -339,44 +353,76 @@ impl BeamTracer {
                 (bb::BEAMS_BINDING_OPAQUE_RADIANCE, StorageImage),
                 (bb::BEAMS_BINDING_RADIANCE, StorageImage),
                 (bb::BEAMS_BINDING_SURFACE_FILTERED, StorageImage),
-            ],
-        )?;
-        let set = DescriptorSet::new(ctx, &layout)?;
-        let g = surface.gbuffer();
-        set.write_buffer(bb::BEAMS_BINDING_TRIANGLES_A, &triangles[0])
-            .write_buffer(bb::BEAMS_BINDING_TRIANGLES_B, &triangles[1])
-            .write_buffer(bb::BEAMS_BINDING_BEAMS, &beams)
-            .write_buffer(bb::BEAMS_BINDING_COUNTERS, &counters)
-            .write_buffer(bb::BEAMS_BINDING_INDIRECT, &indirect)
-            .write_storage_image(bb::BEAMS_BINDING_FRONT_POSITION, &light_view.front_position)
-            .write_storage_image(bb::BEAMS_BINDING_FRONT_NORMAL, &light_view.front_normal)
-            .write_storage_image(bb::BEAMS_BINDING_BACK_POSITION, &light_view.back_position)
-            .write_storage_image(bb::BEAMS_BINDING_BACK_NORMAL, &light_view.back_normal)
-            .write_storage_image(bb::BEAMS_BINDING_OPAQUE_POSITION, &g.position)
-            .write_storage_image(bb::BEAMS_BINDING_OPAQUE_NORMAL, &g.normal)
-            .write_storage_image(bb::BEAMS_BINDING_OPAQUE_ALBEDO, &g.albedo)
-            .write_storage_image(
+            ];
+        // One set (and layout) per group of passes: each pass declares its
+        // image bindings (`vk/pass.rs`), and a set holds only what its
+        // shaders use; the buffers are written into every set that has them.
+        let layout_of = |used: &[u32]| DescriptorSetLayout::of(ctx, &all, used);
+        let layouts = BeamLayouts {
+            receivers: layout_of(&[
+                bb::BEAMS_BINDING_OPAQUE_NORMAL,
+                bb::BEAMS_BINDING_OPAQUE_POSITION,
                 bb::BEAMS_BINDING_SPECULAR_POSITION,
-                &surface.specular().front_position,
-            )
-            .write_buffer(bb::BEAMS_BINDING_RECEIVERS, &receivers)
-            .write_storage_image(bb::BEAMS_BINDING_VOLUME, &volume)
-            .write_storage_image(bb::BEAMS_BINDING_SURFACE, &surface_target)
-            .write_storage_image(bb::BEAMS_BINDING_SURFACE_FILTERED, &surface_filtered)
-            .write_storage_image(bb::BEAMS_BINDING_OPAQUE_RADIANCE, surface.opaque());
-        let sets = [&scene_gpu.layout, &layout];
+                bb::BEAMS_BINDING_RECEIVERS,
+            ])?,
+            beams: layout_of(&[
+                bb::BEAMS_BINDING_FRONT_POSITION,
+                bb::BEAMS_BINDING_FRONT_NORMAL,
+                bb::BEAMS_BINDING_BACK_POSITION,
+                bb::BEAMS_BINDING_BACK_NORMAL,
+                bb::BEAMS_BINDING_TRIANGLES_A,
+                bb::BEAMS_BINDING_TRIANGLES_B,
+                bb::BEAMS_BINDING_BEAMS,
+                bb::BEAMS_BINDING_COUNTERS,
+                bb::BEAMS_BINDING_INDIRECT,
+                bb::BEAMS_BINDING_RECEIVERS,
+            ])?,
+            filter: layout_of(&[
+                bb::BEAMS_BINDING_RECEIVERS,
+                bb::BEAMS_BINDING_SURFACE,
+                bb::BEAMS_BINDING_SURFACE_FILTERED,
+            ])?,
+            apply: layout_of(&[
+                bb::BEAMS_BINDING_OPAQUE_ALBEDO,
+                bb::BEAMS_BINDING_OPAQUE_POSITION,
+                bb::BEAMS_BINDING_OPAQUE_RADIANCE,
+                bb::BEAMS_BINDING_SURFACE,
+            ])?,
+            composite: layout_of(&[bb::BEAMS_BINDING_VOLUME, bb::BEAMS_BINDING_RADIANCE])?,
+        };
+        let buffers = [
+            (bb::BEAMS_BINDING_TRIANGLES_A, &triangles[0]),
+            (bb::BEAMS_BINDING_TRIANGLES_B, &triangles[1]),
+            (bb::BEAMS_BINDING_BEAMS, &beams),
+            (bb::BEAMS_BINDING_COUNTERS, &counters),
+            (bb::BEAMS_BINDING_INDIRECT, &indirect),
+            (bb::BEAMS_BINDING_RECEIVERS, &receivers),
+        ];
+        let new_set = |layout: &DescriptorSetLayout| -> VkResult<DescriptorSet> {
+            let set = DescriptorSet::new(ctx, layout)?;
+            set.write_buffers(&buffers);
+            Ok(set)
+        };
+        let sets = BeamSets {
+            receivers: new_set(&layouts.receivers)?,
+            beams: new_set(&layouts.beams)?,
+            filter: new_set(&layouts.filter)?,
+            apply: new_set(&layouts.apply)?,
+            composite: new_set(&layouts.composite)?,
+        };
+        let with = |layout| [&scene_gpu.layout, layout];
         let refine_pipeline = ComputePipeline::new(
             ctx,
             "beams/refine.comp",
-            &sets,
+            &with(&layouts.beams),
             size_of::<RefinePush>() as u32,
         )?;
         let args_pipeline =
-            ComputePipeline::new(ctx, "beams/args.comp", &sets, size_of::<ArgsPush>() as u32)?;
-        let receivers_pipeline = ComputePipeline::new(ctx, "beams/receivers.comp", &sets, 0)?;
-        let apply_pipeline = ComputePipeline::new(ctx, "beams/apply.comp", &sets, 4)?;
-        let composite_pipeline = ComputePipeline::new(ctx, "beams/composite.comp", &sets, 0)?;
-        let filter_pipeline = ComputePipeline::new(ctx, "beams/filter.comp", &sets, 8)?;
+            ComputePipeline::new(ctx, "beams/args.comp", &with(&layouts.beams), size_of::<ArgsPush>() as u32)?;
+        let receivers_pipeline = ComputePipeline::new(ctx, "beams/receivers.comp", &with(&layouts.receivers), 0)?;
+        let apply_pipeline = ComputePipeline::new(ctx, "beams/apply.comp", &with(&layouts.apply), 4)?;
+        let composite_pipeline = ComputePipeline::new(ctx, "beams/composite.comp", &with(&layouts.composite), 0)?;
+        let filter_pipeline = ComputePipeline::new(ctx, "beams/filter.comp", &with(&layouts.filter), 8)?;
         // A constant density (or none) gets fragments compiled without the
         // density field's code (a CPU rasteriser pays for it in every
         // fragment, as volume_lines measured).
@@ -395,7 +441,7 @@ impl BeamTracer {
         desc.additive = true;
         desc.topology = vk::PrimitiveTopology::POINT_LIST;
         desc.push_size = size_of::<VolumePush>() as u32;
-        let volume_pipeline = GraphicsPipeline::new(ctx, &desc, &sets)?;
+        let volume_pipeline = GraphicsPipeline::new(ctx, &desc, &with(&layouts.beams))?;
 
         let view_flux = view_fluxes(
             &scene.lights,
@@ -454,9 +500,8 @@ impl BeamTracer {
             composite_pipeline,
             filter_pipeline,
             volume_pipeline,
-            set,
-            bound_radiance: TargetBinding::new(bb::BEAMS_BINDING_RADIANCE),
-            _layout: layout,
+            sets,
+            _layouts: layouts,
         })
     }
 
@@ -475,37 +520,32 @@ impl BeamTracer {
         surface: &SurfaceFrame,
         targets: &FrameTargets,
     ) {
-        self.bound_radiance.bind(rec, &self.set, &targets.radiance);
         let ctx = rec.ctx().clone();
-        rec.pass("beam receivers", |cmd| {
-            // The camera G-buffers were written by rasterisation; the
-            // receivers are overwritten after last frame's fragments.
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(&surface.gbuffer().position, Access::ComputeRead),
-                    ImageAccess::new(&surface.gbuffer().normal, Access::ComputeRead),
-                    ImageAccess::new(&surface.specular().front_position, Access::ComputeRead),
-                ],
-                &[BufferAccess::new(&self.receivers, Access::ComputeWrite)],
-            );
+        // The camera G-buffers were written by rasterisation; the
+        // receivers are overwritten after last frame's fragments.
+        let set = &self.sets.receivers;
+        rec.pass("beam receivers")
+            .storage_image(set, bb::BEAMS_BINDING_OPAQUE_POSITION, &surface.gbuffer().position, Access::ComputeRead)
+            .storage_image(set, bb::BEAMS_BINDING_OPAQUE_NORMAL, &surface.gbuffer().normal, Access::ComputeRead)
+            .storage_image(
+                set,
+                bb::BEAMS_BINDING_SPECULAR_POSITION,
+                &surface.specular().front_position,
+                Access::ComputeRead,
+            )
+            .write(&self.receivers, Access::ComputeWrite)
+            .record(|cmd| {
             let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
             self.receivers_pipeline
-                .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
+                .dispatch(cmd, &[&scene.set, set], &[], groups);
         });
-        rec.pass("beam clear", |cmd| {
-            // The frame's statistics start from zero (after last frame's
-            // copy to the host); both targets are cleared.
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::discard(&self.volume, Access::ColorAttachment),
-                    ImageAccess::discard(&self.surface, Access::ColorAttachment),
-                ],
-                &[BufferAccess::new(&self.counters, Access::TransferWrite)],
-            );
+        // The frame's statistics start from zero (after last frame's
+        // copy to the host); both targets are cleared.
+        rec.pass("beam clear")
+            .overwrite(&self.volume, Access::ColorAttachment)
+            .overwrite(&self.surface, Access::ColorAttachment)
+            .write(&self.counters, Access::TransferWrite)
+            .record(|cmd| {
             unsafe {
                 ctx.device
                     .cmd_fill_buffer(cmd, self.counters.raw, 0, vk::WHOLE_SIZE, 0)
@@ -531,66 +571,57 @@ impl BeamTracer {
         if self.surface_filter > 0 {
             let e = self.surface.extent();
             let groups = [e.width.div_ceil(8), e.height.div_ceil(8), 1];
-            rec.pass("beam filter", |cmd| {
-                // x: the volumes' blended irradiance -> the intermediate
-                // (overwritten after last frame's y pass read it). Both
-                // images are bound writable in both passes (one shader
-                // picks the direction), so both are declared written.
-                barrier(
-                    &ctx,
-                    cmd,
-                    &[
-                        ImageAccess::new(&self.surface, Access::ComputeWrite),
-                        ImageAccess::discard(&self.surface_filtered, Access::ComputeWrite),
-                    ],
-                    &[BufferAccess::new(&self.receivers, Access::ComputeRead)],
-                );
+            // x: the volumes' blended irradiance -> the intermediate
+            // (overwritten after last frame's y pass read it). Both
+            // images are bound writable in both passes (one shader
+            // picks the direction), so both are declared written.
+            let set = &self.sets.filter;
+            rec.pass("beam filter")
+                .storage_image(set, bb::BEAMS_BINDING_SURFACE, &self.surface, Access::ComputeWrite)
+                .overwrite_storage_image(
+                    set,
+                    bb::BEAMS_BINDING_SURFACE_FILTERED,
+                    &self.surface_filtered,
+                    Access::ComputeWrite,
+                )
+                .read(&self.receivers, Access::ComputeRead)
+                .record(|cmd| {
                 let push = [self.surface_filter, 0];
                 self.filter_pipeline.dispatch(
                     cmd,
-                    &[&scene.set, &self.set],
+                    &[&scene.set, set],
                     bytemuck::cast_slice(&push),
                     groups,
                 );
                 // y: the intermediate -> the surface target (read-after-
                 // write one way, write-after-read the other).
-                barrier(
-                    &ctx,
-                    cmd,
-                    &[
-                        ImageAccess::new(&self.surface_filtered, Access::ComputeWrite),
-                        ImageAccess::new(&self.surface, Access::ComputeWrite),
-                    ],
-                    &[],
-                );
+                step(&ctx, cmd)
+                    .write(&self.surface_filtered, Access::ComputeWrite)
+                    .write(&self.surface, Access::ComputeWrite)
+                    .emit();
                 let push = [self.surface_filter, 1];
                 self.filter_pipeline.dispatch(
                     cmd,
-                    &[&scene.set, &self.set],
+                    &[&scene.set, set],
                     bytemuck::cast_slice(&push),
                     groups,
                 );
             });
         }
-        rec.pass("beam apply", |cmd| {
-            // The volumes' blended writes are read; the opaque frame was
-            // written by direct lighting.
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(&self.surface, Access::ComputeRead),
-                    ImageAccess::new(&surface.gbuffer().position, Access::ComputeRead),
-                    ImageAccess::new(&surface.gbuffer().albedo, Access::ComputeRead),
-                    ImageAccess::new(surface.opaque(), Access::ComputeWrite),
-                ],
-                &[],
-            );
+        // The volumes' blended writes are read; the opaque frame was
+        // written by direct lighting.
+        let set = &self.sets.apply;
+        rec.pass("beam apply")
+            .storage_image(set, bb::BEAMS_BINDING_SURFACE, &self.surface, Access::ComputeRead)
+            .storage_image(set, bb::BEAMS_BINDING_OPAQUE_POSITION, &surface.gbuffer().position, Access::ComputeRead)
+            .storage_image(set, bb::BEAMS_BINDING_OPAQUE_ALBEDO, &surface.gbuffer().albedo, Access::ComputeRead)
+            .storage_image(set, bb::BEAMS_BINDING_OPAQUE_RADIANCE, surface.opaque(), Access::ComputeWrite)
+            .record(|cmd| {
             let e = surface.opaque().extent();
             let groups = [e.width.div_ceil(8), e.height.div_ceil(8), 1];
             self.apply_pipeline.dispatch(
                 cmd,
-                &[&scene.set, &self.set],
+                &[&scene.set, set],
                 bytemuck::bytes_of(&self.volume_push.medium_steps),
                 groups,
             );
@@ -603,33 +634,22 @@ impl BeamTracer {
     pub fn composite(&self, rec: &mut FrameRecorder, scene: &SceneGpu, targets: &FrameTargets) {
         let ctx = rec.ctx().clone();
         let readback = &self.readbacks[rec.slot()];
-        rec.pass("beam composite", |cmd| {
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(&self.volume, Access::ComputeRead),
-                    ImageAccess::new(&targets.radiance, Access::ComputeWrite),
-                ],
-                &[
-                    BufferAccess::new(&self.counters, Access::TransferRead),
-                    BufferAccess::new(readback, Access::TransferWrite),
-                ],
-            );
+        let set = &self.sets.composite;
+        rec.pass("beam composite")
+            .storage_image(set, bb::BEAMS_BINDING_VOLUME, &self.volume, Access::ComputeRead)
+            .storage_image(set, bb::BEAMS_BINDING_RADIANCE, &targets.radiance, Access::ComputeWrite)
+            .read(&self.counters, Access::TransferRead)
+            .write(readback, Access::TransferWrite)
+            .record(|cmd| {
             let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
             self.composite_pipeline
-                .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
+                .dispatch(cmd, &[&scene.set, set], &[], groups);
             let region = vk::BufferCopy::default().size(self.counters.size);
             unsafe {
                 ctx.device
                     .cmd_copy_buffer(cmd, self.counters.raw, readback.raw, &[region])
             };
-            barrier(
-                &ctx,
-                cmd,
-                &[],
-                &[BufferAccess::new(readback, Access::HostRead)],
-            );
+            step(&ctx, cmd).read(readback, Access::HostRead).emit();
         });
     }
 }
@@ -658,18 +678,12 @@ impl LightViewConsumer for BeamTracer {
         push.up = view.up;
         push.forward = view.forward;
         push.split[3] = self.split_energy * self.view_flux.get(light).copied().unwrap_or(0.0);
-        rec.pass("beam grid", |cmd| {
-            // This light's counts and level-0 arguments start anew, after
-            // the previous light's draw read them (write-after-read).
-            barrier(
-                &ctx,
-                cmd,
-                &[],
-                &[
-                    BufferAccess::new(&self.counters, Access::TransferWrite),
-                    BufferAccess::new(&self.indirect, Access::TransferWrite),
-                ],
-            );
+        // This light's counts and level-0 arguments start anew, after
+        // the previous light's draw read them (write-after-read).
+        rec.pass("beam grid")
+            .write(&self.counters, Access::TransferWrite)
+            .write(&self.indirect, Access::TransferWrite)
+            .record(|cmd| {
             let mut light_words = [0u32; bb::BEAMS_COUNTER_LIGHT_WORDS as usize];
             light_words[bb::BEAMS_COUNTER_TRIS as usize] = first;
             let mut args = [0u32; bb::BEAMS_INDIRECT_WORDS as usize];
@@ -689,26 +703,33 @@ impl LightViewConsumer for BeamTracer {
         });
         for level in 0..=self.refine.grid[1] {
             push.grid[0] = level;
-            rec.pass("beam refine", |cmd| {
-                // The level's arguments as indirect dispatch; the counters,
-                // lists and beams by atomics; the light view's attachments
-                // as storage reads; the BVH after any refit.
-                barrier(
-                    &ctx,
-                    cmd,
-                    &light_view.compute_reads(),
-                    &[
-                        BufferAccess::new(&self.indirect, Access::IndirectRead),
-                        BufferAccess::new(&self.counters, Access::ComputeWrite),
-                        BufferAccess::new(&self.triangles[0], Access::ComputeWrite),
-                        BufferAccess::new(&self.triangles[1], Access::ComputeWrite),
-                        BufferAccess::new(&self.beams, Access::ComputeWrite),
-                        BufferAccess::new(&scene.triangles, Access::ComputeRead),
+            // The level's arguments as indirect dispatch; the counters,
+            // lists and beams by atomics; the light view's attachments as
+            // storage reads; the BVH after any refit.
+            let set = &self.sets.beams;
+            let pass = rec
+                .pass("beam refine")
+                .read(&self.indirect, Access::IndirectRead)
+                .write(&self.counters, Access::ComputeWrite)
+                .write(&self.triangles[0], Access::ComputeWrite)
+                .write(&self.triangles[1], Access::ComputeWrite)
+                .write(&self.beams, Access::ComputeWrite)
+                .read(&scene.triangles, Access::ComputeRead);
+            light_view
+                .bind_reads(
+                    pass,
+                    set,
+                    [
+                        bb::BEAMS_BINDING_FRONT_POSITION,
+                        bb::BEAMS_BINDING_FRONT_NORMAL,
+                        bb::BEAMS_BINDING_BACK_POSITION,
+                        bb::BEAMS_BINDING_BACK_NORMAL,
                     ],
-                );
+                )
+                .record(|cmd| {
                 self.refine_pipeline.dispatch_indirect(
                     cmd,
-                    &[&scene.set, &self.set],
+                    &[&scene.set, set],
                     bytemuck::bytes_of(&push),
                     &self.indirect,
                     12 * level as u64,
@@ -716,43 +737,32 @@ impl LightViewConsumer for BeamTracer {
                 // The next level's arguments (and the draw's) from the
                 // counts this level appended (read-after-write), written
                 // after this level's indirect read (write-after-read).
-                barrier(
-                    &ctx,
-                    cmd,
-                    &[],
-                    &[
-                        BufferAccess::new(&self.counters, Access::ComputeRead),
-                        BufferAccess::new(&self.indirect, Access::ComputeWrite),
-                    ],
-                );
+                step(&ctx, cmd)
+                    .read(&self.counters, Access::ComputeRead)
+                    .write(&self.indirect, Access::ComputeWrite)
+                    .emit();
                 self.args_pipeline.dispatch(
                     cmd,
-                    &[&scene.set, &self.set],
+                    &[&scene.set, set],
                     bytemuck::bytes_of(&self.args),
                     [1, 1, 1],
                 );
             });
         }
-        rec.pass("beam volumes", |cmd| {
-            // Beams pulled by the geometry shader and read again by the
-            // fragments; the draw's count as indirect arguments; the
-            // fragment counter by fragment atomics.
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(&self.volume, Access::ColorAttachment),
-                    ImageAccess::new(&self.surface, Access::ColorAttachment),
-                ],
-                &[
-                    BufferAccess::new(&self.beams, Access::GraphicsRead),
-                    BufferAccess::new(&self.indirect, Access::IndirectRead),
-                    BufferAccess::new(&self.counters, Access::FragmentWrite),
-                    BufferAccess::new(&self.receivers, Access::FragmentRead),
-                    // The receivers' shadow rays traverse the scene.
-                    BufferAccess::new(&scene.triangles, Access::FragmentRead),
-                ],
-            );
+        // Beams pulled by the geometry shader and read again by the
+        // fragments; the draw's count as indirect arguments; the fragment
+        // counter by fragment atomics; the receivers' shadow rays traverse
+        // the scene.
+        let set = &self.sets.beams;
+        rec.pass("beam volumes")
+            .write(&self.volume, Access::ColorAttachment)
+            .write(&self.surface, Access::ColorAttachment)
+            .read(&self.beams, Access::GraphicsRead)
+            .read(&self.indirect, Access::IndirectRead)
+            .write(&self.counters, Access::FragmentWrite)
+            .read(&self.receivers, Access::FragmentRead)
+            .read(&scene.triangles, Access::FragmentRead)
+            .record(|cmd| {
             let extent = self.volume.extent();
             begin_rendering(
                 &ctx,
@@ -763,7 +773,7 @@ impl LightViewConsumer for BeamTracer {
             );
             self.volume_pipeline.bind(
                 cmd,
-                &[&scene.set, &self.set],
+                &[&scene.set, set],
                 bytemuck::bytes_of(&self.volume_push),
                 extent,
             );

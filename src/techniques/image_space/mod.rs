@@ -95,7 +95,7 @@ impl ImageSpace {
             params.refraction(),
         )?;
         let light_views = LightViews::new(ctx, scene, scene_gpu, params.photon_buffer_size)?;
-        let caustics = params.caustic_map(ctx, scene_gpu, &light_views, &surface)?;
+        let caustics = params.caustic_map(ctx, scene_gpu, &light_views)?;
         Ok(Self {
             surface,
             light_views,

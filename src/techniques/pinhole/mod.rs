@@ -65,11 +65,7 @@ use crate::passes::surface_frame::SurfaceFrame;
 use crate::radiometry::Component;
 use crate::scene::Scene;
 use crate::shader_bindings as sb;
-use crate::vk::{
-    barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline, Context,
-    DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageAccess, ImageDesc, Sampler,
-    VkResult,
-};
+use crate::vk::{step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageDesc, Sampler, VkResult};
 use ash::vk;
 use bindings as b;
 use bytemuck::{Pod, Zeroable};
@@ -126,12 +122,17 @@ pub struct Pinhole {
     light_maps: ComputePipeline,
     mips: ComputePipeline,
     receivers: ComputePipeline,
+    /// The sampling passes' set (buffers only).
     set: DescriptorSet,
+    /// "pinhole light maps"' set.
+    light_map_set: DescriptorSet,
+    /// "pinhole receivers"' set.
+    receivers_set: DescriptorSet,
     /// One set per mip level >= 1 (source: the level above).
     mip_sets: Vec<DescriptorSet>,
-    _layout: DescriptorSetLayout,
+    _layouts: [DescriptorSetLayout; 3],
     _mip_layout: DescriptorSetLayout,
-    _sampler: Sampler,
+    sampler: Sampler,
 }
 
 impl Pinhole {
@@ -193,43 +194,56 @@ impl Pinhole {
             },
             levels,
         )?;
-        let layout = DescriptorSetLayout::new(
-            ctx,
-            &[
-                (b::PINHOLE_BINDING_SAMPLES, BindingKind::Storage),
-                (b::PINHOLE_BINDING_STATE, BindingKind::Storage),
-                (b::PINHOLE_BINDING_CDF, BindingKind::Storage),
-                (b::PINHOLE_BINDING_CANDIDATES, BindingKind::Storage),
-                (b::PINHOLE_BINDING_HEADS, BindingKind::Storage),
-                (b::PINHOLE_BINDING_NEXT, BindingKind::Storage),
-                (b::PINHOLE_BINDING_LIGHT_MAP_LEVEL0, BindingKind::StorageImage),
-                (b::PINHOLE_BINDING_LIGHT_MAP, BindingKind::Sampled),
-                (b::PINHOLE_BINDING_POSITION, BindingKind::StorageImage),
-                (b::PINHOLE_BINDING_NORMAL, BindingKind::StorageImage),
-                (b::PINHOLE_BINDING_ALBEDO, BindingKind::StorageImage),
-                (b::PINHOLE_BINDING_RADIANCE, BindingKind::StorageImage),
-            ],
-        )?;
-        let sampler = Sampler::trilinear_clamp(ctx)?;
-        let gbuffer = surface.gbuffer();
-        let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_buffer(b::PINHOLE_BINDING_SAMPLES, &samples)
-            .write_buffer(b::PINHOLE_BINDING_STATE, &state)
-            .write_buffer(b::PINHOLE_BINDING_CDF, &cdf)
-            .write_buffer(b::PINHOLE_BINDING_CANDIDATES, &candidates)
-            .write_buffer(b::PINHOLE_BINDING_HEADS, &heads)
-            .write_buffer(b::PINHOLE_BINDING_NEXT, &next)
-            .write_storage_view(b::PINHOLE_BINDING_LIGHT_MAP_LEVEL0, light_map.level_views[0])
-            .write_sampled_image(
+        use BindingKind::{Sampled, Storage, StorageImage};
+        let all = [
+            (b::PINHOLE_BINDING_SAMPLES, Storage),
+            (b::PINHOLE_BINDING_STATE, Storage),
+            (b::PINHOLE_BINDING_CDF, Storage),
+            (b::PINHOLE_BINDING_CANDIDATES, Storage),
+            (b::PINHOLE_BINDING_HEADS, Storage),
+            (b::PINHOLE_BINDING_NEXT, Storage),
+            (b::PINHOLE_BINDING_LIGHT_MAP_LEVEL0, StorageImage),
+            (b::PINHOLE_BINDING_LIGHT_MAP, Sampled),
+            (b::PINHOLE_BINDING_POSITION, StorageImage),
+            (b::PINHOLE_BINDING_NORMAL, StorageImage),
+            (b::PINHOLE_BINDING_ALBEDO, StorageImage),
+            (b::PINHOLE_BINDING_RADIANCE, StorageImage),
+        ];
+        // One set (and layout) per group of passes: the sampling passes'
+        // buffers (glsl/pinhole/common.glsl) in all of them, plus the images
+        // the light-map and receiver passes declare (`vk/pass.rs`).
+        let buffer_ids = all.iter().filter(|(_, kind)| *kind == Storage).map(|&(id, _)| id);
+        let with_images = |images: &[u32]| {
+            let used: Vec<u32> = buffer_ids.clone().chain(images.iter().copied()).collect();
+            DescriptorSetLayout::of(ctx, &all, &used)
+        };
+        let layouts = [
+            with_images(&[])?,
+            with_images(&[b::PINHOLE_BINDING_LIGHT_MAP_LEVEL0])?,
+            with_images(&[
                 b::PINHOLE_BINDING_LIGHT_MAP,
-                &light_map,
-                &sampler,
-                vk::ImageLayout::GENERAL,
-            )
-            .write_storage_image(b::PINHOLE_BINDING_POSITION, &gbuffer.position)
-            .write_storage_image(b::PINHOLE_BINDING_NORMAL, &gbuffer.normal)
-            .write_storage_image(b::PINHOLE_BINDING_ALBEDO, &gbuffer.albedo)
-            .write_storage_image(b::PINHOLE_BINDING_RADIANCE, surface.opaque());
+                b::PINHOLE_BINDING_POSITION,
+                b::PINHOLE_BINDING_NORMAL,
+                b::PINHOLE_BINDING_ALBEDO,
+                b::PINHOLE_BINDING_RADIANCE,
+            ])?,
+        ];
+        let sampler = Sampler::trilinear_clamp(ctx)?;
+        let buffers = [
+            (b::PINHOLE_BINDING_SAMPLES, &samples),
+            (b::PINHOLE_BINDING_STATE, &state),
+            (b::PINHOLE_BINDING_CDF, &cdf),
+            (b::PINHOLE_BINDING_CANDIDATES, &candidates),
+            (b::PINHOLE_BINDING_HEADS, &heads),
+            (b::PINHOLE_BINDING_NEXT, &next),
+        ];
+        let new_set = |layout: &DescriptorSetLayout| -> VkResult<DescriptorSet> {
+            let set = DescriptorSet::new(ctx, layout)?;
+            set.write_buffers(&buffers);
+            Ok(set)
+        };
+        let (set, light_map_set, receivers_set) =
+            (new_set(&layouts[0])?, new_set(&layouts[1])?, new_set(&layouts[2])?);
         let mip_layout = DescriptorSetLayout::new(
             ctx,
             &[
@@ -237,24 +251,20 @@ impl Pinhole {
                 (b::PINHOLE_MIP_BINDING_DST, BindingKind::StorageImage),
             ],
         )?;
-        let mut mip_sets = Vec::new();
-        for level in 1..levels as usize {
-            let s = DescriptorSet::new(ctx, &mip_layout)?;
-            s.write_storage_view(b::PINHOLE_MIP_BINDING_SRC, light_map.level_views[level - 1])
-                .write_storage_view(b::PINHOLE_MIP_BINDING_DST, light_map.level_views[level]);
-            mip_sets.push(s);
-        }
+        let mip_sets = (1..levels)
+            .map(|_| DescriptorSet::new(ctx, &mip_layout))
+            .collect::<VkResult<Vec<_>>>()?;
         let push_size = size_of::<PinholePush>() as u32;
-        let pipeline = |shader: &str| {
-            ComputePipeline::new(ctx, shader, &[&scene_gpu.layout, &layout], push_size)
+        let pipeline = |shader: &str, layout: &DescriptorSetLayout| {
+            ComputePipeline::new(ctx, shader, &[&scene_gpu.layout, layout], push_size)
         };
-        let areas = pipeline("pinhole/areas.comp")?;
-        let candidates_pass = pipeline("pinhole/candidates.comp")?;
-        let select = pipeline("pinhole/select.comp")?;
-        let gradients = pipeline("pinhole/gradients.comp")?;
-        let clusters = pipeline("pinhole/clusters.comp")?;
-        let light_maps = pipeline("pinhole/light_maps.comp")?;
-        let receivers = pipeline("pinhole/receivers.comp")?;
+        let areas = pipeline("pinhole/areas.comp", &layouts[0])?;
+        let candidates_pass = pipeline("pinhole/candidates.comp", &layouts[0])?;
+        let select = pipeline("pinhole/select.comp", &layouts[0])?;
+        let gradients = pipeline("pinhole/gradients.comp", &layouts[0])?;
+        let clusters = pipeline("pinhole/clusters.comp", &layouts[0])?;
+        let light_maps = pipeline("pinhole/light_maps.comp", &layouts[1])?;
+        let receivers = pipeline("pinhole/receivers.comp", &layouts[2])?;
         let mips = ComputePipeline::new(ctx, "pinhole/mips.comp", &[&scene_gpu.layout, &mip_layout], 0)?;
         let mut push = PinholePush {
             target: n,
@@ -292,10 +302,12 @@ impl Pinhole {
             mips,
             receivers,
             set,
+            light_map_set,
+            receivers_set,
             mip_sets,
-            _layout: layout,
+            _layouts: layouts,
             _mip_layout: mip_layout,
-            _sampler: sampler,
+            sampler,
         })
     }
 
@@ -313,50 +325,35 @@ impl Pinhole {
         let sets = [&scene.set, &self.set];
         let one = [1, 1, 1];
         // Each pass declares its next use of every buffer it touches; a
-        // write after a write or read gets a barrier from `barrier`.
-        let w = |buf| BufferAccess::new(buf, Access::ComputeWrite);
-        let r = |buf| BufferAccess::new(buf, Access::ComputeRead);
-        rec.pass("pinhole areas", |cmd| {
-            barrier(
-                &ctx,
-                cmd,
-                &[],
-                &[r(&scene.triangles), w(&self.cdf), w(&self.state), w(&self.heads)],
-            );
-            self.areas.dispatch(cmd, &sets, push, one);
-        });
-        rec.pass("pinhole candidates", |cmd| {
-            barrier(
-                &ctx,
-                cmd,
-                &[],
-                &[
-                    r(&self.cdf),
-                    r(&self.state),
-                    w(&self.candidates),
-                    w(&self.heads),
-                    w(&self.next),
-                ],
-            );
-            let groups = [self.push.candidates.div_ceil(64), 1, 1];
-            self.candidates_pass.dispatch(cmd, &sets, push, groups);
-        });
-        rec.pass("pinhole samples", |cmd| {
+        // write after a write or read gets a barrier.
+        let (r, w) = (Access::ComputeRead, Access::ComputeWrite);
+        rec.pass("pinhole areas")
+            .read(&scene.triangles, r)
+            .write(&self.cdf, w)
+            .write(&self.state, w)
+            .write(&self.heads, w)
+            .record(|cmd| self.areas.dispatch(cmd, &sets, push, one));
+        rec.pass("pinhole candidates")
+            .read(&self.cdf, r)
+            .read(&self.state, r)
+            .write(&self.candidates, w)
+            .write(&self.heads, w)
+            .write(&self.next, w)
+            .record(|cmd| {
+                let groups = [self.push.candidates.div_ceil(64), 1, 1];
+                self.candidates_pass.dispatch(cmd, &sets, push, groups);
+            });
+        rec.pass("pinhole samples").record(|cmd| {
             // One dispatch per chunk of candidates; each continues the
             // previous one's kept count and flags.
             for first in (0..self.push.candidates).step_by(b::PINHOLE_SELECT_CHUNK as usize) {
-                barrier(
-                    &ctx,
-                    cmd,
-                    &[],
-                    &[
-                        w(&self.candidates),
-                        r(&self.heads),
-                        r(&self.next),
-                        w(&self.samples),
-                        w(&self.state),
-                    ],
-                );
+                step(&ctx, cmd)
+                    .write(&self.candidates, w)
+                    .read(&self.heads, r)
+                    .read(&self.next, r)
+                    .write(&self.samples, w)
+                    .write(&self.state, w)
+                    .emit();
                 let chunk = PinholePush {
                     first_candidate: first,
                     ..self.push
@@ -364,40 +361,44 @@ impl Pinhole {
                 self.select.dispatch(cmd, &sets, bytemuck::bytes_of(&chunk), one);
             }
         });
-        rec.pass("pinhole gradients", |cmd| {
-            barrier(
-                &ctx,
-                cmd,
-                &[],
-                &[r(&self.candidates), r(&self.state), w(&self.samples)],
-            );
-            let groups = [self.push.target.div_ceil(64), 1, 1];
-            self.gradients.dispatch(cmd, &sets, push, groups);
-        });
-        rec.pass("pinhole clusters", |cmd| {
-            barrier(&ctx, cmd, &[], &[w(&self.samples), w(&self.state)]);
-            self.clusters.dispatch(cmd, &sets, push, one);
-        });
-        rec.pass("pinhole light maps", |cmd| {
-            barrier(
-                &ctx,
-                cmd,
-                &[ImageAccess::discard(&self.light_map, Access::ComputeWrite)],
-                &[w(&self.state)],
-            );
-            let s = self.push.cube_size.div_ceil(8);
-            let groups = [s, s, self.light_map.desc.layers];
-            self.light_maps.dispatch(cmd, &sets, push, groups);
-        });
-        rec.pass("pinhole light mips", |cmd| {
+        rec.pass("pinhole gradients")
+            .read(&self.candidates, r)
+            .read(&self.state, r)
+            .write(&self.samples, w)
+            .record(|cmd| {
+                let groups = [self.push.target.div_ceil(64), 1, 1];
+                self.gradients.dispatch(cmd, &sets, push, groups);
+            });
+        rec.pass("pinhole clusters")
+            .write(&self.samples, w)
+            .write(&self.state, w)
+            .record(|cmd| self.clusters.dispatch(cmd, &sets, push, one));
+        let set = &self.light_map_set;
+        rec.pass("pinhole light maps")
+            .write(&self.state, w)
+            .storage_view(
+                set,
+                b::PINHOLE_BINDING_LIGHT_MAP_LEVEL0,
+                &self.light_map,
+                self.light_map.level_views[0],
+                w,
+            )
+            .record(|cmd| {
+                let s = self.push.cube_size.div_ceil(8);
+                let groups = [s, s, self.light_map.desc.layers];
+                self.light_maps.dispatch(cmd, &[&scene.set, set], push, groups);
+            });
+        let mut mips = rec.pass("pinhole light mips");
+        for (l, set) in self.mip_sets.iter().enumerate() {
+            let views = &self.light_map.level_views;
+            mips = mips
+                .storage_view(set, b::PINHOLE_MIP_BINDING_SRC, &self.light_map, views[l], w)
+                .storage_view(set, b::PINHOLE_MIP_BINDING_DST, &self.light_map, views[l + 1], w);
+        }
+        mips.record(|cmd| {
             for (l, set) in self.mip_sets.iter().enumerate() {
                 // Level l + 1 reads level l, written by the previous dispatch.
-                barrier(
-                    &ctx,
-                    cmd,
-                    &[ImageAccess::new(&self.light_map, Access::ComputeWrite)],
-                    &[],
-                );
+                step(&ctx, cmd).write(&self.light_map, w).emit();
                 let s = (self.push.cube_size >> (l + 1)).max(1).div_ceil(8);
                 let groups = [s, s, self.light_map.desc.layers];
                 self.mips.dispatch(cmd, &[&scene.set, set], &[], groups);
@@ -405,23 +406,21 @@ impl Pinhole {
         });
         let gbuffer = self.surface.gbuffer();
         let opaque = self.surface.opaque();
-        rec.pass("pinhole receivers", |cmd| {
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(&self.light_map, Access::ComputeRead),
-                    ImageAccess::new(&gbuffer.position, Access::ComputeRead),
-                    ImageAccess::new(&gbuffer.normal, Access::ComputeRead),
-                    ImageAccess::new(&gbuffer.albedo, Access::ComputeRead),
-                    ImageAccess::new(opaque, Access::ComputeWrite),
-                ],
-                &[r(&self.samples), r(&self.state)],
-            );
-            let extent = opaque.extent();
-            let groups = [extent.width.div_ceil(8), extent.height.div_ceil(8), 1];
-            self.receivers.dispatch(cmd, &sets, push, groups);
-        });
+        let set = &self.receivers_set;
+        rec.pass("pinhole receivers")
+            .sampled(set, b::PINHOLE_BINDING_LIGHT_MAP, &self.light_map, &self.sampler, r)
+            .storage_image(set, b::PINHOLE_BINDING_POSITION, &gbuffer.position, r)
+            .storage_image(set, b::PINHOLE_BINDING_NORMAL, &gbuffer.normal, r)
+            .storage_image(set, b::PINHOLE_BINDING_ALBEDO, &gbuffer.albedo, r)
+            .storage_image(set, b::PINHOLE_BINDING_RADIANCE, opaque, w)
+            .read(&self.samples, r)
+            .read(&self.state, r)
+            .record(|cmd| {
+                let extent = opaque.extent();
+                let groups = [extent.width.div_ceil(8), extent.height.div_ceil(8), 1];
+                self.receivers
+                    .dispatch(cmd, &[&scene.set, set], push, groups);
+            });
     }
 }
 

@@ -9,12 +9,7 @@ use crate::passes::light_views::{LightView, LightViewConsumer};
 use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::passes::surface_frame::SurfaceFrame;
 use crate::scene::{Density, Scene};
-use crate::vk::{
-    TargetBinding,
-    barrier, begin_rendering, end_rendering, Access, BindingKind, Buffer, BufferAccess,
-    BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder,
-    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageAccess, ImageDesc,
-};
+use crate::vk::{begin_rendering, end_rendering, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, VkResult};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
@@ -78,8 +73,11 @@ pub struct VolumeRays {
     line_pipeline: GraphicsPipeline,
     composite_pipeline: ComputePipeline,
     set: DescriptorSet,
-    bound_radiance: TargetBinding,
-    _layout: DescriptorSetLayout,
+    /// "volume visibility"'s set.
+    visibility_set: DescriptorSet,
+    /// "volume composite"'s set.
+    composite_set: DescriptorSet,
+    _layouts: [DescriptorSetLayout; 3],
 }
 
 /// What `VolumeRays` takes from the technique's parameters.
@@ -97,16 +95,12 @@ pub struct RaySettings {
 }
 
 impl VolumeRays {
-    /// Frames of `width` x `height`; `light_view` is the light views'
-    /// G-buffer at `settings.buffer_size`, `surface` the frame it adds to.
-    #[allow(clippy::too_many_arguments)]
+    /// Frames of `width` x `height`, over light views of `settings.buffer_size`.
     pub fn new(
         ctx: &Arc<Context>,
         settings: &RaySettings,
         scene: &Scene,
         scene_gpu: &SceneGpu,
-        light_view: &SpecularGBuffer,
-        surface: &SurfaceFrame,
         width: u32,
         height: u32,
     ) -> anyhow::Result<Self> {
@@ -135,75 +129,76 @@ impl VolumeRays {
                     | vk::ImageUsageFlags::TRANSFER_SRC,
             ),
         )?;
-        let layout = DescriptorSetLayout::new(
-            ctx,
-            &[
-                (bindings::VOLUME_LINES_BINDING_SEGMENTS, BindingKind::Storage),
-                (
-                    bindings::VOLUME_LINES_BINDING_FRONT_POSITION,
-                    BindingKind::StorageImage,
-                ),
-                (
-                    bindings::VOLUME_LINES_BINDING_FRONT_NORMAL,
-                    BindingKind::StorageImage,
-                ),
-                (
-                    bindings::VOLUME_LINES_BINDING_BACK_POSITION,
-                    BindingKind::StorageImage,
-                ),
-                (
-                    bindings::VOLUME_LINES_BINDING_BACK_NORMAL,
-                    BindingKind::StorageImage,
-                ),
-                (bindings::VOLUME_LINES_BINDING_VISIBILITY, BindingKind::Storage),
-                (
-                    bindings::VOLUME_LINES_BINDING_OPAQUE_POSITION,
-                    BindingKind::StorageImage,
-                ),
-                (
-                    bindings::VOLUME_LINES_BINDING_SPECULAR_POSITION,
-                    BindingKind::StorageImage,
-                ),
-                (bindings::VOLUME_LINES_BINDING_VOLUME, BindingKind::StorageImage),
-                (bindings::VOLUME_LINES_BINDING_RADIANCE, BindingKind::StorageImage),
-            ],
-        )?;
-        let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_buffer(bindings::VOLUME_LINES_BINDING_SEGMENTS, &segments)
-            .write_storage_image(
-                bindings::VOLUME_LINES_BINDING_FRONT_POSITION,
-                &light_view.front_position,
-            )
-            .write_storage_image(
-                bindings::VOLUME_LINES_BINDING_FRONT_NORMAL,
-                &light_view.front_normal,
-            )
-            .write_storage_image(
-                bindings::VOLUME_LINES_BINDING_BACK_POSITION,
-                &light_view.back_position,
-            )
-            .write_storage_image(bindings::VOLUME_LINES_BINDING_BACK_NORMAL, &light_view.back_normal)
-            .write_buffer(bindings::VOLUME_LINES_BINDING_VISIBILITY, &visibility)
-            .write_storage_image(
-                bindings::VOLUME_LINES_BINDING_OPAQUE_POSITION,
-                &surface.gbuffer().position,
-            )
-            .write_storage_image(
-                bindings::VOLUME_LINES_BINDING_SPECULAR_POSITION,
-                &surface.specular().front_position,
-            )
-            .write_storage_image(bindings::VOLUME_LINES_BINDING_VOLUME, &volume);
-        let sets = [&scene_gpu.layout, &layout];
+        use bindings as vb;
+        use BindingKind::{Storage, StorageImage};
+        let all = [
+            (vb::VOLUME_LINES_BINDING_SEGMENTS, Storage),
+            (vb::VOLUME_LINES_BINDING_FRONT_POSITION, StorageImage),
+            (vb::VOLUME_LINES_BINDING_FRONT_NORMAL, StorageImage),
+            (vb::VOLUME_LINES_BINDING_BACK_POSITION, StorageImage),
+            (vb::VOLUME_LINES_BINDING_BACK_NORMAL, StorageImage),
+            (vb::VOLUME_LINES_BINDING_VISIBILITY, Storage),
+            (vb::VOLUME_LINES_BINDING_OPAQUE_POSITION, StorageImage),
+            (vb::VOLUME_LINES_BINDING_SPECULAR_POSITION, StorageImage),
+            (vb::VOLUME_LINES_BINDING_VOLUME, StorageImage),
+            (vb::VOLUME_LINES_BINDING_RADIANCE, StorageImage),
+        ];
+        // One set (and layout) per group of passes: each pass declares its
+        // own image bindings (`vk/pass.rs`), and a set holds only what its
+        // shaders use.
+        let layouts = [
+            // "volume visibility"
+            DescriptorSetLayout::of(
+                ctx,
+                &all,
+                &[
+                    vb::VOLUME_LINES_BINDING_OPAQUE_POSITION,
+                    vb::VOLUME_LINES_BINDING_SPECULAR_POSITION,
+                    vb::VOLUME_LINES_BINDING_VISIBILITY,
+                ],
+            )?,
+            // "volume segments" and "volume lines"
+            DescriptorSetLayout::of(
+                ctx,
+                &all,
+                &[
+                    vb::VOLUME_LINES_BINDING_FRONT_POSITION,
+                    vb::VOLUME_LINES_BINDING_FRONT_NORMAL,
+                    vb::VOLUME_LINES_BINDING_BACK_POSITION,
+                    vb::VOLUME_LINES_BINDING_BACK_NORMAL,
+                    vb::VOLUME_LINES_BINDING_SEGMENTS,
+                    vb::VOLUME_LINES_BINDING_VISIBILITY,
+                ],
+            )?,
+            // "volume composite"
+            DescriptorSetLayout::of(
+                ctx,
+                &all,
+                &[vb::VOLUME_LINES_BINDING_VOLUME, vb::VOLUME_LINES_BINDING_RADIANCE],
+            )?,
+        ];
+        let buffers = [
+            (vb::VOLUME_LINES_BINDING_SEGMENTS, &segments),
+            (vb::VOLUME_LINES_BINDING_VISIBILITY, &visibility),
+        ];
+        let new_set = |layout: &DescriptorSetLayout| -> VkResult<DescriptorSet> {
+            let set = DescriptorSet::new(ctx, layout)?;
+            set.write_buffers(&buffers);
+            Ok(set)
+        };
+        let (visibility_set, set, composite_set) =
+            (new_set(&layouts[0])?, new_set(&layouts[1])?, new_set(&layouts[2])?);
+        let with = |layout| [&scene_gpu.layout, layout];
         let segment_pipeline = ComputePipeline::new(
             ctx,
             "volume_lines/segments.comp",
-            &sets,
+            &with(&layouts[1]),
             size_of::<SegmentPush>() as u32,
         )?;
         let visibility_pipeline =
-            ComputePipeline::new(ctx, "volume_lines/visibility.comp", &sets, 0)?;
+            ComputePipeline::new(ctx, "volume_lines/visibility.comp", &with(&layouts[0]), 0)?;
         let composite_pipeline =
-            ComputePipeline::new(ctx, "volume_lines/composite.comp", &sets, 0)?;
+            ComputePipeline::new(ctx, "volume_lines/composite.comp", &with(&layouts[2]), 0)?;
         // A constant density (or none) gets fragments compiled without the
         // density field's code.
         let homogeneous = scene
@@ -221,7 +216,7 @@ impl VolumeRays {
         desc.additive = true;
         desc.topology = vk::PrimitiveTopology::POINT_LIST;
         desc.push_size = size_of::<LinePush>() as u32;
-        let line_pipeline = GraphicsPipeline::new(ctx, &desc, &sets)?;
+        let line_pipeline = GraphicsPipeline::new(ctx, &desc, &with(&layouts[1]))?;
         let transmittance_steps = settings.transmittance_steps;
         Ok(Self {
             segments,
@@ -256,9 +251,10 @@ impl VolumeRays {
             visibility_pipeline,
             line_pipeline,
             composite_pipeline,
+            visibility_set,
             set,
-            bound_radiance: TargetBinding::new(bindings::VOLUME_LINES_BINDING_RADIANCE),
-            _layout: layout,
+            composite_set,
+            _layouts: layouts,
         })
     }
 
@@ -271,31 +267,32 @@ impl VolumeRays {
         surface: &SurfaceFrame,
         targets: &FrameTargets,
     ) {
-        self.bound_radiance.bind(rec, &self.set, &targets.radiance);
         let ctx = rec.ctx().clone();
-        rec.pass("volume visibility", |cmd| {
-            // The camera G-buffers were written by rasterisation; the
-            // distances are overwritten after last frame's line fragments.
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(&surface.gbuffer().position, Access::ComputeRead),
-                    ImageAccess::new(&surface.specular().front_position, Access::ComputeRead),
-                ],
-                &[BufferAccess::new(&self.visibility, Access::ComputeWrite)],
-            );
+        // The camera G-buffers were written by rasterisation; the
+        // distances are overwritten after last frame's line fragments.
+        let set = &self.visibility_set;
+        rec.pass("volume visibility")
+            .storage_image(
+                set,
+                bindings::VOLUME_LINES_BINDING_OPAQUE_POSITION,
+                &surface.gbuffer().position,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bindings::VOLUME_LINES_BINDING_SPECULAR_POSITION,
+                &surface.specular().front_position,
+                Access::ComputeRead,
+            )
+            .write(&self.visibility, Access::ComputeWrite)
+            .record(|cmd| {
             let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
             self.visibility_pipeline
-                .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
+                .dispatch(cmd, &[&scene.set, set], &[], groups);
         });
-        rec.pass("volume clear", |cmd| {
-            barrier(
-                &ctx,
-                cmd,
-                &[ImageAccess::discard(&self.volume, Access::ColorAttachment)],
-                &[],
-            );
+        rec.pass("volume clear")
+            .overwrite(&self.volume, Access::ColorAttachment)
+            .record(|cmd| {
             begin_rendering(
                 &ctx,
                 cmd,
@@ -310,22 +307,16 @@ impl VolumeRays {
     /// Records "volume composite": B added to the frame's radiance (after
     /// the surface frame's refraction wrote it).
     pub fn composite(&self, rec: &mut FrameRecorder, scene: &SceneGpu, targets: &FrameTargets) {
-        let ctx = rec.ctx().clone();
-        rec.pass("volume composite", |cmd| {
-            // The lines' blended writes are read; the frame's radiance was
-            // written by the surface frame's refraction pass.
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(&self.volume, Access::ComputeRead),
-                    ImageAccess::new(&targets.radiance, Access::ComputeWrite),
-                ],
-                &[],
-            );
+        // The lines' blended writes are read; the frame's radiance was
+        // written by the surface frame's refraction pass.
+        let set = &self.composite_set;
+        rec.pass("volume composite")
+            .storage_image(set, bindings::VOLUME_LINES_BINDING_VOLUME, &self.volume, Access::ComputeRead)
+            .storage_image(set, bindings::VOLUME_LINES_BINDING_RADIANCE, &targets.radiance, Access::ComputeWrite)
+            .record(|cmd| {
             let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
             self.composite_pipeline
-                .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
+                .dispatch(cmd, &[&scene.set, set], &[], groups);
         });
     }
 }
@@ -352,19 +343,25 @@ impl LightViewConsumer for VolumeRays {
             forward: view.forward,
             params: self.segment_params,
         };
-        rec.pass("volume segments", |cmd| {
-            // The light view's attachment writes become storage reads;
-            // the buffer is rewritten after the previous light's lines
-            // (or last frame's) pulled it.
-            barrier(
-                &ctx,
-                cmd,
-                &light_view.compute_reads(),
-                &[
-                    BufferAccess::new(&self.segments, Access::ComputeWrite),
-                    BufferAccess::new(&scene.triangles, Access::ComputeRead),
+        // The light view's attachment writes become storage reads; the
+        // buffer is rewritten after the previous light's lines (or last
+        // frame's) pulled it.
+        let pass = rec
+            .pass("volume segments")
+            .write(&self.segments, Access::ComputeWrite)
+            .read(&scene.triangles, Access::ComputeRead);
+        light_view
+            .bind_reads(
+                pass,
+                &self.set,
+                [
+                    bindings::VOLUME_LINES_BINDING_FRONT_POSITION,
+                    bindings::VOLUME_LINES_BINDING_FRONT_NORMAL,
+                    bindings::VOLUME_LINES_BINDING_BACK_POSITION,
+                    bindings::VOLUME_LINES_BINDING_BACK_NORMAL,
                 ],
-            );
+            )
+            .record(|cmd| {
             let groups = [
                 self.buffer_size.div_ceil(8),
                 self.buffer_size.div_ceil(8),
@@ -377,19 +374,14 @@ impl LightViewConsumer for VolumeRays {
                 groups,
             );
         });
-        rec.pass("volume lines", |cmd| {
-            // Segments pulled by the geometry shader and read again by
-            // the fragments (so the next light's segment pass waits for
-            // both); the distances read by the fragments.
-            barrier(
-                &ctx,
-                cmd,
-                &[ImageAccess::new(&self.volume, Access::ColorAttachment)],
-                &[
-                    BufferAccess::new(&self.segments, Access::GraphicsRead),
-                    BufferAccess::new(&self.visibility, Access::FragmentRead),
-                ],
-            );
+        // Segments pulled by the geometry shader and read again by
+        // the fragments (so the next light's segment pass waits for
+        // both); the distances read by the fragments.
+        rec.pass("volume lines")
+            .write(&self.volume, Access::ColorAttachment)
+            .read(&self.segments, Access::GraphicsRead)
+            .read(&self.visibility, Access::FragmentRead)
+            .record(|cmd| {
             let extent = self.volume.extent();
             begin_rendering(&ctx, cmd, extent, &[(self.volume.view, None)], None);
             self.line_pipeline.bind(

@@ -178,7 +178,6 @@ impl VolumeLines {
             ctx,
             scene_gpu,
             caustic_views.as_ref().unwrap_or(&light_views),
-            &surface,
         )?;
         let airlight = Airlight::new(
             ctx,
@@ -201,8 +200,6 @@ impl VolumeLines {
             },
             scene,
             scene_gpu,
-            &light_views.gbuffer,
-            &surface,
             width,
             height,
         )?;

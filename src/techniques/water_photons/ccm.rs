@@ -8,11 +8,7 @@
 use crate::passes::water_surface::WaterSurface;
 use crate::scene::Water;
 use super::bindings;
-use crate::vk::{
-    barrier, begin_rendering, end_rendering, Access, BindingKind, BufferAccess, Context,
-    DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc,
-    Image, ImageAccess, ImageDesc, VkResult,
-};
+use crate::vk::{begin_rendering, end_rendering, Access, BindingKind, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, VkResult};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
@@ -95,23 +91,15 @@ impl Ccm {
     pub fn record(&self, rec: &mut FrameRecorder, time: f32, view_projs: &[Mat4]) {
         self.surface.record(rec, time);
         let ctx = rec.ctx().clone();
-        rec.pass("ccm raster", |cmd| {
-            // The vertices written by compute are pulled by the vertex
-            // shader; every layer is cleared and redrawn (last frame's
-            // trace reads done first).
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::discard(&self.position, Access::ColorAttachment),
-                    ImageAccess::discard(&self.normal, Access::ColorAttachment),
-                    ImageAccess::discard(&self.depth, Access::DepthAttachment),
-                ],
-                &[BufferAccess::new(
-                    &self.surface.vertices,
-                    Access::VertexRead,
-                )],
-            );
+        // The vertices written by compute are pulled by the vertex
+        // shader; every layer is cleared and redrawn (last frame's
+        // trace reads done first).
+        rec.pass("ccm raster")
+            .overwrite(&self.position, Access::ColorAttachment)
+            .overwrite(&self.normal, Access::ColorAttachment)
+            .overwrite(&self.depth, Access::DepthAttachment)
+            .read(&self.surface.vertices, Access::VertexRead)
+            .record(|cmd| {
             let extent = self.position.extent();
             for (c, view_proj) in view_projs.iter().enumerate() {
                 begin_rendering(

@@ -47,10 +47,7 @@
 
 use crate::scene::{Camera, Light, LightKind, Scene};
 use super::bindings;
-use crate::vk::{
-    barrier, copy_image, Access, BindingKind, ComputePipeline, Context, DescriptorSet,
-    DescriptorSetLayout, FrameRecorder, Image, ImageAccess, ImageDesc, Profiler, TimingSource,
-};
+use crate::vk::{copy_image, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageDesc, Profiler, TimingSource};
 use anyhow::{bail, ensure, Context as _};
 use ash::vk;
 use glam::Vec3;
@@ -182,8 +179,6 @@ pub struct Denoiser {
     /// scratch -> caustics (sub-pass along y).
     set_y: DescriptorSet,
     scratch: Image,
-    caustics_raw: vk::Image,
-    position_raw: vk::Image,
 }
 
 fn check_rgba32f_storage(image: &Image, what: &str) -> anyhow::Result<()> {
@@ -250,16 +245,9 @@ impl Denoiser {
                 vk::ImageUsageFlags::STORAGE,
             ),
         )?;
+        // One set per axis: each sub-pass declares its own bindings.
         let set_x = DescriptorSet::new(ctx, &layout)?;
-        set_x
-            .write_storage_image(bindings::DENOISE_BINDING_INPUT, caustics)
-            .write_storage_image(bindings::DENOISE_BINDING_OUTPUT, &scratch)
-            .write_storage_image(bindings::DENOISE_BINDING_POSITION, position);
         let set_y = DescriptorSet::new(ctx, &layout)?;
-        set_y
-            .write_storage_image(bindings::DENOISE_BINDING_INPUT, &scratch)
-            .write_storage_image(bindings::DENOISE_BINDING_OUTPUT, caustics)
-            .write_storage_image(bindings::DENOISE_BINDING_POSITION, position);
         Ok(Self {
             config,
             pipeline,
@@ -267,8 +255,6 @@ impl Denoiser {
             set_x,
             set_y,
             scratch,
-            caustics_raw: caustics.raw,
-            position_raw: position.raw,
         })
     }
 
@@ -298,10 +284,9 @@ impl Denoiser {
         l_min: Vec3,
     ) {
         assert!(
-            caustics.raw == self.caustics_raw && position.raw == self.position_raw,
-            "Denoiser::record: not the caustics and position images it was built for"
+            caustics.extent() == self.scratch.extent() && position.extent() == self.scratch.extent(),
+            "Denoiser::record: images of another size than it was built for"
         );
-        let ctx = rec.ctx().clone();
         let push = |axis: u32| Push {
             eye_c_scene: eye.extend(c_scene(l_min)).to_array(),
             forward_epsilon: forward.extend(DEPTH_EPSILON).to_array(),
@@ -314,48 +299,38 @@ impl Denoiser {
         ];
         let kind = self.config.kind.name();
         for k in 0..self.config.passes {
-            rec.pass(&format!("denoise {kind} {k} x"), |cmd| {
-                // Reads the caustics (written by the splats or the previous
-                // pass) and overwrites all of the scratch image, after the
-                // previous pass's y sub-pass has read it (write-after-read).
-                barrier(
-                    &ctx,
-                    cmd,
-                    &[
-                        ImageAccess::new(caustics, Access::ComputeRead),
-                        ImageAccess::new(position, Access::ComputeRead),
-                        ImageAccess::discard(&self.scratch, Access::ComputeWrite),
-                    ],
-                    &[],
-                );
-                self.pipeline.dispatch(
-                    cmd,
-                    &[&self.set_x],
-                    bytemuck::bytes_of(&push(bindings::DENOISE_AXIS_X)),
-                    groups,
-                );
-            });
-            rec.pass(&format!("denoise {kind} {k} y"), |cmd| {
-                // The x sub-pass's output becomes the input; every caustic
-                // pixel is rewritten, so its old contents are discarded once
-                // the x sub-pass has read them.
-                barrier(
-                    &ctx,
-                    cmd,
-                    &[
-                        ImageAccess::new(&self.scratch, Access::ComputeRead),
-                        ImageAccess::new(position, Access::ComputeRead),
-                        ImageAccess::discard(caustics, Access::ComputeWrite),
-                    ],
-                    &[],
-                );
-                self.pipeline.dispatch(
-                    cmd,
-                    &[&self.set_y],
-                    bytemuck::bytes_of(&push(bindings::DENOISE_AXIS_Y)),
-                    groups,
-                );
-            });
+            // Reads the caustics (written by the splats or the previous
+            // pass) and overwrites all of the scratch image, after the
+            // previous pass's y sub-pass has read it (write-after-read).
+            let set = &self.set_x;
+            rec.pass(&format!("denoise {kind} {k} x"))
+                .storage_image(set, bindings::DENOISE_BINDING_INPUT, caustics, Access::ComputeRead)
+                .storage_image(set, bindings::DENOISE_BINDING_POSITION, position, Access::ComputeRead)
+                .overwrite_storage_image(set, bindings::DENOISE_BINDING_OUTPUT, &self.scratch, Access::ComputeWrite)
+                .record(|cmd| {
+                    self.pipeline.dispatch(
+                        cmd,
+                        &[set],
+                        bytemuck::bytes_of(&push(bindings::DENOISE_AXIS_X)),
+                        groups,
+                    )
+                });
+            // The x sub-pass's output becomes the input; every caustic pixel
+            // is rewritten, so its old contents are discarded once the x
+            // sub-pass has read them.
+            let set = &self.set_y;
+            rec.pass(&format!("denoise {kind} {k} y"))
+                .storage_image(set, bindings::DENOISE_BINDING_INPUT, &self.scratch, Access::ComputeRead)
+                .storage_image(set, bindings::DENOISE_BINDING_POSITION, position, Access::ComputeRead)
+                .overwrite_storage_image(set, bindings::DENOISE_BINDING_OUTPUT, caustics, Access::ComputeWrite)
+                .record(|cmd| {
+                    self.pipeline.dispatch(
+                        cmd,
+                        &[set],
+                        bytemuck::bytes_of(&push(bindings::DENOISE_AXIS_Y)),
+                        groups,
+                    )
+                });
         }
     }
 }
@@ -417,7 +392,8 @@ pub fn adaptive_vs_fixed(
         for frame in 0..=frames {
             let timings = profiler.frame(|rec| {
                 let ctx = rec.ctx().clone();
-                rec.pass("denoise input copy", |cmd| {
+                rec.pass("denoise input copy")
+                    .record(|cmd| {
                     copy_image(&ctx, cmd, input, &work);
                 });
                 denoiser.record(

@@ -324,8 +324,6 @@ impl WaterPhotons {
             ctx,
             scene_gpu,
             &params_buffer,
-            &ccm.position,
-            &ccm.normal,
             &layout,
             capacity,
         )?;
@@ -334,7 +332,6 @@ impl WaterPhotons {
             scene_gpu,
             &params_buffer,
             &trace.photons,
-            surface.gbuffer(),
             width,
             height,
         )?;
@@ -346,22 +343,12 @@ impl WaterPhotons {
         )?;
         let scene_sphere = scene.bounding_sphere(0.0);
         // The composite reads the splat's caustic buffer (denoised in place).
-        let composite = Composite::new(
-            ctx,
-            scene_gpu,
-            &splat.caustics,
-            surface.gbuffer(),
-            surface.opaque(),
-        )?;
+        let composite = Composite::new(ctx, scene_gpu)?;
         let view = WaterView::new(
             ctx,
             scene_gpu,
             &params_buffer,
             &trace.photons,
-            &trace.slots,
-            surface.opaque(),
-            surface.gbuffer(),
-            surface.specular(),
         )?;
         let gpu_params = GpuWpParams {
             light_view: Mat4::IDENTITY.to_cols_array_2d(),

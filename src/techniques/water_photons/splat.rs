@@ -16,11 +16,7 @@ use super::WpParamsBuffer;
 use crate::frame::SceneGpu;
 use crate::passes::gbuffer::{GBuffer, DEPTH_FORMAT};
 use super::bindings;
-use crate::vk::{
-    barrier, begin_rendering_with_depth, end_rendering, Access, BindingKind, Buffer, BufferAccess,
-    ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
-    GraphicsPipelineDesc, Image, ImageAccess, ImageDesc, Sampler, VkResult,
-};
+use crate::vk::{begin_rendering_with_depth, end_rendering, Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, Sampler, VkResult};
 use ash::vk;
 use std::sync::Arc;
 
@@ -31,7 +27,7 @@ pub struct Splat {
     pub caustics: Image,
     pipeline: GraphicsPipeline,
     set: DescriptorSet,
-    _sampler: Sampler,
+    sampler: Sampler,
     _layout: DescriptorSetLayout,
 }
 
@@ -41,7 +37,6 @@ impl Splat {
         scene_gpu: &SceneGpu,
         params: &WpParamsBuffer,
         photons: &Buffer,
-        gbuffer: &GBuffer,
         width: u32,
         height: u32,
     ) -> VkResult<Self> {
@@ -69,13 +64,7 @@ impl Splat {
         let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
         let set = DescriptorSet::new(ctx, &layout)?;
         set.write_buffer(bindings::WP_BINDING_PARAMS, &params.0)
-            .write_buffer(bindings::WP_BINDING_PHOTONS, photons)
-            .write_sampled_image(
-                bindings::WP_BINDING_GBUFFER_NORMAL,
-                &gbuffer.normal,
-                &sampler,
-                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            );
+            .write_buffer(bindings::WP_BINDING_PHOTONS, photons);
         let mut desc =
             GraphicsPipelineDesc::new("water_photons/splat.vert", "water_photons/splat.frag");
         desc.color_formats = vec![CAUSTIC_BUFFER_FORMAT];
@@ -89,7 +78,7 @@ impl Splat {
             caustics,
             pipeline,
             set,
-            _sampler: sampler,
+            sampler,
             _layout: layout,
         })
     }
@@ -105,25 +94,24 @@ impl Splat {
         draw: &Buffer,
     ) {
         let ctx = rec.ctx().clone();
-        rec.pass("photon splat", |cmd| {
-            // The trace's atomics (instanceCount) must be visible to the
-            // indirect read, its photon writes to the vertex shader; the
-            // G-buffer's depth is tested (read) and its normals read by
-            // the fragment stage (the arrival side test), the caustic
-            // buffer overwritten after last frame's composite read it.
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::discard(&self.caustics, Access::ColorAttachment),
-                    ImageAccess::new(&gbuffer.depth, Access::DepthAttachment),
-                    ImageAccess::new(&gbuffer.normal, Access::FragmentRead),
-                ],
-                &[
-                    BufferAccess::new(draw, Access::IndirectRead),
-                    BufferAccess::new(photons, Access::VertexRead),
-                ],
-            );
+        // The trace's atomics (instanceCount) must be visible to the
+        // indirect read, its photon writes to the vertex shader; the
+        // G-buffer's depth is tested (read) and its normals read by
+        // the fragment stage (the arrival side test), the caustic
+        // buffer overwritten after last frame's composite read it.
+        rec.pass("photon splat")
+            .overwrite(&self.caustics, Access::ColorAttachment)
+            .write(&gbuffer.depth, Access::DepthAttachment)
+            .sampled(
+                &self.set,
+                bindings::WP_BINDING_GBUFFER_NORMAL,
+                &gbuffer.normal,
+                &self.sampler,
+                Access::FragmentRead,
+            )
+            .read(draw, Access::IndirectRead)
+            .read(photons, Access::VertexRead)
+            .record(|cmd| {
             let extent = self.caustics.extent();
             begin_rendering_with_depth(
                 &ctx,
@@ -148,14 +136,7 @@ pub struct Composite {
 }
 
 impl Composite {
-    /// Reads the caustic irradiance from `caustics`, adds into `radiance`.
-    pub fn new(
-        ctx: &Arc<Context>,
-        scene_gpu: &SceneGpu,
-        caustics: &Image,
-        gbuffer: &GBuffer,
-        radiance: &Image,
-    ) -> VkResult<Self> {
+    pub fn new(ctx: &Arc<Context>, scene_gpu: &SceneGpu) -> VkResult<Self> {
         let layout = DescriptorSetLayout::new(
             ctx,
             &[
@@ -167,11 +148,6 @@ impl Composite {
             ],
         )?;
         let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_storage_image(bindings::WP_BINDING_CAUSTICS, caustics)
-            .write_storage_image(bindings::WP_BINDING_GBUFFER_POSITION, &gbuffer.position)
-            .write_storage_image(bindings::WP_BINDING_GBUFFER_NORMAL, &gbuffer.normal)
-            .write_storage_image(bindings::WP_BINDING_GBUFFER_ALBEDO, &gbuffer.albedo)
-            .write_storage_image(bindings::WP_BINDING_RADIANCE, radiance);
         let pipeline = ComputePipeline::new(
             ctx,
             "water_photons/composite.comp",
@@ -193,22 +169,16 @@ impl Composite {
         gbuffer: &GBuffer,
         radiance: &Image,
     ) {
-        let ctx = rec.ctx().clone();
-        rec.pass("caustic composite", |cmd| {
-            // The splat's attachment writes and the direct pass's radiance
-            // writes before this read-modify-write.
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(caustics, Access::ComputeRead),
-                    ImageAccess::new(&gbuffer.position, Access::ComputeRead),
-                    ImageAccess::new(&gbuffer.normal, Access::ComputeRead),
-                    ImageAccess::new(&gbuffer.albedo, Access::ComputeRead),
-                    ImageAccess::new(radiance, Access::ComputeWrite),
-                ],
-                &[],
-            );
+        // The splat's attachment writes and the direct pass's radiance
+        // writes before this read-modify-write.
+        let set = &self.set;
+        rec.pass("caustic composite")
+            .storage_image(set, bindings::WP_BINDING_CAUSTICS, caustics, Access::ComputeRead)
+            .storage_image(set, bindings::WP_BINDING_GBUFFER_POSITION, &gbuffer.position, Access::ComputeRead)
+            .storage_image(set, bindings::WP_BINDING_GBUFFER_NORMAL, &gbuffer.normal, Access::ComputeRead)
+            .storage_image(set, bindings::WP_BINDING_GBUFFER_ALBEDO, &gbuffer.albedo, Access::ComputeRead)
+            .storage_image(set, bindings::WP_BINDING_RADIANCE, radiance, Access::ComputeWrite)
+            .record(|cmd| {
             let e = radiance.extent();
             let groups = [e.width.div_ceil(8), e.height.div_ceil(8), 1];
             self.pipeline

@@ -13,11 +13,7 @@ use super::WpParamsBuffer;
 use crate::cascades::CascadeLayout;
 use crate::frame::SceneGpu;
 use super::bindings;
-use crate::vk::{
-    barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline, Context,
-    DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageAccess, ImageDesc, VkResult,
-    MAX_FRAMES_IN_FLIGHT,
-};
+use crate::vk::{step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageDesc, MAX_FRAMES_IN_FLIGHT, VkResult};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
@@ -102,8 +98,6 @@ impl Trace {
         ctx: &Arc<Context>,
         scene_gpu: &SceneGpu,
         params: &WpParamsBuffer,
-        ccm_position: &Image,
-        ccm_normal: &Image,
         layout_c: &CascadeLayout,
         capacity: u32,
     ) -> VkResult<Self> {
@@ -155,11 +149,8 @@ impl Trace {
         )?;
         let set = DescriptorSet::new(ctx, &layout)?;
         set.write_buffer(bindings::WP_BINDING_PARAMS, &params.0)
-            .write_storage_image(bindings::WP_BINDING_CCM_POSITION, ccm_position)
-            .write_storage_image(bindings::WP_BINDING_CCM_NORMAL, ccm_normal)
             .write_buffer(bindings::WP_BINDING_PHOTONS, &photons)
-            .write_buffer(bindings::WP_BINDING_DRAW, &draw)
-            .write_storage_image(bindings::WP_BINDING_PHOTON_SLOTS, &slots);
+            .write_buffer(bindings::WP_BINDING_DRAW, &draw);
         let pipeline = ComputePipeline::new(
             ctx,
             "water_photons/trace.comp",
@@ -203,19 +194,16 @@ impl Trace {
         let ctx = rec.ctx().clone();
         self.last_slot.set(rec.slot());
         let readback = &self.readbacks[rec.slot()];
-        rec.pass("photon trace", |cmd| {
-            // Reset by a transfer write, after last frame's indirect read
-            // and copy (write-after-read).
-            // The slots are cleared the same way, after last frame's
-            // water view read them: a texel that sends no photon this
-            // frame (and the inner texels of cascades ≥ 1, never written)
-            // must read "none".
-            barrier(
-                &ctx,
-                cmd,
-                &[ImageAccess::discard(&self.slots, Access::TransferWrite)],
-                &[BufferAccess::new(&self.draw, Access::TransferWrite)],
-            );
+        // Reset by a transfer write, after last frame's indirect read
+        // and copy (write-after-read).
+        // The slots are cleared the same way, after last frame's
+        // water view read them: a texel that sends no photon this
+        // frame (and the inner texels of cascades ≥ 1, never written)
+        // must read "none".
+        rec.pass("photon reset")
+            .overwrite(&self.slots, Access::TransferWrite)
+            .write(&self.draw, Access::TransferWrite)
+            .record(|cmd| {
             let reset = DrawCounters {
                 vertex_count: 4,
                 ..Zeroable::zeroed()
@@ -241,23 +229,19 @@ impl Trace {
                     &[all_layers],
                 );
             };
-            // The reset before the atomics; the CCM attachments before the
-            // storage-image reads; the photon slots after last frame's
-            // vertex reads; the BVH after any refit.
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(ccm_position, Access::ComputeRead),
-                    ImageAccess::new(ccm_normal, Access::ComputeRead),
-                    ImageAccess::new(&self.slots, Access::ComputeWrite),
-                ],
-                &[
-                    BufferAccess::new(&self.draw, Access::ComputeWrite),
-                    BufferAccess::new(&self.photons, Access::ComputeWrite),
-                    BufferAccess::new(&scene.triangles, Access::ComputeRead),
-                ],
-            );
+        });
+        // The reset before the atomics; the CCM attachments before the
+        // storage-image reads; the photons after last frame's vertex reads;
+        // the BVH after any refit.
+        let set = &self.set;
+        rec.pass("photon trace")
+            .storage_image(set, bindings::WP_BINDING_CCM_POSITION, ccm_position, Access::ComputeRead)
+            .storage_image(set, bindings::WP_BINDING_CCM_NORMAL, ccm_normal, Access::ComputeRead)
+            .storage_image(set, bindings::WP_BINDING_PHOTON_SLOTS, &self.slots, Access::ComputeWrite)
+            .write(&self.draw, Access::ComputeWrite)
+            .write(&self.photons, Access::ComputeWrite)
+            .read(&scene.triangles, Access::ComputeRead)
+            .record(|cmd| {
             let per_row = (bindings::WP_TRACE_GROUP_SIZE * bindings::WP_TRACE_GROUPS_PER_ROW) as u64;
             let groups = if self.threads <= per_row {
                 [
@@ -273,28 +257,18 @@ impl Trace {
                 ]
             };
             self.pipeline
-                .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
+                .dispatch(cmd, &[&scene.set, set], &[], groups);
             // The atomics done, the counts go to the host...
-            barrier(
-                &ctx,
-                cmd,
-                &[],
-                &[
-                    BufferAccess::new(&self.draw, Access::TransferRead),
-                    BufferAccess::new(readback, Access::TransferWrite),
-                ],
-            );
+            step(&ctx, cmd)
+                .read(&self.draw, Access::TransferRead)
+                .write(readback, Access::TransferWrite)
+                .emit();
             let region = vk::BufferCopy::default().size(self.draw.size);
             unsafe {
                 ctx.device
                     .cmd_copy_buffer(cmd, self.draw.raw, readback.raw, &[region])
             };
-            barrier(
-                &ctx,
-                cmd,
-                &[],
-                &[BufferAccess::new(readback, Access::HostRead)],
-            );
+            step(&ctx, cmd).read(readback, Access::HostRead).emit();
         });
     }
 }

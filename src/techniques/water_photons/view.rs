@@ -12,31 +12,21 @@ use crate::frame::{FrameTargets, SceneGpu};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::specular_gbuffer::SpecularGBuffer;
 use super::bindings;
-use crate::vk::{
-    TargetBinding,
-    barrier, Access, BindingKind, Buffer, BufferAccess, ComputePipeline, Context, DescriptorSet,
-    DescriptorSetLayout, FrameRecorder, Image, ImageAccess, VkResult,
-};
+use crate::vk::{Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, VkResult};
 use std::sync::Arc;
 
 pub struct WaterView {
     pipeline: ComputePipeline,
     set: DescriptorSet,
-    bound_radiance: TargetBinding,
     _layout: DescriptorSetLayout,
 }
 
 impl WaterView {
-    #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: &Arc<Context>,
         scene_gpu: &SceneGpu,
         params: &WpParamsBuffer,
         photons: &Buffer,
-        slots: &Image,
-        opaque: &Image,
-        opaque_gbuffer: &GBuffer,
-        specular: &SpecularGBuffer,
     ) -> VkResult<Self> {
         let layout = DescriptorSetLayout::new(
             ctx,
@@ -54,13 +44,7 @@ impl WaterView {
         )?;
         let set = DescriptorSet::new(ctx, &layout)?;
         set.write_buffer(bindings::WP_BINDING_PARAMS, &params.0)
-            .write_buffer(bindings::WP_BINDING_PHOTONS, photons)
-            .write_storage_image(bindings::WP_BINDING_PHOTON_SLOTS, slots)
-            .write_storage_image(bindings::WP_BINDING_OPAQUE_RADIANCE, opaque)
-            .write_storage_image(bindings::WP_BINDING_GBUFFER_POSITION, &opaque_gbuffer.position)
-            .write_storage_image(bindings::WP_BINDING_FRONT_POSITION, &specular.front_position)
-            .write_storage_image(bindings::WP_BINDING_FRONT_NORMAL, &specular.front_normal)
-            .write_storage_image(bindings::WP_BINDING_BACK_POSITION, &specular.back_position);
+            .write_buffer(bindings::WP_BINDING_PHOTONS, photons);
         let pipeline = ComputePipeline::new(
             ctx,
             "water_photons/view.comp",
@@ -70,7 +54,6 @@ impl WaterView {
         Ok(Self {
             pipeline,
             set,
-            bound_radiance: TargetBinding::new(bindings::WP_BINDING_RADIANCE),
             _layout: layout,
         })
     }
@@ -90,31 +73,25 @@ impl WaterView {
         specular: &SpecularGBuffer,
         targets: &FrameTargets,
     ) {
-        self.bound_radiance.bind(rec, &self.set, &targets.radiance);
-        let ctx = rec.ctx().clone();
-        rec.pass("water view", |cmd| {
-            // The trace's photon and slot writes, the composite's radiance
-            // writes and the refraction pass's radiance writes (this pass
-            // rewrites some of its pixels: write after write) before these
-            // reads; the specular G-buffer's attachments were made visible
-            // to compute by the refraction pass's barrier.
-            barrier(
-                &ctx,
-                cmd,
-                &[
-                    ImageAccess::new(slots, Access::ComputeRead),
-                    ImageAccess::new(opaque, Access::ComputeRead),
-                    ImageAccess::new(&opaque_gbuffer.position, Access::ComputeRead),
-                    ImageAccess::new(&specular.front_position, Access::ComputeRead),
-                    ImageAccess::new(&specular.front_normal, Access::ComputeRead),
-                    ImageAccess::new(&specular.back_position, Access::ComputeRead),
-                    ImageAccess::new(&targets.radiance, Access::ComputeWrite),
-                ],
-                &[BufferAccess::new(photons, Access::ComputeRead)],
-            );
+        // The trace's photon and slot writes, the composite's radiance
+        // writes and the refraction pass's radiance writes (this pass
+        // rewrites some of its pixels: write after write) before these
+        // reads; the specular G-buffer's attachments were made visible
+        // to compute by the refraction pass's barrier.
+        let set = &self.set;
+        rec.pass("water view")
+            .storage_image(set, bindings::WP_BINDING_PHOTON_SLOTS, slots, Access::ComputeRead)
+            .storage_image(set, bindings::WP_BINDING_OPAQUE_RADIANCE, opaque, Access::ComputeRead)
+            .storage_image(set, bindings::WP_BINDING_GBUFFER_POSITION, &opaque_gbuffer.position, Access::ComputeRead)
+            .storage_image(set, bindings::WP_BINDING_FRONT_POSITION, &specular.front_position, Access::ComputeRead)
+            .storage_image(set, bindings::WP_BINDING_FRONT_NORMAL, &specular.front_normal, Access::ComputeRead)
+            .storage_image(set, bindings::WP_BINDING_BACK_POSITION, &specular.back_position, Access::ComputeRead)
+            .storage_image(set, bindings::WP_BINDING_RADIANCE, &targets.radiance, Access::ComputeWrite)
+            .read(photons, Access::ComputeRead)
+            .record(|cmd| {
             let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
             self.pipeline
-                .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
+                .dispatch(cmd, &[&scene.set, set], &[], groups);
         });
     }
 }
