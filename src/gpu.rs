@@ -5,7 +5,7 @@
 
 use crate::scene::{
     Density, Emitter, EmitterShape, Light, LightKind, Material, MaterialKind, Medium, Triangle,
-    Wave,
+    Wave, Wrap,
 };
 use crate::shader_bindings as b;
 use bytemuck::{Pod, Zeroable};
@@ -61,7 +61,8 @@ pub struct GpuMaterial {
     pub color: [f32; 4],
     /// rgb absorption (1/m); w = ior.
     pub absorption_ior: [f32; 4],
-    /// x = albedo texture layer (int bits, -1: none); yz = uv_scale; w = alpha
+    /// x = albedo texture layer in bits 0-15 and the wrap modes of u and v
+    /// (WRAP_*) in bits 16-17 and 18-19 (int bits, -1: none); yz = uv_scale; w = alpha
     /// cutoff (0: opaque). A diffuse albedo is `color.rgb` times the layer at
     /// `uv * uv_scale`; where the layer's alpha is below the cutoff the
     /// surface is cut out.
@@ -252,10 +253,19 @@ impl GpuMaterial {
             MaterialKind::Mirror => b::MATERIAL_MIRROR,
             MaterialKind::Dielectric => b::MATERIAL_DIELECTRIC,
         };
+        let wrap_code = |w: Wrap| match w {
+            Wrap::Repeat => b::WRAP_REPEAT,
+            Wrap::ClampToEdge => b::WRAP_CLAMP_TO_EDGE,
+            Wrap::MirroredRepeat => b::WRAP_MIRRORED_REPEAT,
+        };
+        // The layer in bits 0-15 (the array holds far fewer), the wrap
+        // modes above it; -1 (all bits) without a texture.
         let (layer, uv_scale, alpha_cutoff) = match m.texture {
-            Some(t) if m.kind == MaterialKind::Diffuse => {
-                (t.index as i32, t.uv_scale, t.alpha_cutoff)
-            }
+            Some(t) if m.kind == MaterialKind::Diffuse => (
+                (t.index | wrap_code(t.wrap[0]) << 16 | wrap_code(t.wrap[1]) << 18) as i32,
+                t.uv_scale,
+                t.alpha_cutoff,
+            ),
             _ => (-1, glam::Vec2::ONE, 0.0),
         };
         Self {

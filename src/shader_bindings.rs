@@ -35,6 +35,12 @@ pub const MATERIAL_DIFFUSE: u32 = 0;
 pub const MATERIAL_MIRROR: u32 = 1;
 pub const MATERIAL_DIELECTRIC: u32 = 2;
 
+// Texture wrap modes (glTF sampler wrapS/wrapT), packed per axis into
+// GpuMaterial.texture.x above the layer (bits 16-17: u, 18-19: v).
+pub const WRAP_REPEAT: u32 = 0;
+pub const WRAP_CLAMP_TO_EDGE: u32 = 1;
+pub const WRAP_MIRRORED_REPEAT: u32 = 2;
+
 // Light kinds (GpuLight.position.w as uint bits).
 pub const LIGHT_POINT: u32 = 0;
 pub const LIGHT_SPOT: u32 = 1;

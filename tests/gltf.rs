@@ -10,7 +10,7 @@ mod common;
 use caustics::params::{ParamSet, Params};
 use caustics::renderer::Renderer;
 use caustics::scene::gltf::{self as loader, LUMENS_PER_WATT};
-use caustics::scene::{shapes, LightKind, MaterialKind, Mesh, Scene};
+use caustics::scene::{shapes, LightKind, MaterialKind, Mesh, Scene, Wrap};
 use caustics::techniques;
 use common::*;
 use glam::{Mat4, Quat, Vec2, Vec3};
@@ -504,6 +504,107 @@ size = [6.0, 6.0]
         assert_eq!(m.uv_scale, Vec2::ONE, "{name}: the transform is in the UVs");
         let worst = max_diff(&reference, &render_direct(scene));
         eprintln!("{name}: direct 32², max difference {worst}, peak {peak}");
+        assert!(worst <= 1e-5, "{name}: max difference {worst}, peak {peak}");
+    }
+}
+
+/// An 8 x 8 PNG of distinct, asymmetric grey codes, and its texel `(x, y)`
+/// as a code.
+fn asymmetric_code(x: u32, y: u32) -> u8 {
+    ((37 * x + 91 * y * y + 13) % 200 + 30) as u8
+}
+
+fn png_of(side: u32, code: impl Fn(u32, u32) -> u8) -> Vec<u8> {
+    let img = image::RgbImage::from_fn(side, side, |x, y| {
+        let c = code(x, y);
+        image::Rgb([c, c, c])
+    });
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
+    bytes.into_inner()
+}
+
+/// glTF sampler wrap modes: a floor whose 8² texture is read over UVs
+/// beyond [0, 1] with MIRRORED_REPEAT (or CLAMP_TO_EDGE) renders the same
+/// `direct` image as a floor reading, inside (0, 1) with REPEAT, a 32²
+/// texture that holds those mirrored (or edge-extended) texels explicitly,
+/// texel for texel (the UV maps line the two texel grids up; the camera
+/// looks straight down so every lookup magnifies, level 0). The same file
+/// with REPEAT differs, so the comparison can fail.
+#[test]
+fn sampler_wrap_modes_match_explicitly_wrapped_textures() {
+    let dir = temp_dir("wrap");
+    let floor = shapes::plane(Vec3::ZERO, Vec3::Y, None, [6.0, 6.0]);
+    // Each file: one image, one sampler, a KHR_texture_transform on the
+    // floor's [0, 1]² UVs (uv' = scale uv + offset).
+    let write = |name: &str, png: &[u8], wrap: u32, scale: f32, offset: f32| {
+        let mut g = Gltf::new();
+        g.root["images"] = json!([{"bufferView": g.view(png), "mimeType": "image/png"}]);
+        g.root["samplers"] = json!([{"wrapS": wrap, "wrapT": wrap, "magFilter": 9729}]);
+        g.root["textures"] = json!([{"source": 0, "sampler": 0}]);
+        g.root["extensionsUsed"] = json!(["KHR_texture_transform"]);
+        let mat = g.material(json!({"name": "floor", "pbrMetallicRoughness": {
+            "metallicFactor": 0.0,
+            "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform":
+                {"scale": [scale, scale], "offset": [offset, offset]}}}}}));
+        let mesh = g.mesh(&floor, true, Some(mat));
+        let uvs = g.vec2s(&floor.uvs);
+        g.root["meshes"][mesh]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uvs);
+        g.root_node(json!({"mesh": mesh}));
+        let path = g.write_glb(&dir, name);
+        let text = format!(
+            "[camera]\neye = [0.0, 8.0, 0.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 0.0, -1.0]\n\
+             [[light]]\nkind = \"point\"\nposition = [1.0, 4.0, 2.0]\nintensity = 30.0\n\
+             [[object]]\nshape = \"gltf\"\npath = \"{}\"\n",
+            path.file_name().unwrap().to_str().unwrap()
+        );
+        Scene::from_str(&text, &dir.join(format!("{name}.toml"))).unwrap()
+    };
+    let small = png_of(8, asymmetric_code);
+    const REPEAT: u32 = 10497;
+    const CLAMP: u32 = 33071;
+    const MIRROR: u32 = 33648;
+    // Floor UV w in [0, 1]. Small texture: uv = 2 w + o, texel coordinate
+    // 8 uv; big one (32²): uv = w / 2 + 1/4, texel coordinate 32 uv, which
+    // is the small one's plus `shift` texels, away from its own seams.
+    let mirrored = |i: u32| {
+        let m = (i + 16 - 8) % 16;
+        if m < 8 {
+            m
+        } else {
+            15 - m
+        }
+    };
+    let clamped = |i: u32| (i as i32 - 12).clamp(0, 7) as u32;
+    let cases: [(&str, u32, f32, &dyn Fn(u32) -> u32); 2] = [
+        ("mirrored", MIRROR, 0.0, &mirrored),
+        ("clamped", CLAMP, -0.5, &clamped),
+    ];
+    for (name, wrap, offset, explicit) in cases {
+        let wrapped = write(name, &small, wrap, 2.0, offset);
+        let t = wrapped.materials[0].texture.expect("textured");
+        assert_eq!(
+            t.wrap,
+            [if wrap == MIRROR {
+                Wrap::MirroredRepeat
+            } else {
+                Wrap::ClampToEdge
+            }; 2]
+        );
+        let big = png_of(32, |x, y| asymmetric_code(explicit(x), explicit(y)));
+        let expected = render_direct(write(&format!("{name}_explicit"), &big, REPEAT, 0.5, 0.25));
+        let repeated = render_direct(write(
+            &format!("{name}_repeat"),
+            &small,
+            REPEAT,
+            2.0,
+            offset,
+        ));
+        let peak = expected.iter().copied().fold(0.0f32, f32::max);
+        let worst = max_diff(&expected, &render_direct(wrapped));
+        let repeat_diff = max_diff(&expected, &repeated);
+        eprintln!("{name}: max difference {worst} (repeat instead: {repeat_diff}), peak {peak}");
+        assert!(repeat_diff > 0.1 * peak, "{name}: repeat should differ");
         assert!(worst <= 1e-5, "{name}: max difference {worst}, peak {peak}");
     }
 }

@@ -162,6 +162,21 @@ pub struct AlbedoTexture {
     /// alpha is below it the surface is absent from every pass (camera and
     /// shadow rasterisation, every traced ray). 0: opaque.
     pub alpha_cutoff: f32,
+    /// How u and v outside [0, 1] (after `uv_scale`) map into the texture
+    /// (glTF sampler `wrapS`, `wrapT`; TOML and MTL textures repeat).
+    pub wrap: [Wrap; 2],
+}
+
+/// A texture's wrap mode along one axis (glTF sampler `wrapS`/`wrapT`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Wrap {
+    /// fract(u): tiles.
+    #[default]
+    Repeat,
+    /// clamp(u, 0, 1): the edge texels extend.
+    ClampToEdge,
+    /// Every other tile mirrored: 1 - |1 - (u mod 2)|.
+    MirroredRepeat,
 }
 
 /// A decoded image: linear RGB per texel (8-bit files decoded from sRGB,

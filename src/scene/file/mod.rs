@@ -342,5 +342,6 @@ fn albedo_texture(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Option<Al
         index,
         uv_scale,
         alpha_cutoff,
+        wrap: [Wrap::Repeat; 2],
     }))
 }
