@@ -252,6 +252,7 @@ impl GpuMaterial {
             MaterialKind::Diffuse => b::MATERIAL_DIFFUSE,
             MaterialKind::Mirror => b::MATERIAL_MIRROR,
             MaterialKind::Dielectric => b::MATERIAL_DIELECTRIC,
+            MaterialKind::ThinDielectric => b::MATERIAL_THIN_DIELECTRIC,
         };
         let wrap_code = |w: Wrap| match w {
             Wrap::Repeat => b::WRAP_REPEAT,

@@ -34,6 +34,7 @@ pub const EMITTER_SPHERE: u32 = 1;
 pub const MATERIAL_DIFFUSE: u32 = 0;
 pub const MATERIAL_MIRROR: u32 = 1;
 pub const MATERIAL_DIELECTRIC: u32 = 2;
+pub const MATERIAL_THIN_DIELECTRIC: u32 = 3;
 
 // Texture wrap modes (glTF sampler wrapS/wrapT), packed per axis into
 // GpuMaterial.texture.x above the layer (bits 16-17: u, 18-19: v).

@@ -66,6 +66,10 @@ pub enum MaterialKind {
     Diffuse,
     Mirror,
     Dielectric,
+    /// A thin dielectric sheet (a window pane, glTF thin-walled
+    /// transmission): Fresnel at both faces, the inter-reflections between
+    /// them summed, no net deflection (`radiometry::thin_sheet_reflectance`).
+    ThinDielectric,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -74,7 +78,7 @@ pub struct Material {
     pub kind: MaterialKind,
     /// Diffuse: albedo. Mirror: reflectance per channel. Dielectric: unused (1).
     pub color: Vec3,
-    /// Dielectric: index of refraction (>= 1). Others: 1.
+    /// Dielectric, thin dielectric: index of refraction (>= 1). Others: 1.
     pub ior: f32,
     /// Dielectric: Beer-Lambert absorption coefficient inside, 1/m. Others: 0.
     pub absorption: Vec3,

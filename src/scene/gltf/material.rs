@@ -89,15 +89,15 @@ pub(super) fn convert_material(
                 "the base colour {base} tinting the transmission is not applied"
             ));
         }
+        let ior = m.ior().unwrap_or(1.5);
+        out.ior = if ior >= 1.0 {
+            ior
+        } else {
+            notes.push(format!("ior {ior} below 1 rendered as 1.5"));
+            1.5
+        };
         match m.volume().filter(|v| v.thickness_factor() > 0.0) {
             Some(v) => {
-                let ior = m.ior().unwrap_or(1.5);
-                out.ior = if ior >= 1.0 {
-                    ior
-                } else {
-                    notes.push(format!("ior {ior} below 1 rendered as 1.5"));
-                    1.5
-                };
                 // KHR_materials_volume: transmittance over attenuationDistance
                 // d is attenuationColor c, so Beer-Lambert σa = -ln(c)/d
                 // (an infinite distance, the default, absorbs nothing).
@@ -107,15 +107,9 @@ pub(super) fn convert_material(
                     out.absorption = Vec3::new(-c.x.ln(), -c.y.ln(), -c.z.ln()) / d;
                 }
             }
-            None => {
-                // Thin-walled (the glTF default without a volume): a sheet
-                // with Fresnel at both faces and no net deflection. The
-                // nearest supported material keeps its geometry optics: a
-                // dielectric of ior 1 lets light through undeflected (it
-                // drops the sheet's ~8% Fresnel reflection).
-                out.ior = 1.0;
-                notes.push("thin-walled transmission (no KHR_materials_volume) rendered as a dielectric of ior 1: undeflected, without the sheet's Fresnel reflection".to_owned());
-            }
+            // Thin-walled (the glTF default without a volume): a sheet with
+            // Fresnel at both faces and no net deflection.
+            None => out.kind = MaterialKind::ThinDielectric,
         }
     } else if metallic >= 0.5 {
         if metallic < 1.0 {
