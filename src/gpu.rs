@@ -4,8 +4,8 @@
 //! offsets, and the GLSL side mirrors the same field order.
 
 use crate::scene::{
-    Density, Emitter, EmitterShape, Light, LightKind, Material, MaterialKind, Medium, Triangle,
-    Wave, Wrap,
+    Density, Emitter, EmitterShape, Light, LightKind, Material, MaterialKind, Medium, Scene,
+    Triangle, Wave, Wrap,
 };
 use crate::shader_bindings as b;
 use bytemuck::{Pod, Zeroable};
@@ -77,11 +77,13 @@ pub struct GpuMaterial {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuEmitter {
-    /// xyz centre; w = kind (EMITTER_RECT / EMITTER_SPHERE, uint bits).
+    /// xyz centre (triangle: vertex 0); w = kind (EMITTER_*, uint bits).
     pub position: [f32; 4],
-    /// xyz unit normal (rect: the side it emits to); w = width (rect) or radius (sphere).
+    /// xyz unit normal (rect: the side it emits to; triangle: the edge to
+    /// vertex 1); w = width (rect), radius (sphere) or area (triangle).
     pub normal: [f32; 4],
-    /// xyz unit tangent, the direction of the width (rect); w = height (rect).
+    /// xyz unit tangent, the direction of the width (rect; triangle: the
+    /// edge to vertex 2); w = height (rect).
     pub tangent: [f32; 4],
     /// rgb radiance; w = power (luminance, W) for light selection.
     pub radiance: [f32; 4],
@@ -320,6 +322,29 @@ impl GpuLight {
 }
 
 impl GpuEmitter {
+    /// Every triangle of `triangles` (world space) whose material emits and
+    /// that is not an area light's own geometry (which its rect or sphere
+    /// record samples): an EMITTER_TRIANGLE record of power π L A, emitting
+    /// from its front face (the side `cross(p1 - p0, p2 - p0)` points to, as
+    /// `hit_geometric_normal`).
+    pub fn emissive_triangles(scene: &Scene, triangles: &[Triangle]) -> Vec<Self> {
+        triangles
+            .iter()
+            .filter(|t| !scene.emitters.iter().any(|e| e.object == t.object))
+            .filter_map(|t| {
+                let l = scene.materials.get(t.material as usize)?.emission;
+                let [p0, p1, p2] = t.positions;
+                let area = 0.5 * (p1 - p0).cross(p2 - p0).length();
+                (l.max_element() > 0.0 && area > 0.0).then(|| Self {
+                    position: v4(p0, f32::from_bits(b::EMITTER_TRIANGLE)),
+                    normal: v4(p1 - p0, area),
+                    tangent: v4(p2 - p0, 0.0),
+                    radiance: v4(l, (l * std::f32::consts::PI * area).dot(LUMINANCE)),
+                })
+            })
+            .collect()
+    }
+
     pub fn new(e: &Emitter) -> Self {
         let power = crate::environment::emitter_power(e).dot(LUMINANCE);
         let radiance = v4(e.radiance, power);

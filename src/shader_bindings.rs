@@ -29,6 +29,9 @@ pub const BINDING_ENVIRONMENT_DATA: u32 = 11;
 // Area light kinds (GpuEmitter.position.w as uint bits).
 pub const EMITTER_RECT: u32 = 0;
 pub const EMITTER_SPHERE: u32 = 1;
+/// An emissive triangle (a glTF `emissiveFactor`): position = vertex 0,
+/// normal.xyz = edge to vertex 1, tangent.xyz = edge to vertex 2.
+pub const EMITTER_TRIANGLE: u32 = 2;
 
 // Material kinds (GpuMaterial.color.w as uint bits).
 pub const MATERIAL_DIFFUSE: u32 = 0;

@@ -86,8 +86,10 @@ pub struct Material {
     /// surface's UV (docs/SCENES.md, "Albedo textures").
     pub texture: Option<AlbedoTexture>,
     /// Radiance (W m^-2 sr^-1) emitted from the front faces (the side the
-    /// geometric normal points to): non-zero only on an area light's own
-    /// material (black diffuse, `Emitter`).
+    /// geometric normal points to): non-zero on an area light's own
+    /// material (black diffuse, `Emitter`) and on a glTF emissive diffuse
+    /// material, whose every triangle is then an area light of its own
+    /// (`GpuEmitter::emissive_triangles`).
     pub emission: Vec3,
 }
 

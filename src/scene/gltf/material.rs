@@ -55,11 +55,14 @@ pub(super) fn convert_material(
             notes.push("alphaMode BLEND is not supported: rendered opaque".to_owned())
         }
     }
-    let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
-    if emission.max_element() > 0.0 {
-        notes.push(format!(
-            "emissive {emission} is not rendered (no area emitters yet)"
-        ));
+    // Emission: emissiveFactor × emissiveStrength is a luminance in cd/m²
+    // (KHR_materials_emissive_strength); the lights' luminous efficacy
+    // turns it into radiance, W m^-2 sr^-1 = (cd/m²) / LUMENS_PER_WATT.
+    let mut emission = Vec3::from(m.emissive_factor()).max(Vec3::ZERO)
+        * m.emissive_strength().unwrap_or(1.0).max(0.0)
+        / LUMENS_PER_WATT;
+    if emission.max_element() > 0.0 && m.emissive_texture().is_some() {
+        notes.push("emissiveTexture is not applied: the factor emits uniformly".to_owned());
     }
     let mut out = Material {
         texture: None,
@@ -132,6 +135,13 @@ pub(super) fn convert_material(
             "metallic {metallic} rendered as a non-metal (diffuse)"
         ));
     }
+    if emission.max_element() > 0.0 && out.kind != MaterialKind::Diffuse {
+        notes.push(format!(
+            "emission {emission} W m^-2 sr^-1 on a specular material is not rendered (only diffuse surfaces emit)"
+        ));
+        emission = Vec3::ZERO;
+    }
+    out.emission = emission;
     if matches!(coverage, Coverage::Mask(_)) && out.kind != MaterialKind::Diffuse {
         notes.push(
             "alphaMode MASK cut-outs apply to diffuse materials only: rendered opaque".to_owned(),
