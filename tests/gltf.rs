@@ -706,6 +706,57 @@ size = [6.0, 6.0]
     }
 }
 
+/// Only `direct` and the reference render a thin dielectric sheet and an
+/// emissive glTF surface; every other technique refuses the scene in its
+/// `check_scene`, naming the material, and `--technique auto` falls back
+/// to `direct`. A bad `thin_dielectric` is one error naming the field.
+#[test]
+fn other_techniques_refuse_sheets_and_emissive_surfaces() {
+    let dir = temp_dir("refuse");
+    let mut g = Gltf::new();
+    let mat = g.material(json!({"name": "glow", "emissiveFactor": [1.0, 1.0, 1.0],
+        "pbrMetallicRoughness": {"metallicFactor": 0.0}}));
+    let mesh = g.mesh(&quad(), true, Some(mat));
+    g.root_node(json!({"mesh": mesh}));
+    g.write_glb(&dir, "glow");
+    let head = SCENE_HEAD;
+    let sheet = format!(
+        "{head}\n[[material]]\nname = \"pane\"\nkind = \"thin_dielectric\"\nior = 1.5\n\
+         [[object]]\nshape = \"plane\"\nmaterial = \"pane\"\ncenter = [0.0, 1.0, 0.0]\nsize = [1.0, 1.0]\n"
+    );
+    let glow = format!("{head}\n[[object]]\nshape = \"gltf\"\npath = \"glow.glb\"\n");
+    for (text, material) in [(sheet, "pane"), (glow, "glow.glb:glow")] {
+        let scene = Scene::from_str(&text, &dir.join("s.toml")).unwrap();
+        for t in techniques::TECHNIQUES {
+            let result = (t.check_scene)(&scene);
+            if t.name == "direct" {
+                assert!(result.is_ok(), "direct: {result:?}");
+                continue;
+            }
+            let e = result.expect_err(t.name).to_string();
+            assert!(
+                e.contains(&format!("`{material}`"))
+                    && e.contains(t.name)
+                    && e.contains("use `direct` or `reference`"),
+                "{}: {e}",
+                t.name
+            );
+        }
+        assert_eq!(techniques::auto(&scene), "direct");
+    }
+    for (bad, field) in [
+        ("ior = 0.5", "material[1].ior"),
+        ("absorption = 1.0", "material[1]"),
+    ] {
+        let text = format!(
+            "{SCENE_HEAD}\n[[material]]\nname = \"pane\"\nkind = \"thin_dielectric\"\n{bad}\n"
+        );
+        let e = Scene::from_str(&text, &dir.join("bad.toml")).unwrap_err();
+        assert_eq!(e.to_string().lines().count(), 1, "{e}");
+        assert!(e.to_string().contains(field), "{e}");
+    }
+}
+
 // ------------------------------------------------------------ transforms
 
 const SIZE: u32 = 32;
