@@ -581,9 +581,11 @@ fn sampler_wrap_modes_match_explicitly_wrapped_textures() {
         }
     };
     let clamped = |i: u32| (i as i32 - 12).clamp(0, 7) as u32;
-    let cases: [(&str, u32, f32, &dyn Fn(u32) -> u32); 2] = [
-        ("mirrored", MIRROR, 0.0, &mirrored),
-        ("clamped", CLAMP, -0.5, &clamped),
+    // Name, wrap mode, UV offset, the big texture's texel -> the small one's.
+    type Case = (&'static str, u32, f32, fn(u32) -> u32);
+    let cases: [Case; 2] = [
+        ("mirrored", MIRROR, 0.0, mirrored),
+        ("clamped", CLAMP, -0.5, clamped),
     ];
     for (name, wrap, offset, explicit) in cases {
         let wrapped = write(name, &small, wrap, 2.0, offset);
