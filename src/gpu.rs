@@ -4,8 +4,8 @@
 //! offsets, and the GLSL side mirrors the same field order.
 
 use crate::scene::{
-    Density, Emitter, EmitterShape, Light, LightKind, Material, MaterialKind, Medium, Triangle,
-    Wave,
+    Density, Emitter, EmitterShape, Light, LightKind, Material, MaterialKind, Medium, Scene,
+    Triangle, Wave, Wrap,
 };
 use crate::shader_bindings as b;
 use bytemuck::{Pod, Zeroable};
@@ -61,7 +61,8 @@ pub struct GpuMaterial {
     pub color: [f32; 4],
     /// rgb absorption (1/m); w = ior.
     pub absorption_ior: [f32; 4],
-    /// x = albedo texture layer (int bits, -1: none); yz = uv_scale; w = alpha
+    /// x = albedo texture layer in bits 0-15 and the wrap modes of u and v
+    /// (WRAP_*) in bits 16-17 and 18-19 (int bits, -1: none); yz = uv_scale; w = alpha
     /// cutoff (0: opaque). A diffuse albedo is `color.rgb` times the layer at
     /// `uv * uv_scale`; where the layer's alpha is below the cutoff the
     /// surface is cut out.
@@ -76,11 +77,13 @@ pub struct GpuMaterial {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuEmitter {
-    /// xyz centre; w = kind (EMITTER_RECT / EMITTER_SPHERE, uint bits).
+    /// xyz centre (triangle: vertex 0); w = kind (EMITTER_*, uint bits).
     pub position: [f32; 4],
-    /// xyz unit normal (rect: the side it emits to); w = width (rect) or radius (sphere).
+    /// xyz unit normal (rect: the side it emits to; triangle: the edge to
+    /// vertex 1); w = width (rect), radius (sphere) or area (triangle).
     pub normal: [f32; 4],
-    /// xyz unit tangent, the direction of the width (rect); w = height (rect).
+    /// xyz unit tangent, the direction of the width (rect; triangle: the
+    /// edge to vertex 2); w = height (rect).
     pub tangent: [f32; 4],
     /// rgb radiance; w = power (luminance, W) for light selection.
     pub radiance: [f32; 4],
@@ -251,11 +254,21 @@ impl GpuMaterial {
             MaterialKind::Diffuse => b::MATERIAL_DIFFUSE,
             MaterialKind::Mirror => b::MATERIAL_MIRROR,
             MaterialKind::Dielectric => b::MATERIAL_DIELECTRIC,
+            MaterialKind::ThinDielectric => b::MATERIAL_THIN_DIELECTRIC,
         };
+        let wrap_code = |w: Wrap| match w {
+            Wrap::Repeat => b::WRAP_REPEAT,
+            Wrap::ClampToEdge => b::WRAP_CLAMP_TO_EDGE,
+            Wrap::MirroredRepeat => b::WRAP_MIRRORED_REPEAT,
+        };
+        // The layer in bits 0-15 (the array holds far fewer), the wrap
+        // modes above it; -1 (all bits) without a texture.
         let (layer, uv_scale, alpha_cutoff) = match m.texture {
-            Some(t) if m.kind == MaterialKind::Diffuse => {
-                (t.index as i32, t.uv_scale, t.alpha_cutoff)
-            }
+            Some(t) if m.kind == MaterialKind::Diffuse => (
+                (t.index | wrap_code(t.wrap[0]) << 16 | wrap_code(t.wrap[1]) << 18) as i32,
+                t.uv_scale,
+                t.alpha_cutoff,
+            ),
             _ => (-1, glam::Vec2::ONE, 0.0),
         };
         Self {
@@ -309,6 +322,29 @@ impl GpuLight {
 }
 
 impl GpuEmitter {
+    /// Every triangle of `triangles` (world space) whose material emits and
+    /// that is not an area light's own geometry (which its rect or sphere
+    /// record samples): an EMITTER_TRIANGLE record of power π L A, emitting
+    /// from its front face (the side `cross(p1 - p0, p2 - p0)` points to, as
+    /// `hit_geometric_normal`).
+    pub fn emissive_triangles(scene: &Scene, triangles: &[Triangle]) -> Vec<Self> {
+        triangles
+            .iter()
+            .filter(|t| !scene.emitters.iter().any(|e| e.object == t.object))
+            .filter_map(|t| {
+                let l = scene.materials.get(t.material as usize)?.emission;
+                let [p0, p1, p2] = t.positions;
+                let area = 0.5 * (p1 - p0).cross(p2 - p0).length();
+                (l.max_element() > 0.0 && area > 0.0).then(|| Self {
+                    position: v4(p0, f32::from_bits(b::EMITTER_TRIANGLE)),
+                    normal: v4(p1 - p0, area),
+                    tangent: v4(p2 - p0, 0.0),
+                    radiance: v4(l, (l * std::f32::consts::PI * area).dot(LUMINANCE)),
+                })
+            })
+            .collect()
+    }
+
     pub fn new(e: &Emitter) -> Self {
         let power = crate::environment::emitter_power(e).dot(LUMINANCE);
         let radiance = v4(e.radiance, power);

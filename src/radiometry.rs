@@ -46,15 +46,45 @@ pub fn light_power(light: &Light, scene_radius: f32) -> Vec3 {
 /// `cos_i` the cosine of the incident angle, `eta` = n_incident / n_transmitted.
 /// Returns 1 under total internal reflection.
 pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
+    let [s, p] = fresnel_polarised(cos_i, eta);
+    0.5 * (s + p)
+}
+
+/// Fresnel reflectance of the s and p polarisations (perpendicular and
+/// parallel to the plane of incidence), as [`fresnel_dielectric`].
+pub fn fresnel_polarised(cos_i: f32, eta: f32) -> [f32; 2] {
     let cos_i = cos_i.abs().min(1.0);
     let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
     if sin2_t >= 1.0 {
-        return 1.0;
+        return [1.0; 2];
     }
     let cos_t = (1.0 - sin2_t).sqrt();
     let r_s = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
     let r_p = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    0.5 * (r_s * r_s + r_p * r_p)
+    [r_s * r_s, r_p * r_p]
+}
+
+/// Reflectance of a thin dielectric sheet of index `ior` in air (a
+/// `thin_dielectric` material) for light arriving at cos θ = `cos_i`; it
+/// transmits the rest, undeflected. Derivation (incoherent, a sheet much
+/// thicker than the light's coherence length, no absorption): each face
+/// reflects r and transmits t = 1 − r of one polarisation, the same r at
+/// the inner face (the Fresnel equations are symmetric in the two angles,
+/// the Stokes relations). Light bounces between the faces: reflected r,
+/// then t·r·t, t·r³·t, …; transmitted t·t, t·r²·t, …, so
+///     R_sheet = r + t² r / (1 − r²) = 2r / (1 + r),
+///     T_sheet = t² / (1 − r²) = (1 − r) / (1 + r),
+/// with R_sheet + T_sheet = 1. The two polarisations do not mix at
+/// parallel faces, so the series is summed for each and the two averaged
+/// (unpolarised light). Both faces parallel: Snell's law twice gives back
+/// the incident direction, with a lateral shift of the order of the
+/// thickness, which a sheet of zero thickness has not. (pbrt-v4, Pharr,
+/// Jakob & Humphreys 2023, §9.5.2 "Thin Dielectric BSDF", sums the same
+/// series on the unpolarised reflectance.) glsl/common/optics.glsl
+/// `thin_sheet_reflectance` is the same function.
+pub fn thin_sheet_reflectance(cos_i: f32, ior: f32) -> f32 {
+    let [s, p] = fresnel_polarised(cos_i, 1.0 / ior);
+    0.5 * (2.0 * s / (1.0 + s) + 2.0 * p / (1.0 + p))
 }
 
 /// Henyey-Greenstein phase function, normalised over the sphere (1/(4 pi) at g = 0).
@@ -155,6 +185,22 @@ mod tests {
             1.0,
             "total internal reflection"
         );
+    }
+
+    /// At normal incidence both polarisations reflect r = ((n-1)/(n+1))²
+    /// and the sheet 2r/(1+r) (0.0769 for n = 1.5: the two faces' 4% each,
+    /// less what the second face cannot reflect); ior 1 reflects nothing;
+    /// at grazing incidence everything.
+    #[test]
+    fn thin_sheet_sums_the_inter_reflections() {
+        let r = (0.5f32 / 2.5).powi(2);
+        assert!((thin_sheet_reflectance(1.0, 1.5) - 2.0 * r / (1.0 + r)).abs() < 1e-6);
+        // The series itself: r + t² r Σ r^2k.
+        let t = 1.0 - r;
+        let series: f32 = r + (0..20).map(|k| t * t * r * r.powi(2 * k)).sum::<f32>();
+        assert!((thin_sheet_reflectance(1.0, 1.5) - series).abs() < 1e-6);
+        assert_eq!(thin_sheet_reflectance(0.7, 1.0), 0.0);
+        assert!(thin_sheet_reflectance(1e-4, 1.5) > 0.99);
     }
 
     #[test]

@@ -29,11 +29,21 @@ pub const BINDING_ENVIRONMENT_DATA: u32 = 11;
 // Area light kinds (GpuEmitter.position.w as uint bits).
 pub const EMITTER_RECT: u32 = 0;
 pub const EMITTER_SPHERE: u32 = 1;
+/// An emissive triangle (a glTF `emissiveFactor`): position = vertex 0,
+/// normal.xyz = edge to vertex 1, tangent.xyz = edge to vertex 2.
+pub const EMITTER_TRIANGLE: u32 = 2;
 
 // Material kinds (GpuMaterial.color.w as uint bits).
 pub const MATERIAL_DIFFUSE: u32 = 0;
 pub const MATERIAL_MIRROR: u32 = 1;
 pub const MATERIAL_DIELECTRIC: u32 = 2;
+pub const MATERIAL_THIN_DIELECTRIC: u32 = 3;
+
+// Texture wrap modes (glTF sampler wrapS/wrapT), packed per axis into
+// GpuMaterial.texture.x above the layer (bits 16-17: u, 18-19: v).
+pub const WRAP_REPEAT: u32 = 0;
+pub const WRAP_CLAMP_TO_EDGE: u32 = 1;
+pub const WRAP_MIRRORED_REPEAT: u32 = 2;
 
 // Light kinds (GpuLight.position.w as uint bits).
 pub const LIGHT_POINT: u32 = 0;

@@ -82,22 +82,21 @@ vec3 sample_environment_table(vec2 u, out float pdf) {
     return environment_to_world(equirect_dir(uv));
 }
 
-// Unoccluded irradiance at x (normal n) from rect area light `em`:
-// Lambert's polygon formula, E = L/2 |sum_i Theta_i (n . gamma_i)| with
-// Theta_i the angle edge i subtends at x and gamma_i the unit normal of the
-// plane through x and that edge (Arvo 1995, "Applications of Irradiance
-// Tensors to the Simulation of Non-Lambertian Phenomena", Sect. 3), after
-// clipping the rect to the receiver's upper half-space; 0 behind the
-// emitting side. Exact.
-vec3 rect_irradiance(Emitter em, vec3 x, vec3 n) {
-    vec3 c = em.position.xyz, nr = em.normal.xyz, t = em.tangent.xyz;
-    if (dot(x - c, nr) <= 0.0) return vec3(0.0);
-    vec3 hu = t * (0.5 * em.normal.w), hv = cross(nr, t) * (0.5 * em.tangent.w);
-    vec3 q[4] = vec3[4](c - hu - hv - x, c + hu - hv - x, c + hu + hv - x, c - hu + hv - x);
+// Unoccluded irradiance at x (normal n) from a Lambertian polygon of
+// radiance `radiance`, its `count` (3 or 4) corners q relative to x,
+// emitting to the side `nr` points to: Lambert's polygon formula,
+// E = L/2 |sum_i Theta_i (n . gamma_i)| with Theta_i the angle edge i
+// subtends at x and gamma_i the unit normal of the plane through x and
+// that edge (Arvo 1995, "Applications of Irradiance Tensors to the
+// Simulation of Non-Lambertian Phenomena", Sect. 3), after clipping the
+// polygon to the receiver's upper half-space; 0 behind the emitting side.
+// Exact.
+vec3 polygon_irradiance(vec3 q[4], int count, vec3 nr, vec3 radiance, vec3 n) {
+    if (dot(-q[0], nr) <= 0.0) return vec3(0.0);
     vec3 p[8];
     int m = 0;
-    for (int i = 0; i < 4; ++i) {
-        vec3 a = q[i], b = q[(i + 1) % 4];
+    for (int i = 0; i < count; ++i) {
+        vec3 a = q[i], b = q[(i + 1) % count];
         float da = dot(a, n), db = dot(b, n);
         if (da >= 0.0) p[m++] = a;
         if ((da >= 0.0) != (db >= 0.0)) p[m++] = a + (b - a) * (da / (da - db));
@@ -110,7 +109,22 @@ vec3 rect_irradiance(Emitter em, vec3 x, vec3 n) {
         if (len < 1e-12) continue;
         sum += atan(len, dot(a, b)) * dot(g / len, n);
     }
-    return em.radiance.rgb * (0.5 * abs(sum));
+    return radiance * (0.5 * abs(sum));
+}
+
+// Rect area light `em` (polygon_irradiance).
+vec3 rect_irradiance(Emitter em, vec3 x, vec3 n) {
+    vec3 c = em.position.xyz, nr = em.normal.xyz, t = em.tangent.xyz;
+    vec3 hu = t * (0.5 * em.normal.w), hv = cross(nr, t) * (0.5 * em.tangent.w);
+    vec3 q[4] = vec3[4](c - hu - hv - x, c + hu - hv - x, c + hu + hv - x, c - hu + hv - x);
+    return polygon_irradiance(q, 4, nr, em.radiance.rgb, n);
+}
+
+// Emissive triangle `em` (EMITTER_TRIANGLE; polygon_irradiance).
+vec3 triangle_irradiance(Emitter em, vec3 x, vec3 n) {
+    vec3 p0 = em.position.xyz - x, e1 = em.normal.xyz, e2 = em.tangent.xyz;
+    vec3 q[4] = vec3[4](p0, p0 + e1, p0 + e2, p0);
+    return polygon_irradiance(q, 3, normalize(cross(e1, e2)), em.radiance.rgb, n);
 }
 
 // Unoccluded irradiance at x (normal n) from sphere light `em`: a
@@ -131,10 +145,18 @@ vec3 sphere_irradiance(Emitter em, vec3 x, vec3 n) {
 // go before it would meet the light's own geometry.
 vec3 emitter_irradiance(uint e, vec3 x, vec3 n, out vec3 to_light, out float reach) {
     Emitter em = emitters[e];
+    uint kind = floatBitsToUint(em.position.w);
+    if (kind == EMITTER_TRIANGLE) {
+        vec3 v = em.position.xyz + (em.normal.xyz + em.tangent.xyz) / 3.0 - x; // to the centroid
+        float d = length(v);
+        to_light = v / max(d, 1e-30);
+        reach = d * (1.0 - 1e-3);
+        return triangle_irradiance(em, x, n);
+    }
     vec3 v = em.position.xyz - x;
     float d = length(v);
     to_light = v / max(d, 1e-30);
-    if (floatBitsToUint(em.position.w) == EMITTER_RECT) {
+    if (kind == EMITTER_RECT) {
         reach = d * (1.0 - 1e-3);
         return rect_irradiance(em, x, n);
     }

@@ -8,14 +8,32 @@ const float PI = 3.14159265358979323846;
 
 // Unpolarised Fresnel reflectance; cos_i = |cos| of the incident angle,
 // eta = n_incident / n_transmitted. 1 under total internal reflection.
-float fresnel_dielectric(float cos_i, float eta) {
+// Fresnel reflectance of the s and p polarisations (x, y), as below.
+vec2 fresnel_polarised(float cos_i, float eta) {
     cos_i = min(abs(cos_i), 1.0);
     float sin2_t = eta * eta * (1.0 - cos_i * cos_i);
-    if (sin2_t >= 1.0) return 1.0;
+    if (sin2_t >= 1.0) return vec2(1.0);
     float cos_t = sqrt(1.0 - sin2_t);
     float rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
     float rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    return 0.5 * (rs * rs + rp * rp);
+    return vec2(rs * rs, rp * rp);
+}
+
+float fresnel_dielectric(float cos_i, float eta) {
+    vec2 r = fresnel_polarised(cos_i, eta);
+    return 0.5 * (r.x + r.y);
+}
+
+// Reflectance of a thin dielectric sheet of index `ior` in air, light
+// arriving at |cos| = cos_i; the rest passes straight through. Per
+// polarisation the inter-reflections between the two faces sum to
+// R = r + t^2 r / (1 - r^2) = 2r / (1 + r), T = (1 - r) / (1 + r);
+// averaged over s and p. Derivation and citation: src/radiometry.rs
+// `thin_sheet_reflectance`.
+float thin_sheet_reflectance(float cos_i, float ior) {
+    vec2 r = fresnel_polarised(cos_i, 1.0 / ior);
+    vec2 sheet = 2.0 * r / (1.0 + r);
+    return 0.5 * (sheet.x + sheet.y);
 }
 
 // Snell's law: d incident (unit), n the normal on the incident side

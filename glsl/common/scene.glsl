@@ -35,7 +35,7 @@ struct BvhNode {
 struct Material {
     vec4 color;          // rgb albedo/reflectance; w: kind (uint bits)
     vec4 absorption_ior; // rgb absorption 1/m; w: ior
-    vec4 albedo_texture; // x: texture array layer (int bits, -1: none); yz: uv_scale; w: alpha cutoff
+    vec4 albedo_texture; // x: layer in bits 0-15, wrap u/v (WRAP_*) in bits 16-17/18-19 (int bits, -1: none); yz: uv_scale; w: alpha cutoff
     vec4 emission;       // rgb radiance emitted from front faces (area lights)
 };
 
@@ -100,7 +100,8 @@ layout(set = SCENE_SET, binding = BINDING_LIGHTS, std430) readonly buffer LightB
 layout(set = SCENE_SET, binding = BINDING_MEDIUM, std430) readonly buffer MediumBlock { Medium medium; };
 layout(set = SCENE_SET, binding = BINDING_DENSITY_GRID, std430) readonly buffer DensityBlock { float density_grid[]; };
 layout(set = SCENE_SET, binding = BINDING_TRIANGLE_UVS, std430) readonly buffer TriangleUvBlock { TriangleUv triangle_uvs[]; };
-// Every albedo texture, one layer each (src/frame/textures.rs): trilinear, repeat wrap.
+// Every albedo texture, one layer each (src/frame/textures.rs): trilinear,
+// repeat wrap (other wrap modes: material_texture_coordinate).
 layout(set = SCENE_SET, binding = BINDING_ALBEDO_TEXTURES) uniform sampler2DArray albedo_textures;
 layout(set = SCENE_SET, binding = BINDING_EMITTERS, std430) readonly buffer EmitterBlock { Emitter emitters[]; };
 // The environment's equirectangular radiance (linear, bilinear; glsl/common/emitters.glsl).
@@ -122,15 +123,51 @@ vec2 triangle_uv(uint tri, vec2 b) {
     return (1.0 - b.x - b.y) * t.uv01.xy + b.x * t.uv01.zw + b.y * t.uv2.xy;
 }
 
+// Material m's texture array layer (-1: none).
+int material_layer(uint m) {
+    int packed = floatBitsToInt(materials[m].albedo_texture.x);
+    return packed < 0 ? -1 : packed & 0xffff;
+}
+
+// One texture coordinate through wrap mode `wrap` (WRAP_*; glTF sampler
+// wrapS/wrapT): repeat is the sampler's own; clamp-to-edge and mirrored
+// repeat fold the coordinate into [0, 1] here and then keep it `margin`
+// inside the edges, so the repeat sampler's bilinear taps never reach
+// across to the opposite edge.
+float wrap_coordinate(float u, uint wrap, float margin) {
+    if (wrap == WRAP_REPEAT) return u;
+    if (wrap == WRAP_MIRRORED_REPEAT) u = 1.0 - abs(1.0 - mod(u, 2.0));
+    return clamp(u, margin, 1.0 - margin);
+}
+
+// The array coordinate of material m's texture at `uv` (times uv_scale,
+// wrapped). `lod` is the mip level the lookup filters at: the clamp margin
+// is half a texel of the coarser level a trilinear lookup reads, exact
+// there and within a texel of the finer one.
+vec3 material_texture_coordinate(uint m, vec2 uv, float lod) {
+    int packed = floatBitsToInt(materials[m].albedo_texture.x);
+    uvec2 wrap = (uvec2(packed) >> uvec2(16u, 18u)) & 3u;
+    vec2 st = uv * materials[m].albedo_texture.yz;
+    if (wrap != uvec2(WRAP_REPEAT)) {
+        float margin = 0.5 * exp2(ceil(max(lod, 0.0))) / float(textureSize(albedo_textures, 0).x);
+        st = vec2(wrap_coordinate(st.x, wrap.x, margin), wrap_coordinate(st.y, wrap.y, margin));
+    }
+    return vec3(st, float(packed & 0xffff));
+}
+
 // Albedo of diffuse material m at `uv`: its colour times its texture (if
-// any) at uv * uv_scale, filtered over the footprint given by the UV
-// derivatives across a pixel (docs/SCENES.md, "Albedo textures").
+// any) at uv * uv_scale, wrapped, filtered over the footprint given by the
+// UV derivatives across a pixel (docs/SCENES.md, "Albedo textures").
 vec3 material_albedo_grad(uint m, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
     vec3 c = materials[m].color.rgb;
-    int layer = floatBitsToInt(materials[m].albedo_texture.x);
-    if (layer < 0) return c;
+    if (material_layer(m) < 0) return c;
     vec2 s = materials[m].albedo_texture.yz;
-    return c * textureGrad(albedo_textures, vec3(uv * s, float(layer)), duv_dx * s, duv_dy * s).rgb;
+    vec2 dx = duv_dx * s, dy = duv_dy * s;
+    // The level the lookup reads (the larger footprint axis, as the
+    // Vulkan spec's isotropic LOD): only to size the clamp margin.
+    float size = float(textureSize(albedo_textures, 0).x);
+    float lod = log2(max(max(length(dx), length(dy)) * size, 1e-30));
+    return c * textureGrad(albedo_textures, material_texture_coordinate(m, uv, lod), dx, dy).rgb;
 }
 
 // The same at the finest mip level (bilinear): for ray hits, which have no
@@ -148,9 +185,7 @@ vec3 material_albedo(uint m, vec2 uv) {
 bool material_cut_out(uint m, vec2 uv) {
     float cutoff = materials[m].albedo_texture.w;
     if (cutoff <= 0.0) return false;
-    int layer = floatBitsToInt(materials[m].albedo_texture.x);
-    vec2 s = materials[m].albedo_texture.yz;
-    return textureLod(albedo_textures, vec3(uv * s, float(layer)), 0.0).a < cutoff;
+    return textureLod(albedo_textures, material_texture_coordinate(m, uv, 0.0), 0.0).a < cutoff;
 }
 
 bool triangle_cut_out(uint tri, vec2 b) {

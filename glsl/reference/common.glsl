@@ -107,7 +107,8 @@ struct SpecularState {
     vec3 inside_absorption;  // that dielectric's absorption, 1/m
 };
 
-// Reflects at a mirror or reflects/refracts at a dielectric (exact Fresnel;
+// Reflects at a mirror, reflects or passes a thin dielectric sheet, or
+// reflects/refracts at a dielectric (exact Fresnel;
 // reflection chosen with probability F keeps the weight unchanged; total
 // internal reflection always reflects). `front`: the ray arrived on the side
 // the geometric normal `ng` points to. Smooth shading normals can bend a new
@@ -127,6 +128,20 @@ void specular_bounce(inout SpecularState s, vec3 x, vec3 ng, vec3 ns, bool front
         vec3 r = reflect(s.dir, ns_in);
         s.dir = dot(r, ng_in) > 0.0 ? r : reflect(s.dir, ng_in);
         s.origin = offset_origin(x, ng_in);
+        return;
+    }
+    if (kind == MATERIAL_THIN_DIELECTRIC) {
+        // A thin sheet (optics.glsl thin_sheet_reflectance): reflected with
+        // probability R_sheet (about the shading normal, as a mirror), else
+        // through undeflected; in and out of one medium, so no (n_t/n_i)^2.
+        vec3 n = ns_in;
+        if (u < thin_sheet_reflectance(dot(s.dir, n), m.absorption_ior.w)) {
+            vec3 r = reflect(s.dir, n);
+            s.dir = dot(r, ng_in) > 0.0 ? r : reflect(s.dir, ng_in);
+            s.origin = offset_origin(x, ng_in);
+        } else {
+            s.origin = offset_origin(x, -ng_in);
+        }
         return;
     }
     float ior = m.absorption_ior.w;

@@ -92,15 +92,25 @@ uint pick_light(float u, out float probability) {
 
 // Emits a photon from area light `e`: a point uniform over its area (pdf
 // 1/A) and a cosine-weighted direction about its normal there (pdf
-// cos/pi), so every photon carries the power pi L A (rect: one-sided;
-// sphere: A = 4 pi r^2, outward at every point).
+// cos/pi), so every photon carries the power pi L A (rect and triangle:
+// one-sided, the triangle's front being the side cross(p1-p0, p2-p0)
+// points to; sphere: A = 4 pi r^2, outward at every point).
 void emit_area(uint e, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) {
     Emitter em = emitters[e];
     vec2 u = vec2(rng_next(rng), rng_next(rng));
     vec2 v = vec2(rng_next(rng), rng_next(rng));
     vec3 n;
     float area;
-    if (floatBitsToUint(em.position.w) == EMITTER_RECT) {
+    uint kind = floatBitsToUint(em.position.w);
+    if (kind == EMITTER_TRIANGLE) {
+        // Uniform over the triangle: barycentrics (1 - sqrt(u1),
+        // sqrt(u1) (1 - u2), sqrt(u1) u2) (Shirley's warp, pdf 1/A).
+        vec3 e1 = em.normal.xyz, e2 = em.tangent.xyz;
+        n = normalize(cross(e1, e2));
+        float su = sqrt(u.x);
+        origin = em.position.xyz + e1 * (su * (1.0 - u.y)) + e2 * (su * u.y);
+        area = em.normal.w;
+    } else if (kind == EMITTER_RECT) {
         n = em.normal.xyz;
         vec3 t = em.tangent.xyz;
         vec3 b = cross(n, t);

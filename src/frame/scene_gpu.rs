@@ -173,7 +173,10 @@ impl SceneGpu {
         let albedo_textures = AlbedoTextures::new(ctx, &scene.textures)?;
         let nodes_buf = Buffer::with_data(ctx, "bvh nodes", &bvh.nodes, storage)?;
         let materials_buf = Buffer::with_data(ctx, "materials", &materials, storage)?;
+        // The area lights, then the emissive triangles (at `time`: an
+        // animated one's records stay where it was then).
         let mut emitters: Vec<GpuEmitter> = scene.emitters.iter().map(GpuEmitter::new).collect();
+        emitters.extend(GpuEmitter::emissive_triangles(scene, &triangles));
         let emitter_count = emitters.len() as u32;
         if emitters.is_empty() {
             emitters.push(bytemuck::Zeroable::zeroed());

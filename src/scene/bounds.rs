@@ -13,6 +13,11 @@ use super::Scene;
 /// for a translation plus an orbit plus a bob.
 pub const MAX_WORLD_EXTENT: f32 = 1e7;
 
+/// Most emissive triangles (glTF `emissiveFactor`) one object may hold: each
+/// is an area light of its own, which `direct` gives a shadow ray per pixel
+/// and the reference's light selection scans.
+pub const MAX_EMISSIVE_TRIANGLES: usize = 1024;
+
 impl Scene {
     /// Checks the scene at `time` (seconds): every object's transform
     /// finite and its vertices within [`MAX_WORLD_EXTENT`] of the origin,
@@ -55,6 +60,21 @@ impl Scene {
                     field,
                     format!(
                         "`{}` reaches {far:e} m from the origin at time {time} s, beyond {MAX_WORLD_EXTENT:e} m",
+                        o.name
+                    ),
+                ));
+            }
+            let emissive = mesh
+                .materials
+                .iter()
+                .filter(|&&m| self.materials[m as usize].emission.max_element() > 0.0)
+                .count();
+            let area_light = self.emitters.iter().any(|e| e.object as usize == i);
+            if !area_light && emissive > MAX_EMISSIVE_TRIANGLES {
+                return Err(at(
+                    format!("object[{i}]"),
+                    format!(
+                        "`{}` has {emissive} emissive triangles, at most {MAX_EMISSIVE_TRIANGLES} (each is an area light)",
                         o.name
                     ),
                 ));

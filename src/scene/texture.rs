@@ -134,12 +134,20 @@ pub fn layer_size(textures: &[Texture]) -> u32 {
 /// 2x2 box average of the one before, down to 1x1. RGBA (alpha 1 without
 /// one in the file), rows top to bottom. Filtering happens on linear values,
 /// as it must for radiometry; alpha is coverage, filtered the same way.
+///
+/// With alpha (cut-outs), colour is filtered **coverage-weighted**
+/// (premultiplied: colour = Σ α c / Σ α), so a texel on a cut-out's edge
+/// takes the colour of its kept part only; and every texel without
+/// coverage whose neighbours have some takes their coverage-weighted
+/// colour ([`dilate_into_transparent`]), so the shader's bilinear taps
+/// across the edge blend no colour of the cut-away texels into what stays.
 pub fn mip_chain(texture: &Texture, size: u32) -> Vec<Vec<[f32; 4]>> {
-    let flat: Vec<f32> = texture
+    let has_alpha = !texture.alpha.is_empty();
+    let straight: Vec<[f32; 4]> = texture
         .texels
         .iter()
         .enumerate()
-        .flat_map(|(i, t)| {
+        .map(|(i, t)| {
             [
                 t[0],
                 t[1],
@@ -148,15 +156,29 @@ pub fn mip_chain(texture: &Texture, size: u32) -> Vec<Vec<[f32; 4]>> {
             ]
         })
         .collect();
-    let image = Rgba32FImage::from_raw(texture.width, texture.height, flat)
-        .expect("texel count matches the size");
-    let level0 = if (texture.width, texture.height) == (size, size) {
-        image
-    } else {
+    let resize = |texels: Vec<[f32; 4]>| -> Vec<[f32; 4]> {
+        if (texture.width, texture.height) == (size, size) {
+            return texels;
+        }
+        let flat: Vec<f32> = texels.into_iter().flatten().collect();
+        let image = Rgba32FImage::from_raw(texture.width, texture.height, flat)
+            .expect("texel count matches the size");
         imageops::resize(&image, size, size, FilterType::Triangle)
+            .pixels()
+            .map(|p| p.0)
+            .collect()
     };
-    let mut levels = vec![level0.pixels().map(|p| p.0).collect::<Vec<_>>()];
-    let mut side = size as usize;
+    let side = size as usize;
+    let mut level0 = resize(straight.clone());
+    if has_alpha {
+        let weighted = resize(straight.iter().map(|&t| premultiply(t)).collect());
+        for (t, w) in level0.iter_mut().zip(&weighted) {
+            *t = unpremultiply(*w, *t);
+        }
+        dilate_into_transparent(&mut level0, side);
+    }
+    let mut levels = vec![level0];
+    let mut side = side;
     while side > 1 {
         let prev = levels.last().expect("level 0 exists");
         let half = side / 2;
@@ -164,19 +186,71 @@ pub fn mip_chain(texture: &Texture, size: u32) -> Vec<Vec<[f32; 4]>> {
         for y in 0..half {
             for x in 0..half {
                 let mut sum = [0.0f32; 4];
+                let mut weighted = [0.0f32; 4];
                 for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
                     let t = prev[(2 * y + dy) * side + 2 * x + dx];
+                    let w = premultiply(t);
                     for c in 0..4 {
                         sum[c] += 0.25 * t[c];
+                        weighted[c] += 0.25 * w[c];
                     }
                 }
-                next.push(sum);
+                next.push(if has_alpha {
+                    unpremultiply(weighted, sum)
+                } else {
+                    sum
+                });
             }
+        }
+        if has_alpha {
+            dilate_into_transparent(&mut next, half);
         }
         levels.push(next);
         side = half;
     }
     levels
+}
+
+fn premultiply(t: [f32; 4]) -> [f32; 4] {
+    [t[0] * t[3], t[1] * t[3], t[2] * t[3], t[3]]
+}
+
+/// Straight colour from a premultiplied average `w`; where it has no
+/// coverage, the plain average `fallback`.
+fn unpremultiply(w: [f32; 4], fallback: [f32; 4]) -> [f32; 4] {
+    if w[3] > 0.0 {
+        [w[0] / w[3], w[1] / w[3], w[2] / w[3], w[3]]
+    } else {
+        [fallback[0], fallback[1], fallback[2], 0.0]
+    }
+}
+
+/// Gives every texel of coverage 0 that has a covered texel among its 8
+/// neighbours (wrapping around, as the repeat sampler does) the
+/// coverage-weighted colour of those neighbours; its alpha stays 0. One
+/// ring is what a bilinear tap reaches.
+fn dilate_into_transparent(texels: &mut [[f32; 4]], side: usize) {
+    let source = texels.to_vec();
+    for y in 0..side {
+        for x in 0..side {
+            if source[y * side + x][3] > 0.0 {
+                continue;
+            }
+            let mut w = [0.0f32; 4];
+            for dy in [side - 1, 0, 1] {
+                for dx in [side - 1, 0, 1] {
+                    let n = premultiply(source[((y + dy) % side) * side + (x + dx) % side]);
+                    for c in 0..4 {
+                        w[c] += n[c];
+                    }
+                }
+            }
+            if w[3] > 0.0 {
+                let t = &mut texels[y * side + x];
+                *t = [w[0] / w[3], w[1] / w[3], w[2] / w[3], 0.0];
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -275,6 +349,66 @@ mod tests {
                     assert!((a - b).abs() < 1e-6, "{t:?}");
                 }
             }
+        }
+    }
+
+    /// A cut-out's mip chain weights colour by coverage: a texture whose
+    /// left half is red and kept, right half green and cut away, keeps no
+    /// green anywhere a bilinear tap of any level can reach from the kept
+    /// half (before the fix: level 2 was (0.5, 0.5, 0), half green), and
+    /// coverage itself is still the plain box average.
+    #[test]
+    fn cut_out_mips_do_not_bleed_transparent_colour() {
+        let texels = (0..64)
+            .map(|i| {
+                if i % 8 < 4 {
+                    [1.0, 0.0, 0.0]
+                } else {
+                    [0.0, 1.0, 0.0]
+                }
+            })
+            .collect();
+        let mut t = texture(8, 8, texels);
+        t.alpha = (0..64).map(|i| if i % 8 < 4 { 1.0 } else { 0.0 }).collect();
+        let levels = mip_chain(&t, 8);
+        assert_eq!(levels.len(), 4);
+        for (l, level) in levels.iter().enumerate() {
+            let side = 8 >> l;
+            for (i, texel) in level.iter().enumerate() {
+                let x = i % side;
+                let covered = |x: usize| x < side / 2;
+                let alpha = if side == 1 {
+                    0.5
+                } else {
+                    covered(x) as u32 as f32
+                };
+                assert_eq!(texel[3], alpha, "level {l} texel {i}");
+                // Covered texels by weighting, transparent ones next to a
+                // covered one (wrapping) by dilation: the kept colour.
+                let reached = side == 1
+                    || covered(x)
+                    || covered((x + 1) % side)
+                    || covered((x + side - 1) % side);
+                if reached {
+                    assert_eq!(&texel[..3], &[1.0, 0.0, 0.0], "level {l} texel {i}");
+                }
+            }
+        }
+        // Partial coverage: weights 1 and 1/3 give (3 c1 + c2) / 4.
+        let mut t = texture(
+            2,
+            2,
+            vec![
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+            ],
+        );
+        t.alpha = vec![1.0, 1.0 / 3.0, 1.0, 1.0 / 3.0];
+        let top = &mip_chain(&t, 2)[1][0];
+        for (a, b) in top.iter().zip([0.75, 0.25, 0.0, 2.0 / 3.0]) {
+            assert!((a - b).abs() < 1e-6, "{top:?}");
         }
     }
 }

@@ -66,6 +66,10 @@ pub enum MaterialKind {
     Diffuse,
     Mirror,
     Dielectric,
+    /// A thin dielectric sheet (a window pane, glTF thin-walled
+    /// transmission): Fresnel at both faces, the inter-reflections between
+    /// them summed, no net deflection (`radiometry::thin_sheet_reflectance`).
+    ThinDielectric,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -74,7 +78,7 @@ pub struct Material {
     pub kind: MaterialKind,
     /// Diffuse: albedo. Mirror: reflectance per channel. Dielectric: unused (1).
     pub color: Vec3,
-    /// Dielectric: index of refraction (>= 1). Others: 1.
+    /// Dielectric, thin dielectric: index of refraction (>= 1). Others: 1.
     pub ior: f32,
     /// Dielectric: Beer-Lambert absorption coefficient inside, 1/m. Others: 0.
     pub absorption: Vec3,
@@ -82,8 +86,10 @@ pub struct Material {
     /// surface's UV (docs/SCENES.md, "Albedo textures").
     pub texture: Option<AlbedoTexture>,
     /// Radiance (W m^-2 sr^-1) emitted from the front faces (the side the
-    /// geometric normal points to): non-zero only on an area light's own
-    /// material (black diffuse, `Emitter`).
+    /// geometric normal points to): non-zero on an area light's own
+    /// material (black diffuse, `Emitter`) and on a glTF emissive diffuse
+    /// material, whose every triangle is then an area light of its own
+    /// (`GpuEmitter::emissive_triangles`).
     pub emission: Vec3,
 }
 
@@ -162,6 +168,21 @@ pub struct AlbedoTexture {
     /// alpha is below it the surface is absent from every pass (camera and
     /// shadow rasterisation, every traced ray). 0: opaque.
     pub alpha_cutoff: f32,
+    /// How u and v outside [0, 1] (after `uv_scale`) map into the texture
+    /// (glTF sampler `wrapS`, `wrapT`; TOML and MTL textures repeat).
+    pub wrap: [Wrap; 2],
+}
+
+/// A texture's wrap mode along one axis (glTF sampler `wrapS`/`wrapT`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Wrap {
+    /// fract(u): tiles.
+    #[default]
+    Repeat,
+    /// clamp(u, 0, 1): the edge texels extend.
+    ClampToEdge,
+    /// Every other tile mirrored: 1 - |1 - (u mod 2)|.
+    MirroredRepeat,
 }
 
 /// A decoded image: linear RGB per texel (8-bit files decoded from sRGB,

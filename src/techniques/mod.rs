@@ -159,6 +159,42 @@ registry! {
     pinhole::Pinhole,
 }
 
+/// Refuses, naming the first such material, what only `direct` and the
+/// reference render: a thin dielectric sheet (`thin_dielectric`; the other
+/// techniques model mirrors and solid dielectrics, and would refract
+/// through it into a solid that is not there) and an emissive surface
+/// that is not a scene area light (a glTF `emissiveFactor`: their light
+/// reaches receivers only through `direct`'s and the reference's area
+/// light sampling). Every technique but `direct` calls it from its
+/// `check_scene`.
+pub fn check_materials(scene: &Scene, technique: &str) -> anyhow::Result<()> {
+    let mut used = vec![false; scene.materials.len()];
+    for o in &scene.objects {
+        for &m in &o.mesh.materials {
+            if let Some(u) = used.get_mut(m as usize) {
+                *u = true;
+            }
+        }
+    }
+    let file = scene.source.display();
+    for (i, m) in scene.materials.iter().enumerate().filter(|&(i, _)| used[i]) {
+        if m.kind == crate::scene::MaterialKind::ThinDielectric {
+            anyhow::bail!(
+                "{file}: material `{}`: {technique} does not render thin dielectric sheets (kind = \"thin_dielectric\", glTF transmission without a volume); use `direct` or `reference`",
+                m.name
+            );
+        }
+        let area_light = scene.emitters.iter().any(|e| e.material as usize == i);
+        if m.emission.max_element() > 0.0 && !area_light {
+            anyhow::bail!(
+                "{file}: material `{}`: {technique} does not render emissive surfaces other than area lights (glTF emissiveFactor); use `direct` or `reference`",
+                m.name
+            );
+        }
+    }
+    Ok(())
+}
+
 /// `--technique auto`: the technique that renders every component `scene`
 /// has, among those that accept it (`check_scene`: e.g. image_space and
 /// volume_lines refuse sphere lights). A participating medium needs airlight

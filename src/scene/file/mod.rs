@@ -301,10 +301,18 @@ fn material(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Material> {
             }
             m.absorption = non_negative_rgb(t, "absorption", Some(Vec3::ZERO))?;
         }
+        "thin_dielectric" => {
+            t.check_keys(&["name", "kind", "ior"], "a thin dielectric material")?;
+            m.kind = MaterialKind::ThinDielectric;
+            m.ior = t.f32_or("ior", 1.5)?;
+            if m.ior < 1.0 {
+                return Err(t.err("ior", format!("must be at least 1, got {}", m.ior)));
+            }
+        }
         other => {
             return Err(t.err(
                 "kind",
-                format!("unknown material kind `{other}`; expected diffuse, mirror or dielectric"),
+                format!("unknown material kind `{other}`; expected diffuse, mirror, dielectric or thin_dielectric"),
             ))
         }
     }
@@ -342,5 +350,6 @@ fn albedo_texture(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Option<Al
         index,
         uv_scale,
         alpha_cutoff,
+        wrap: [Wrap::Repeat; 2],
     }))
 }

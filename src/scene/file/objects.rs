@@ -241,6 +241,7 @@ fn mesh_object(
             index,
             uv_scale: Vec2::ONE,
             alpha_cutoff: 0.0,
+            wrap: [Wrap::Repeat; 2],
         }))
     };
     file_object(
@@ -319,6 +320,7 @@ fn gltf_object(
             index: materials.add_texture(t.pixels.clone()),
             uv_scale: Vec2::ONE,
             alpha_cutoff: t.alpha_cutoff,
+            wrap: t.wrap,
         }))
     };
     file_object(

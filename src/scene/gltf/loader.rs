@@ -312,6 +312,7 @@ impl Loader<'_> {
             scale = Vec2::from(t.scale());
             tex_coord = t.tex_coord().unwrap_or(tex_coord);
         }
+        let sampler = texture.sampler();
         if tex_coord != 0 {
             let at = m.index().map_or("the default material".to_owned(), |i| {
                 format!("materials[{i}]")
@@ -338,6 +339,11 @@ impl Loader<'_> {
             rotation,
             scale,
             alpha_cutoff: 0.0,
+            wrap: [sampler.wrap_s(), sampler.wrap_t()].map(|w| match w {
+                WrappingMode::Repeat => Wrap::Repeat,
+                WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+                WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+            }),
         }))
     }
 

@@ -55,11 +55,14 @@ pub(super) fn convert_material(
             notes.push("alphaMode BLEND is not supported: rendered opaque".to_owned())
         }
     }
-    let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
-    if emission.max_element() > 0.0 {
-        notes.push(format!(
-            "emissive {emission} is not rendered (no area emitters yet)"
-        ));
+    // Emission: emissiveFactor × emissiveStrength is a luminance in cd/m²
+    // (KHR_materials_emissive_strength); the lights' luminous efficacy
+    // turns it into radiance, W m^-2 sr^-1 = (cd/m²) / LUMENS_PER_WATT.
+    let mut emission = Vec3::from(m.emissive_factor()).max(Vec3::ZERO)
+        * m.emissive_strength().unwrap_or(1.0).max(0.0)
+        / LUMENS_PER_WATT;
+    if emission.max_element() > 0.0 && m.emissive_texture().is_some() {
+        notes.push("emissiveTexture is not applied: the factor emits uniformly".to_owned());
     }
     let mut out = Material {
         texture: None,
@@ -89,15 +92,15 @@ pub(super) fn convert_material(
                 "the base colour {base} tinting the transmission is not applied"
             ));
         }
+        let ior = m.ior().unwrap_or(1.5);
+        out.ior = if ior >= 1.0 {
+            ior
+        } else {
+            notes.push(format!("ior {ior} below 1 rendered as 1.5"));
+            1.5
+        };
         match m.volume().filter(|v| v.thickness_factor() > 0.0) {
             Some(v) => {
-                let ior = m.ior().unwrap_or(1.5);
-                out.ior = if ior >= 1.0 {
-                    ior
-                } else {
-                    notes.push(format!("ior {ior} below 1 rendered as 1.5"));
-                    1.5
-                };
                 // KHR_materials_volume: transmittance over attenuationDistance
                 // d is attenuationColor c, so Beer-Lambert σa = -ln(c)/d
                 // (an infinite distance, the default, absorbs nothing).
@@ -107,15 +110,9 @@ pub(super) fn convert_material(
                     out.absorption = Vec3::new(-c.x.ln(), -c.y.ln(), -c.z.ln()) / d;
                 }
             }
-            None => {
-                // Thin-walled (the glTF default without a volume): a sheet
-                // with Fresnel at both faces and no net deflection. The
-                // nearest supported material keeps its geometry optics: a
-                // dielectric of ior 1 lets light through undeflected (it
-                // drops the sheet's ~8% Fresnel reflection).
-                out.ior = 1.0;
-                notes.push("thin-walled transmission (no KHR_materials_volume) rendered as a dielectric of ior 1: undeflected, without the sheet's Fresnel reflection".to_owned());
-            }
+            // Thin-walled (the glTF default without a volume): a sheet with
+            // Fresnel at both faces and no net deflection.
+            None => out.kind = MaterialKind::ThinDielectric,
         }
     } else if metallic >= 0.5 {
         if metallic < 1.0 {
@@ -138,6 +135,13 @@ pub(super) fn convert_material(
             "metallic {metallic} rendered as a non-metal (diffuse)"
         ));
     }
+    if emission.max_element() > 0.0 && out.kind != MaterialKind::Diffuse {
+        notes.push(format!(
+            "emission {emission} W m^-2 sr^-1 on a specular material is not rendered (only diffuse surfaces emit)"
+        ));
+        emission = Vec3::ZERO;
+    }
+    out.emission = emission;
     if matches!(coverage, Coverage::Mask(_)) && out.kind != MaterialKind::Diffuse {
         notes.push(
             "alphaMode MASK cut-outs apply to diffuse materials only: rendered opaque".to_owned(),

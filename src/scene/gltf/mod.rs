@@ -22,6 +22,7 @@ use super::types::*;
 use crate::shader_bindings::MAX_LIGHTS;
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::mesh::Mode;
+use ::gltf::texture::WrappingMode;
 use ::gltf::{json, Document, Semantic};
 use files::*;
 use glam::{Mat3, Mat4, Vec2, Vec3};
@@ -106,6 +107,8 @@ pub struct TextureRef {
     /// where the texture's alpha is below this (`AlbedoTexture::alpha_cutoff`);
     /// 0 for an opaque material.
     pub alpha_cutoff: f32,
+    /// The sampler's `wrapS`, `wrapT` (glTF default: repeat).
+    pub wrap: [Wrap; 2],
 }
 
 impl TextureRef {

@@ -61,7 +61,7 @@ pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError
     let mut by_path = std::collections::HashMap::new();
     for (m, t) in materials.iter_mut().zip(asset.base_color_textures) {
         let Some(t) = t else { continue };
-        let alpha_cutoff = t.alpha_cutoff;
+        let (alpha_cutoff, wrap) = (t.alpha_cutoff, t.wrap);
         let index = *by_path.entry(t.pixels.path.clone()).or_insert_with(|| {
             textures.push(t.pixels);
             textures.len() - 1
@@ -70,6 +70,7 @@ pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError
             index: index as u32,
             uv_scale: Vec2::ONE,
             alpha_cutoff,
+            wrap,
         });
     }
     let mut objects = vec![Object {

@@ -140,6 +140,11 @@ impl TechniqueBuild for Beams {
     ];
     type Params = BeamsParams;
 
+    /// Thin sheets and emissive surfaces are outside its model.
+    fn check_scene(scene: &Scene) -> anyhow::Result<()> {
+        super::check_materials(scene, Self::NAME)
+    }
+
     fn build(
         ctx: &Arc<Context>,
         params: &BeamsParams,

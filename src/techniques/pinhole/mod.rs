@@ -434,6 +434,11 @@ impl TechniqueBuild for Pinhole {
     ];
     type Params = PinholeParams;
 
+    /// Thin sheets and emissive surfaces are outside its model.
+    fn check_scene(scene: &Scene) -> anyhow::Result<()> {
+        super::check_materials(scene, Self::NAME)
+    }
+
     fn build(
         ctx: &Arc<Context>,
         params: &PinholeParams,

@@ -454,6 +454,7 @@ impl TechniqueBuild for WaterPhotons {
     /// A `water` object and a directional light (the paper's sun), named
     /// as the scene fields that lack them.
     fn check_scene(scene: &Scene) -> anyhow::Result<()> {
+        super::check_materials(scene, Self::NAME)?;
         let file = scene.source.display();
         if !scene.objects.iter().any(|o| o.water.is_some()) {
             anyhow::bail!(
