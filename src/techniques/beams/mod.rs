@@ -105,6 +105,8 @@ crate::declare_params! {
             "Gauss-Legendre points per interval of a camera ray inside a beam (Sect. 5)";
         refraction: u32 [0, 1] = 0, rebuild,
             "two-sided refraction (Sect. 6): 0 Wyman's image-space exit through the light view's back faces (the paper's approximate ray tracing), 1 exactly through the BVH (internal total reflections followed)";
+        bounces: u32 [1, 3] = 2, rebuild,
+            "specular events per beam path (Sect. 6): a beam whose edge rays all meet a further specular object ends there and spawns its reflected / refracted beams, up to this many events (1: one event, edges pass further specular surfaces)";
         tir_remedy: u32 [0, 2] = 1, rebuild,
             "total internal reflection at the approximated exit of two-sided refraction (as image_space's): 0 single refraction, 1 clamp to the critical angle, 2 reflect";
         eq_6_3_2: u32 [0, 1] = 1, rebuild,
@@ -187,6 +189,7 @@ impl TechniqueBuild for Beams {
                 tir_remedy: params.tir_remedy,
                 eq_6_3_2: params.eq_6_3_2,
                 refraction: params.refraction,
+                bounces: params.bounces,
                 extrusion_cutoff: params.extrusion_cutoff,
                 surface_filter: params.surface_filter,
                 medium_steps: params.direct.medium_steps,
