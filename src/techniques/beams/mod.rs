@@ -47,12 +47,20 @@
 //! last. Counters (beams and triangles per level, the dropped fraction,
 //! fragments) go to `bench --json` through `counters`.
 //!
-//! Not implemented (documented limits): multiple bounces through further
-//! specular surfaces (Sect. 6; an edge ray passes through them); the flux is uniform across a beam (one area function
+//! Multiple bounces (Sect. 6, `bounces`): a beam whose three edge rays
+//! meet one further specular object ends there (its extrusion, and the
+//! surface gather, stop at that surface) and spawns that surface's
+//! reflected and refracted beams (Fresnel split, refraction traced through
+//! the BVH with Beer-Lambert absorption), each child recording its parent
+//! (`GpuBeam::parent`); a beam only partly meeting it splits its triangle,
+//! and at the last level passes the object as a one-bounce beam.
+//!
+//! Limits (documented): the flux is uniform across a beam (one area function
 //! per beam, as in the paper; Fresnel and absorption factors averaged over
 //! its three vertices); the beam's base plane is normal to the mean edge
 //! direction rather than the surface triangle (an equivalent beam space
-//! that stays valid after two refractions); area lights give no caustics.
+//! that stays valid after two refractions); area lights are point stand-ins
+//! (small rects only, `check_scene`).
 
 pub mod bindings;
 mod tracer;
@@ -209,6 +217,14 @@ impl TechniqueBuild for Beams {
             airlight,
             last_counts: None,
         })
+    }
+
+    /// Area lights become point stand-ins (`environment::caustic_lights`:
+    /// a rect is a spot at its centre with the cosine profile, I = L A cos
+    /// theta, whose light view and beams are a spot's), within their size
+    /// limit; sphere lights are refused.
+    fn check_scene(scene: &Scene) -> anyhow::Result<()> {
+        crate::environment::check_stand_ins(scene, Self::NAME).map_err(anyhow::Error::msg)
     }
 }
 

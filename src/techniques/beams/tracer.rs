@@ -409,8 +409,11 @@ impl BeamTracer {
         desc.push_size = size_of::<VolumePush>() as u32;
         let volume_pipeline = GraphicsPipeline::new(ctx, &desc, &sets)?;
 
+        // The lights the views are of: the scene's, then the stand-ins of
+        // its sun and rect lights (without them the energy criterion of a
+        // stand-in's view would split every triangle).
         let view_flux = view_fluxes(
-            &scene.lights,
+            &crate::environment::caustic_lights(scene),
             crate::passes::light_views::specular_bounds(scene),
             light_view_size,
         );
