@@ -1207,19 +1207,11 @@ fn multiple_bounces_match_reference() {
 #[test]
 fn small_rect_lights_are_point_stand_ins() {
     let ctx = validated_context();
-    let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/ball_lens.toml");
-    let text = std::fs::read_to_string(&path).unwrap();
-    let point =
-        "[[light]]\nkind = \"point\"\nposition = [0.0, 8.0, 0.0]\nintensity = [60.0, 60.0, 60.0]\n";
-    assert!(text.contains(point));
-    let rect = |size: f32| {
-        format!(
-            "[[light]]\nkind = \"rect\"\ncenter = [0.0, 8.0, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [{size}, {size}]\nradiance = {}\n",
-            60.0 / (size * size)
-        )
-    };
-    let scene = |light: &str| Scene::from_str(&text.replace(point, light), &path).unwrap();
+    let (point, rect, scene) = (
+        BALL_LENS_POINT_LIGHT,
+        ball_lens_rect_light,
+        ball_lens_with_light,
+    );
     let bound = Bound {
         energy: 0.09,
         flip: 0.045,
