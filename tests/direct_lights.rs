@@ -167,18 +167,9 @@ fn water_photons_takes_the_sky_sun_as_its_directional_light() {
 fn image_space_caustics_from_a_small_rect_light() {
     use caustics::radiometry::Component;
     let ctx = validated_context();
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/ball_lens.toml");
-    let text = std::fs::read_to_string(&path).unwrap();
-    let point =
-        "[[light]]\nkind = \"point\"\nposition = [0.0, 8.0, 0.0]\nintensity = [60.0, 60.0, 60.0]\n";
-    assert!(text.contains(point));
-    let rect = |size: f32| {
-        format!(
-            "[[light]]\nkind = \"rect\"\ncenter = [0.0, 8.0, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [{size}, {size}]\nradiance = {}\n",
-            60.0 / (size * size)
-        )
-    };
-    let scene = |light: &str| Scene::from_str(&text.replace(point, light), &path).unwrap();
+    let point = BALL_LENS_POINT_LIGHT;
+    let rect = ball_lens_rect_light;
+    let scene = ball_lens_with_light;
     let params = Params::resolve(
         "image_space",
         techniques::image_space::ImageSpaceParams::specs(),

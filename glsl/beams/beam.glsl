@@ -18,9 +18,9 @@ struct Beam {
     vec4 v0;       // base vertex 0; w: y_max, the extrusion (height of the far end)
     vec4 v1;       // w: refinement level (uint bits)
     vec4 v2;       // w: BEAM_REFLECTED or BEAM_REFRACTED (uint bits)
-    vec4 e0;       // edge direction, dot(e, n) = 1
-    vec4 e1;
-    vec4 e2;
+    vec4 e0;       // edge direction, dot(e, n) = 1; w: bounce, 1 at the first specular event (uint bits)
+    vec4 e1;       // w: the parent beam's index, ~0u for the first event's (uint bits)
+    vec4 e2;       // w: > 0 where the beam ends on a further specular surface (Sect. 6): the lowest height its edges meet it
     vec4 n;        // unit normal of the base plane; w: the plane's offset dot(v_k, n)
     vec4 area;     // A(y) coefficients (m^2, signed); w: measure of the incident triangle (sr or m^2)
     vec4 flux;     // rgb: flux carried by the beam (W)
@@ -201,22 +201,31 @@ vec3 beam_inscatter(Beam b, vec3 eye, vec3 w, float t_surface, uint points, uint
 
 // --- Surface caustics (Sect. 5.3) ---------------------------------------
 
-// True if no diffuse surface lies between x and the beam's base along -d
-// over s1 (the beam reaches x). Specular surfaces are passed, as the edge
-// rays pass them (one specular event per beam), and so is the emitting
-// surface itself, which between the base vertices bulges past the base
-// plane.
-bool beam_reaches(vec3 x, vec3 d, float s1) {
+// True if no diffuse surface lies between x (at height y) and the beam's
+// base along -d over s1 (the beam reaches x). Specular surfaces are passed,
+// as the edge rays of a beam that does not bounce on pass them, and so is
+// the emitting surface itself, which between the base vertices bulges past
+// the base plane; but a beam that ends on a further specular surface
+// (Sect. 6, b.e2.w > 0: its light goes on in the child beams) is blocked
+// by specular surfaces above half the height where its edges meet it (the
+// far surface may bulge toward the base between the edges).
+bool beam_reaches(Beam b, vec3 x, float y, vec3 d, float s1) {
     vec3 o = x;
     float left = s1;
+    float y_block = b.e2.w > 0.0 ? 0.5 * b.e2.w : 1e30;
+    float dy = dot(d, b.n.xyz); // height per unit length along d
+    float back = 0.0;
     for (int i = 0; i < 16 && left > 0.0; ++i) {
         Hit h;
         if (!trace_closest(o, -d, 0.0, left, h)) return true;
         if (material_kind(hit_material(h)) == MATERIAL_DIFFUSE) return false;
+        back += h.t;
+        if (y - back * dy > y_block) return false;
         vec3 p = hit_position(h, o, -d);
         float eps = 1e-4 * max(1.0, bvh_max_abs(p));
         o = p - d * eps;
         left -= h.t + eps;
+        back += eps;
     }
     return true;
 }
@@ -237,7 +246,7 @@ vec3 beam_receiver(Beam b, vec3 x, vec3 n_r, uint steps) {
     vec3 e_perp = beam_flux_density(b, x, y, sub / total, steps, d, s1);
     float cos_r = -dot(d, n_r);
     if (cos_r <= 0.0) return vec3(0.0);
-    if (!beam_reaches(x + n_r * (1e-4 * max(1.0, bvh_max_abs(x))), d, s1)) return vec3(0.0);
+    if (!beam_reaches(b, x + n_r * (1e-4 * max(1.0, bvh_max_abs(x))), y, d, s1)) return vec3(0.0);
     return e_perp * cos_r;
 }
 

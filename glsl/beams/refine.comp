@@ -200,17 +200,34 @@ float edge_length(vec3 o, vec3 d) {
 // flipped, as after two refractions) through the exit point furthest along
 // it; the other base vertices are moved forward along their edges onto
 // that plane. y_max: the highest point where an edge ray meets a diffuse
-// surface (the extrusion length from occlusion, Sect. 4.3).
-bool make_beam(vec3 p[3], vec3 d[3], vec3 flux, vec3 incident, float measure, uint kind, out Beam beam) {
+// surface (the extrusion length from occlusion, Sect. 4.3), or, for a beam
+// that bounces on (Sect. 6), the highest of its edges' hits on the next
+// specular surface (stop[k] >= 0: the distance along d_k from p_k).
+// Set where make_beam found no beam space (the triangle is too coarse for
+// the beam's spread).
+bool beam_too_wide = false;
+
+bool make_beam(vec3 p[3], vec3 d[3], float stop[3], vec3 flux, vec3 incident, float measure, uint kind,
+               out Beam beam) {
     vec3 n = normalize(d[0] + d[1] + d[2]);
     float h = max(dot(p[0], n), max(dot(p[1], n), dot(p[2], n)));
     vec3 v[3], e[3];
     float y_max = 0.0;
+    float y_stop = 1e30; // the lowest edge hit on the next specular surface
     for (int k = 0; k < 3; ++k) {
         float c = dot(d[k], n);
-        if (c < 0.2) return false; // edges more than ~78 degrees apart: no beam space
+        if (c < 0.2) { // edges more than ~78 degrees apart: no beam space
+            beam_too_wide = true;
+            return false;
+        }
         e[k] = d[k] / c;
         v[k] = p[k] + (h - dot(p[k], n)) * e[k];
+        if (stop[k] >= 0.0) {
+            float y_hit = dot(p[k] + stop[k] * d[k], n) - h;
+            y_max = max(y_max, y_hit);
+            y_stop = min(y_stop, y_hit);
+            continue;
+        }
         float eps = 1e-4 * max(1.0, bvh_max_abs(p[k]));
         float s = edge_length(p[k] + d[k] * eps, d[k]);
         if (s > 0.0) y_max = max(y_max, dot(p[k] + (s + eps) * d[k], n) - h);
@@ -247,9 +264,9 @@ bool make_beam(vec3 p[3], vec3 d[3], vec3 flux, vec3 incident, float measure, ui
     beam.v0 = vec4(v[0], y_max * 1.001);
     beam.v1 = vec4(v[1], uintBitsToFloat(pc.grid.x));
     beam.v2 = vec4(v[2], uintBitsToFloat(kind));
-    beam.e0 = vec4(e[0], 0.0);
+    beam.e0 = vec4(e[0], 0.0); // w: bounce and parent, set by the caller
     beam.e1 = vec4(e[1], 0.0);
-    beam.e2 = vec4(e[2], 0.0);
+    beam.e2 = vec4(e[2], y_stop < 1e30 ? max(y_stop, 1e-9) : 0.0);
     beam.n = vec4(n, h);
     beam.area = vec4(area, measure);
     beam.flux = vec4(flux, 0.0);
@@ -317,15 +334,172 @@ float camera_size(Beam b) {
     return sqrt(abs(beam_area(b, y))) / max(length(x - frame.eye.xyz), 1e-6);
 }
 
-void emit(Beam b) {
+// Appends beam b; its index, or ~0u where the buffer is full. The flux
+// statistic counts the first specular event's beams only (what the light
+// sends into the kept triangles; later bounces re-split that flux).
+uint emit(Beam b) {
     uint index = atomicAdd(counters[BEAMS_COUNTER_BEAMS], 1u);
     if (index >= pc.config.x) {
         STAT_ADD(BEAMS_STAT_BEAM_OVERFLOW, 1u);
-        return;
+        return ~0u;
     }
     beams[index] = b;
     STAT_ADD(BEAMS_STAT_BEAMS + pc.grid.x, 1u);
-    atomicAdd(measures[BEAMS_STAT_FLUX_OUT - BEAMS_STAT_KEPT_MEASURE], luminance(b.flux.rgb));
+    if (floatBitsToUint(b.e0.w) == 1u)
+        atomicAdd(measures[BEAMS_STAT_FLUX_OUT - BEAMS_STAT_KEPT_MEASURE], luminance(b.flux.rgb));
+    return index;
+}
+
+// --- Multiple bounces (Sect. 6) ------------------------------------------
+//
+// A triangle's beams form a small tree: the first specular event's
+// (reflected, refracted) beams, and, while `bounces` allows, the beams
+// that one spawns where all three of its edge rays meet one further
+// specular object (the beam ends there and its flux, times the medium's
+// transmittance along it, is split again by that surface: a mirror's
+// reflectance, or Fresnel between a reflected and a refracted beam traced
+// through the object with Beer-Lambert absorption). Where only some edge
+// rays meet it, the beam is partially intersected: the paper splits it,
+// and so does the oracle here (criterion (a) for the beam tree); at the
+// last level it is kept as a single beam whose edges pass the object (the
+// one-bounce approximation) and spawns nothing.
+
+// One beam still to be built: where its light leaves a specular surface
+// (p, d), its flux, its generation and its parent's slot in `pending`.
+struct Pending {
+    vec3 p[3];
+    vec3 d[3];
+    vec3 flux;
+    vec3 incident; // flux reaching the surface it leaves (before Fresnel and absorption)
+    uint kind;
+    uint bounce; // 1: the first specular event
+    int parent;  // slot in `pending`, -1 for the first event
+    uint source; // the object the light leaves (its own hits are not a bounce)
+};
+const int MAX_PENDING = 2 + 4 + 8; // bounces <= 3
+Pending pending[MAX_PENDING];
+int pending_count = 0;
+
+void push_pending(vec3 p[3], vec3 d[3], vec3 flux, vec3 incident, uint kind, uint bounce, int parent, uint source) {
+    if (pending_count >= MAX_PENDING) return;
+    Pending e;
+    e.p = p;
+    e.d = d;
+    e.flux = flux;
+    e.incident = incident;
+    e.kind = kind;
+    e.bounce = bounce;
+    e.parent = parent;
+    e.source = source;
+    pending[pending_count++] = e;
+}
+
+uint hit_object(Hit h) { return floatBitsToUint(triangles[h.triangle].p1.w); }
+
+// The specular event at p[k] (light arriving along d[k], normals n[k]
+// facing it, material m): the reflected and the refracted beams pushed as
+// pending, Fresnel splitting each vertex's flux (the factors averaged
+// over the three vertices, one flux per beam as in the paper). The first
+// event may refract through the light view's back faces (q: its texels,
+// d_n: Wyman's d_N); later ones are traced through the BVH.
+void specular_event(vec3 p[3], vec3 d[3], vec3 n[3], uint m, vec3 flux, vec3 incident, uint bounce, int parent,
+                    uint object, bool image_space, ivec2 q[3], float d_n[3]) {
+    vec3 refl[3];
+    for (int k = 0; k < 3; ++k) refl[k] = reflect(d[k], n[k]);
+    if (material_kind(m) == MATERIAL_MIRROR) {
+        push_pending(p, refl, flux * materials[m].color.rgb, incident, BEAM_REFLECTED, bounce, parent, object);
+        return;
+    }
+    float ior = materials[m].absorption_ior.w;
+    vec3 absorption = materials[m].absorption_ior.rgb;
+    float f_refl = 0.0;
+    vec3 f_refr = vec3(0.0);
+    vec3 exit_p[3], exit_d[3];
+    bool refracts = true;
+    for (int k = 0; k < 3; ++k) {
+        float f0 = fresnel_dielectric(-dot(d[k], n[k]), 1.0 / ior);
+        f_refl += f0 / 3.0;
+        if (!image_space) {
+            vec3 factor;
+            if (!traced_refraction(d[k], p[k], n[k], ior, absorption, exit_p[k], exit_d[k], factor)) {
+                refracts = false;
+                continue;
+            }
+            f_refr += (1.0 - f0) * factor / 3.0;
+            continue;
+        }
+        vec4 bp = imageLoad(back_position, q[k]);
+        if (bp.w < 0.0) {
+            // No back face: an open sheet (d_N = 0) refracts once and its
+            // beam starts at the interface; a closed refractor's texel
+            // without one is its silhouette.
+            vec3 t1;
+            if (d_n[k] > 0.0 || !refract_dir(d[k], n[k], 1.0 / ior, t1)) { refracts = false; continue; }
+            exit_p[k] = p[k];
+            exit_d[k] = t1;
+            f_refr += vec3(1.0 - f0) / 3.0;
+        } else {
+            TwoSidedExit x;
+            if (!two_sided_refraction(d[k], p[k], n[k], ior, length(bp.xyz - p[k]), d_n[k],
+                                      pc.config.y, pc.config.z != 0u, x)) { refracts = false; continue; }
+            exit_p[k] = x.p2;
+            exit_d[k] = x.dir;
+            f_refr += (1.0 - f0) * x.transmit * exp(-absorption * x.dist) / 3.0;
+        }
+    }
+    if (f_refl > 0.0) push_pending(p, refl, flux * f_refl, incident, BEAM_REFLECTED, bounce, parent, object);
+    if (refracts) push_pending(exit_p, exit_d, flux * f_refr, incident, BEAM_REFRACTED, bounce, parent, object);
+}
+
+const uint EDGES_FREE = 0u;    // no edge ray meets a specular surface first
+const uint EDGES_BOUNCE = 1u;  // all three meet one specular object first
+const uint EDGES_PARTIAL = 2u; // some do
+
+// Where the edge rays of pending beam e first meet a surface other than
+// the one they leave: the hits (distance along d_k, point, normal facing
+// the ray) and the classification above.
+uint edge_hits(Pending e, out float dist[3], out vec3 hp[3], out vec3 hn[3], out uint material, out uint object) {
+    uint specular = 0u;
+    material = 0u;
+    object = ~0u;
+    bool one_object = true;
+    for (int k = 0; k < 3; ++k) {
+        dist[k] = -1.0;
+        hp[k] = e.p[k];
+        hn[k] = vec3(0.0);
+        vec3 x = e.p[k];
+        float travelled = 0.0;
+        for (int i = 0; i < 4; ++i) {
+            float eps = 1e-4 * max(1.0, bvh_max_abs(x));
+            Hit h;
+            if (!trace_closest(x + e.d[k] * eps, e.d[k], 0.0, 1e30, h)) break;
+            travelled += h.t + eps;
+            x = hit_position(h, x + e.d[k] * eps, e.d[k]);
+            uint obj = hit_object(h);
+            if (obj == e.source) continue; // the surface the beam leaves (a lens's rim)
+            uint mat = hit_material(h);
+            if (material_kind(mat) == MATERIAL_DIFFUSE) break;
+            if (specular > 0u && obj != object) one_object = false;
+            specular++;
+            object = obj;
+            material = mat;
+            dist[k] = travelled;
+            hp[k] = x;
+            vec3 nn = hit_normal(h);
+            hn[k] = dot(nn, e.d[k]) > 0.0 ? -nn : nn;
+            break;
+        }
+    }
+    if (specular == 0u) return EDGES_FREE;
+    return specular == 3u && one_object ? EDGES_BOUNCE : EDGES_PARTIAL;
+}
+
+// The object whose surface the light view sees at p (hit from the light
+// along d), ~0u if the short ray misses it.
+uint object_at(vec3 p, vec3 d) {
+    float delta = 1e-3 * max(1.0, bvh_max_abs(p));
+    Hit h;
+    return trace_closest(p - d * delta, d, 0.0, 2.0 * delta, h) ? hit_object(h) : ~0u;
 }
 
 void main() {
@@ -403,11 +577,14 @@ void main() {
         split = split || c < pc.split.y;
     }
 
-    // The beams of a triangle on one specular surface.
-    Beam beam[2];
-    bool has[2] = bool[2](false, false);
+    // The beams of a triangle on one specular surface: the first
+    // specular event, then the bounces (Sect. 6).
+    Beam beam[MAX_PENDING];
+    bool has[MAX_PENDING];
+    for (int i = 0; i < MAX_PENDING; ++i) has[i] = false;
     float measure = 0.0;
     vec3 phi_in = vec3(0.0);
+    uint bounces = floatBitsToUint(pc.split2.w);
     if (!silhouette) {
         phi_in = incident_flux(q[0], q[1], q[2], measure);
         // The medium between the light and the surface (a directional
@@ -417,60 +594,37 @@ void main() {
             vec3 src = planar_view() ? p[k] - dir[k] * light_travel(1e30, p[k]) : pc.origin.xyz;
             tau += bm_transmittance(src, p[k], pc.config.w) / 3.0;
         }
-        vec3 phi = phi_in * tau;
-        uint m = mat[0];
-        vec3 refl[3];
-        for (int k = 0; k < 3; ++k) refl[k] = reflect(dir[k], nrm[k]);
-        if (material_kind(m) == MATERIAL_MIRROR) {
-            has[0] = make_beam(p, refl, phi * materials[m].color.rgb, phi_in, measure, BEAM_REFLECTED, beam[0]);
-        } else {
-            // Dielectric: Fresnel splits each vertex's light into the
-            // reflected and the refracted beam (the flux factors are
-            // averaged over the three vertices).
-            float ior = materials[m].absorption_ior.w;
-            vec3 absorption = materials[m].absorption_ior.rgb;
-            float f_refl = 0.0;
-            vec3 f_refr = vec3(0.0);
-            vec3 exit_p[3], exit_d[3];
-            bool refracts = true;
-            for (int k = 0; k < 3; ++k) {
-                float f0 = fresnel_dielectric(-dot(dir[k], nrm[k]), 1.0 / ior);
-                f_refl += f0 / 3.0;
-                vec4 bp = imageLoad(back_position, q[k]);
-                if (floatBitsToUint(pc.split2.y) == BEAMS_REFRACTION_TRACED) {
-                    vec3 factor;
-                    if (!traced_refraction(dir[k], p[k], nrm[k], ior, absorption, exit_p[k], exit_d[k], factor)) {
-                        refracts = false;
-                        continue;
-                    }
-                    f_refr += (1.0 - f0) * factor / 3.0;
-                } else if (bp.w < 0.0) {
-                    // No back face: an open sheet (d_N = 0) refracts once
-                    // and its beam starts at the interface; a closed
-                    // refractor's texel without one is its silhouette.
-                    vec3 t1;
-                    if (d_n[k] > 0.0 || !refract_dir(dir[k], nrm[k], 1.0 / ior, t1)) { refracts = false; continue; }
-                    exit_p[k] = p[k];
-                    exit_d[k] = t1;
-                    f_refr += vec3(1.0 - f0) / 3.0;
-                } else {
-                    TwoSidedExit x;
-                    if (!two_sided_refraction(dir[k], p[k], nrm[k], ior, length(bp.xyz - p[k]), d_n[k],
-                                              pc.config.y, pc.config.z != 0u, x)) { refracts = false; continue; }
-                    exit_p[k] = x.p2;
-                    exit_d[k] = x.dir;
-                    f_refr += (1.0 - f0) * x.transmit * exp(-absorption * x.dist) / 3.0;
-                }
-            }
-            if (f_refl > 0.0) has[0] = make_beam(p, refl, phi * f_refl, phi_in, measure, BEAM_REFLECTED, beam[0]);
-            if (refracts) has[1] = make_beam(exit_p, exit_d, phi * f_refr, phi_in, measure, BEAM_REFRACTED, beam[1]);
-        }
-        // (b) and (c) on the beams.
-        for (int i = 0; i < 2; ++i) {
+        bool image_space = floatBitsToUint(pc.split2.y) != BEAMS_REFRACTION_TRACED;
+        specular_event(p, dir, nrm, mat[0], phi_in * tau, phi_in, 1u, -1, object_at(p[0], dir[0]), image_space, q,
+                       d_n);
+        for (int i = 0; i < MAX_PENDING; ++i) {
+            if (i >= pending_count) break;
+            Pending e = pending[i];
+            float dist[3];
+            vec3 hp[3], hn[3];
+            uint hit_mat, hit_obj;
+            uint edges = e.bounce < bounces ? edge_hits(e, dist, hp, hn, hit_mat, hit_obj) : EDGES_FREE;
+            if (edges == EDGES_PARTIAL) split = true;
+            if (edges != EDGES_BOUNCE) dist = float[3](-1.0, -1.0, -1.0);
+            beam_too_wide = false;
+            has[i] = make_beam(e.p, e.d, dist, e.flux, e.incident, measure, e.kind, beam[i]);
+            // A bounced beam spreading too wide for one beam space (a coarse
+            // triangle of a mirror's light across a lens) splits the triangle.
+            if (beam_too_wide && e.bounce > 1u) split = true;
             if (!has[i]) continue;
+            beam[i].e0.w = uintBitsToFloat(e.bounce);
+            beam[i].e1.w = intBitsToFloat(e.parent); // a slot until emitted
+            // (b) and (c) on every beam of the tree.
             if (focus_ratio(beam[i]) < pc.split.z) split = true;
             if (luminance(beam[i].flux.rgb) > pc.split.w) split = true;
             if (camera_size(beam[i]) > pc.split2.x) split = true;
+            if (edges != EDGES_BOUNCE) continue;
+            // The flux arriving at the next surface: the beam's, times the
+            // medium's transmittance from its base along each edge.
+            vec3 arriving = vec3(0.0);
+            vec3 base[3] = vec3[3](beam[i].v0.xyz, beam[i].v1.xyz, beam[i].v2.xyz);
+            for (int k = 0; k < 3; ++k) arriving += e.flux * bm_transmittance(base[k], hp[k], pc.config.w) / 3.0;
+            specular_event(hp, e.d, hn, hit_mat, arriving, arriving, e.bounce + 1u, i, hit_obj, false, q, d_n);
         }
     }
 
@@ -502,5 +656,14 @@ void main() {
     }
     atomicAdd(measures[0], measure);
     atomicAdd(measures[BEAMS_STAT_FLUX_IN - BEAMS_STAT_KEPT_MEASURE], luminance(phi_in));
-    for (int i = 0; i < 2; ++i) if (has[i]) emit(beam[i]);
+    // Parents come before their children in `pending`, so a child's slot
+    // becomes its parent's buffer index (~0u: none, or not emitted).
+    uint emitted[MAX_PENDING];
+    for (int i = 0; i < MAX_PENDING; ++i) {
+        emitted[i] = ~0u;
+        if (i >= pending_count || !has[i]) continue;
+        int parent = floatBitsToInt(beam[i].e1.w);
+        beam[i].e1.w = uintBitsToFloat(parent >= 0 ? emitted[parent] : ~0u);
+        emitted[i] = emit(beam[i]);
+    }
 }

@@ -532,3 +532,25 @@ pub fn block_errors(
     b.mean /= b.used.max(1) as f64;
     b
 }
+
+/// `ball_lens.toml`'s point light, as its TOML reads.
+pub const BALL_LENS_POINT_LIGHT: &str =
+    "[[light]]\nkind = \"point\"\nposition = [0.0, 8.0, 0.0]\nintensity = [60.0, 60.0, 60.0]\n";
+
+/// `ball_lens.toml` with its point light replaced by `light` (TOML).
+pub fn ball_lens_with_light(light: &str) -> Scene {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/ball_lens.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains(BALL_LENS_POINT_LIGHT));
+    Scene::from_str(&text.replace(BALL_LENS_POINT_LIGHT, light), &path).unwrap()
+}
+
+/// A square rect light of side `size` (m) in place of `ball_lens`'s point
+/// light, facing down, with the same on-axis intensity I0 = L A = 60 W/sr.
+pub fn ball_lens_rect_light(size: f32) -> String {
+    format!(
+        "[[light]]\nkind = \"rect\"\ncenter = [0.0, 8.0, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [{size}, {size}]\nradiance = {}\n",
+        60.0 / (size * size)
+    )
+}

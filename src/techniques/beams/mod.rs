@@ -47,12 +47,20 @@
 //! last. Counters (beams and triangles per level, the dropped fraction,
 //! fragments) go to `bench --json` through `counters`.
 //!
-//! Not implemented (documented limits): multiple bounces through further
-//! specular surfaces (Sect. 6; an edge ray passes through them); the flux is uniform across a beam (one area function
+//! Multiple bounces (Sect. 6, `bounces`): a beam whose three edge rays
+//! meet one further specular object ends there (its extrusion, and the
+//! surface gather, stop at that surface) and spawns that surface's
+//! reflected and refracted beams (Fresnel split, refraction traced through
+//! the BVH with Beer-Lambert absorption), each child recording its parent
+//! (`GpuBeam::parent`); a beam only partly meeting it splits its triangle,
+//! and at the last level passes the object as a one-bounce beam.
+//!
+//! Limits (documented): the flux is uniform across a beam (one area function
 //! per beam, as in the paper; Fresnel and absorption factors averaged over
 //! its three vertices); the beam's base plane is normal to the mean edge
 //! direction rather than the surface triangle (an equivalent beam space
-//! that stays valid after two refractions); area lights give no caustics.
+//! that stays valid after two refractions); area lights are point stand-ins
+//! (small rects only, `check_scene`).
 
 pub mod bindings;
 mod tracer;
@@ -105,6 +113,8 @@ crate::declare_params! {
             "Gauss-Legendre points per interval of a camera ray inside a beam (Sect. 5)";
         refraction: u32 [0, 1] = 0, rebuild,
             "two-sided refraction (Sect. 6): 0 Wyman's image-space exit through the light view's back faces (the paper's approximate ray tracing), 1 exactly through the BVH (internal total reflections followed)";
+        bounces: u32 [1, 3] = 2, rebuild,
+            "specular events per beam path (Sect. 6): a beam whose edge rays all meet a further specular object ends there and spawns its reflected / refracted beams, up to this many events (1: one event, edges pass further specular surfaces)";
         tir_remedy: u32 [0, 2] = 1, rebuild,
             "total internal reflection at the approximated exit of two-sided refraction (as image_space's): 0 single refraction, 1 clamp to the critical angle, 2 reflect";
         eq_6_3_2: u32 [0, 1] = 1, rebuild,
@@ -192,6 +202,7 @@ impl TechniqueBuild for Beams {
                 tir_remedy: params.tir_remedy,
                 eq_6_3_2: params.eq_6_3_2,
                 refraction: params.refraction,
+                bounces: params.bounces,
                 extrusion_cutoff: params.extrusion_cutoff,
                 surface_filter: params.surface_filter,
                 medium_steps: params.direct.medium_steps,
@@ -209,6 +220,14 @@ impl TechniqueBuild for Beams {
             airlight,
             last_counts: None,
         })
+    }
+
+    /// Area lights become point stand-ins (`environment::caustic_lights`:
+    /// a rect is a spot at its centre with the cosine profile, I = L A cos
+    /// theta, whose light view and beams are a spot's), within their size
+    /// limit; sphere lights are refused.
+    fn check_scene(scene: &Scene) -> anyhow::Result<()> {
+        crate::environment::check_stand_ins(scene, Self::NAME).map_err(anyhow::Error::msg)
     }
 }
 

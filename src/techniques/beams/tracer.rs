@@ -46,6 +46,15 @@ impl GpuBeam {
     pub fn kind(&self) -> u32 {
         self.v[2][3].to_bits()
     }
+    /// 1 for the first specular event's beams, 2 for those they spawn, ...
+    pub fn bounce(&self) -> u32 {
+        self.e[0][3].to_bits()
+    }
+    /// The index of the beam this one was spawned by (Sect. 6).
+    pub fn parent(&self) -> Option<usize> {
+        let p = self.e[1][3].to_bits();
+        (p != u32::MAX).then_some(p as usize)
+    }
     /// A(y), the cross-section parallel to the base at height y (m^2, signed).
     pub fn area_at(&self, y: f32) -> f32 {
         self.area[0] + self.area[1] * y + self.area[2] * y * y
@@ -121,7 +130,8 @@ struct RefinePush {
     config: [u32; 4],
     /// relative depth, cos(normal angle), focus ratio, energy (W).
     split: [f32; 4],
-    /// camera angular size (rad); refraction (u32 bits); extrusion cut-off.
+    /// camera angular size (rad); refraction (u32 bits); extrusion cut-off;
+    /// bounces (u32 bits).
     split2: [f32; 4],
 }
 const _: () = assert!(size_of::<RefinePush>() == 128);
@@ -161,6 +171,8 @@ pub struct TracerSettings {
     pub eq_6_3_2: u32,
     /// `BEAMS_REFRACTION_*`.
     pub refraction: u32,
+    /// Specular events per beam path (Sect. 6), 1 to 3.
+    pub bounces: u32,
     /// Extrusion cut-off (fraction of the base's flux density; 0: none).
     pub extrusion_cutoff: f32,
     /// Low-pass filter radius of the surface caustics in pixels (0: none).
@@ -443,8 +455,11 @@ impl BeamTracer {
         desc.push_size = size_of::<VolumePush>() as u32;
         let volume_pipeline = GraphicsPipeline::new(ctx, &desc, &with(&layouts.beams))?;
 
+        // The lights the views are of: the scene's, then the stand-ins of
+        // its sun and rect lights (without them the energy criterion of a
+        // stand-in's view would split every triangle).
         let view_flux = view_fluxes(
-            &scene.lights,
+            &crate::environment::caustic_lights(scene),
             crate::passes::light_views::specular_bounds(scene),
             light_view_size,
         );
@@ -477,7 +492,7 @@ impl BeamTracer {
                     settings.split_camera,
                     f32::from_bits(settings.refraction),
                     settings.extrusion_cutoff,
-                    0.0,
+                    f32::from_bits(settings.bounces),
                 ],
             },
             args: ArgsPush {
