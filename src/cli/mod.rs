@@ -9,6 +9,7 @@ pub mod render;
 
 use caustics::output;
 use caustics::params::Params;
+use caustics::renderer::Stage;
 use caustics::scene::{Scene, DEFAULT_SCENE};
 use caustics::techniques;
 use caustics::vk::{Context, ContextOptions, FrameOptions, MAX_FRAMES_IN_FLIGHT};
@@ -289,6 +290,23 @@ pub fn check_device_limits(ctx: &Context, args: &SceneArgs) -> anyhow::Result<()
         }
     }
     Ok(())
+}
+
+/// Names the arguments behind a failure of `Renderer::new` (a device limit
+/// met by the scene, the image size or the technique's parameters).
+pub fn name_arguments(e: anyhow::Error, run: &TechniqueArgs) -> anyhow::Error {
+    let what = match e.downcast_ref::<Stage>() {
+        Some(Stage::Scene) => format!("--scene {}", run.scene.scene.display()),
+        Some(Stage::Targets { .. }) => {
+            format!("--width {} --height {}", run.scene.width, run.scene.height)
+        }
+        Some(Stage::Technique) => {
+            let params: String = run.params.iter().map(|p| format!(" --param {p}")).collect();
+            format!("--technique {}{params}", run.technique)
+        }
+        None => return e,
+    };
+    e.context(what)
 }
 
 /// Fails the command if the validation layer reported errors, leaked objects

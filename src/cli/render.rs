@@ -99,7 +99,8 @@ fn start(
         s.width,
         s.height,
         s.time,
-    )?;
+    )
+    .map_err(|e| super::name_arguments(e, run))?;
     renderer.set_frame_options(options)?;
     Ok((ctx, renderer))
 }

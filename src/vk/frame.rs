@@ -31,7 +31,7 @@
 
 use super::ring::Ring;
 use super::sync::ResourceState;
-use super::{Access, Buffer, Context, VkError, VkResult};
+use super::{fault, Access, Buffer, Context, VkError, VkResult};
 use ash::vk;
 use std::any::Any;
 use std::collections::VecDeque;
@@ -254,7 +254,14 @@ impl Frames {
         let mut done = std::mem::take(&mut self.completed_early);
         if self.slots[index].pending.is_some() {
             self.order.retain(|&s| s != index);
-            done.push(self.complete(index)?);
+            match self.complete(index) {
+                Ok(t) => done.push(t),
+                Err(e) => {
+                    // Frames completed before keep their timings.
+                    self.completed_early = done;
+                    return Err(e);
+                }
+            }
         }
         let ctx = self.ctx.clone();
         let slot = &mut self.slots[index];
@@ -289,6 +296,7 @@ impl Frames {
         let start = Instant::now();
         unsafe {
             ctx.device.wait_for_fences(&[slot.fence], true, u64::MAX)?;
+            fault::queue_op()?;
             ctx.device.reset_fences(&[slot.fence])?;
         }
         let waited = start.elapsed();
@@ -325,7 +333,14 @@ impl Frames {
     pub fn wait_all(&mut self) -> VkResult<Vec<FrameTiming>> {
         let mut out = std::mem::take(&mut self.completed_early);
         while let Some(index) = self.order.pop_front() {
-            out.push(self.complete(index)?);
+            match self.complete(index) {
+                Ok(t) => out.push(t),
+                Err(e) => {
+                    // Frames completed before keep their timings.
+                    self.completed_early = out;
+                    return Err(e);
+                }
+            }
         }
         Ok(out)
     }
@@ -363,8 +378,12 @@ fn timings(ctx: &Context, names: Vec<String>, ticks: &[u64]) -> Vec<PassTiming> 
 
 impl Drop for Frames {
     fn drop(&mut self) {
-        // Nothing a slot owns may go while its frame runs.
-        let _ = self.wait_all();
+        // Nothing a slot owns may go while its frame runs. After a failed
+        // wait (a lost device) the frames behind it are not waited for one
+        // by one: idle the device instead.
+        if self.wait_all().is_err() {
+            self.ctx.wait_idle();
+        }
         let mut slots = std::mem::take(&mut self.slots);
         for slot in &mut slots {
             self.destroy_slot(slot);
@@ -602,6 +621,7 @@ impl FrameRecorder<'_> {
             .command_buffer_infos(&cmds)
             .signal_semaphore_infos(&signals);
         let start = Instant::now();
+        fault::queue_op()?;
         unsafe { ctx.device.queue_submit2(ctx.queue, &[submit], slot.fence) }?;
         self.frames.host_submit += start.elapsed();
         slot.pending = Some(Pending {
