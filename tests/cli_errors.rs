@@ -258,3 +258,27 @@ fn a_lost_device_or_its_memory_running_out_is_one_line_and_no_output() {
     assert!(dir.join("x.png").exists() && dir.join("x.exr").exists());
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// Output into a closed pipe (`caustics render --technique list | head -1`)
+/// ends the process by SIGPIPE, as Unix tools do, not by a panic in println!.
+#[test]
+fn a_closed_stdout_pipe_is_no_panic() {
+    use std::os::unix::process::ExitStatusExt as _;
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_caustics"))
+        .args(["render", "--technique", "list"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run caustics");
+    drop(child.stdout.take()); // the reader is gone before the first line
+    let o = child.wait_with_output().expect("wait");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(
+        o.status.signal(),
+        Some(13),
+        "SIGPIPE: {:?} {stderr}",
+        o.status
+    );
+}

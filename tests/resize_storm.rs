@@ -87,7 +87,11 @@ fn a_hundred_resizes_with_frames_in_flight_leak_nothing() {
         after.allocated
     );
     assert_eq!(after.allocations, before.allocations, "live allocations");
-    assert_eq!(ctx.memory.heaps(), heaps_before, "the heap accounting returns");
+    assert_eq!(
+        ctx.memory.heaps(),
+        heaps_before,
+        "the heap accounting returns"
+    );
     drop(r);
     common::assert_validation_clean(&ctx);
 }

@@ -192,6 +192,11 @@ pub struct BenchArgs {
     /// Also write the results as JSON.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Sample host RSS and gpu-allocator's device memory this many times,
+    /// evenly over the timed frames (printed, and in the JSON): a soak
+    /// test's leak check (scripts/soak.sh).
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0)]
+    pub memory_samples: u32,
     #[command(flatten)]
     pub frame: FrameArgs,
     #[command(flatten)]
