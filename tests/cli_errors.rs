@@ -162,6 +162,22 @@ fn photons_rounded_to_whole_passes_say_so() {
     );
     assert!(stdout.contains("traced 262144 photons"), "{stdout}");
     let _ = std::fs::remove_dir_all(&dir);
+    // An absurd count (it overflowed the rounding and panicked) is refused.
+    let o = run(
+        &[
+            "reference",
+            "--photons",
+            "18446744073709551615",
+            "--out",
+            dir.join("r.png").to_str().unwrap(),
+        ],
+        &[],
+    );
+    one_line_error(
+        &o,
+        &["--photons 18446744073709551615: must be between 1 and 1e15"],
+    );
+    assert!(!dir.exists(), "nothing created at --out");
 }
 
 #[test]

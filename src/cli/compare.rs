@@ -58,8 +58,8 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
     if args.frames == 0 {
         anyhow::bail!("--frames must be at least 1");
     }
-    if args.photons == Some(0) {
-        anyhow::bail!("--photons must be at least 1");
+    if let Some(photons) = args.photons {
+        super::check_photons(photons)?;
     }
     if let Some(s) = args.reference_time {
         if !(s.is_finite() && s > 0.0) {
