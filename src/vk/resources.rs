@@ -103,7 +103,7 @@ impl Buffer {
             Ok(a) => a,
             Err(e) => {
                 unsafe { ctx.device.destroy_buffer(raw, None) };
-                return Err(e.into());
+                return Err(e);
             }
         };
         unsafe {
@@ -477,7 +477,7 @@ impl Image {
             Ok(a) => a,
             Err(e) => {
                 unsafe { ctx.device.destroy_image(raw, None) };
-                return Err(e.into());
+                return Err(e);
             }
         };
         unsafe {
