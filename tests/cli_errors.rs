@@ -298,3 +298,52 @@ fn a_closed_stdout_pipe_is_no_panic() {
         o.status
     );
 }
+
+/// `bench --memory-samples N` (the soak's leak check, scripts/soak.sh):
+/// N samples evenly over the timed frames, in the JSON, each with the
+/// host's RSS and gpu-allocator's live device memory.
+#[test]
+fn bench_samples_memory_over_the_timed_frames() {
+    let dir = out_dir("memory");
+    let json = dir.join("b.json");
+    let o = run(
+        &[
+            "bench",
+            "--technique",
+            "direct",
+            "--scene",
+            &manifest("assets/scenes/ball_lens.toml"),
+            "--param",
+            "shadow_map_size=64",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--frames",
+            "6",
+            "--warmup",
+            "1",
+            "--memory-samples",
+            "3",
+            "--json",
+            json.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let samples = report["memory"].as_array().expect("memory samples");
+    let frames: Vec<u64> = samples
+        .iter()
+        .map(|s| s["frame"].as_u64().unwrap())
+        .collect();
+    assert_eq!(frames, vec![2, 4, 6]);
+    for s in samples {
+        assert!(s["host_rss"].as_u64().unwrap() > 1 << 20, "{s}");
+        assert!(s["device_allocated"].as_u64().unwrap() > 0, "{s}");
+        // Nothing is allocated per frame: every sample holds the same.
+        assert_eq!(s["device_allocated"], samples[0]["device_allocated"]);
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}
