@@ -298,16 +298,20 @@ pub fn check_device_limits(ctx: &Context, args: &SceneArgs) -> anyhow::Result<()
 }
 
 /// Names the arguments behind a failure of `Renderer::new` (a device limit
-/// met by the scene, the image size or the technique's parameters).
-pub fn name_arguments(e: anyhow::Error, run: &TechniqueArgs) -> anyhow::Error {
+/// met by the scene, the image size or the technique `technique` with the
+/// `--param`s `params`).
+pub fn name_arguments(
+    e: anyhow::Error,
+    scene: &SceneArgs,
+    technique: &str,
+    params: &[String],
+) -> anyhow::Error {
     let what = match e.downcast_ref::<Stage>() {
-        Some(Stage::Scene) => format!("--scene {}", run.scene.scene.display()),
-        Some(Stage::Targets { .. }) => {
-            format!("--width {} --height {}", run.scene.width, run.scene.height)
-        }
+        Some(Stage::Scene) => format!("--scene {}", scene.scene.display()),
+        Some(Stage::Targets { .. }) => format!("--width {} --height {}", scene.width, scene.height),
         Some(Stage::Technique) => {
-            let params: String = run.params.iter().map(|p| format!(" --param {p}")).collect();
-            format!("--technique {}{params}", run.technique)
+            let params: String = params.iter().map(|p| format!(" --param {p}")).collect();
+            format!("--technique {technique}{params}")
         }
         None => return e,
     };

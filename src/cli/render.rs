@@ -101,7 +101,7 @@ fn start(
         s.height,
         s.time,
     )
-    .map_err(|e| super::name_arguments(e, run))?;
+    .map_err(|e| super::name_arguments(e, s, &run.technique, &run.params))?;
     renderer.set_frame_options(options)?;
     Ok((ctx, renderer))
 }
