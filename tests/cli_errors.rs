@@ -347,3 +347,50 @@ fn bench_samples_memory_over_the_timed_frames() {
     }
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// A valid scene whose triangles do not fit one storage buffer (a sphere of
+/// 1200 segments: 1,437,600 triangles of 96 bytes, over lavapipe's
+/// maxStorageBufferRange of 128 MiB, 1,398,101 triangles) is refused before
+/// the BVH build, naming --scene, the count and the limit. Before, nothing
+/// checked this limit.
+#[test]
+fn a_scene_over_the_storage_buffer_limit_is_refused() {
+    let dir = out_dir("triangles");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("sphere.toml");
+    std::fs::write(
+        &scene,
+        "[camera]\neye = [0.0, 2.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n\n\
+         [[light]]\nkind = \"point\"\nposition = [0.0, 5.0, 0.0]\nintensity = [10.0, 10.0, 10.0]\n\n\
+         [[material]]\nname = \"m\"\nkind = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n\n\
+         [[object]]\nshape = \"sphere\"\nradius = 1.0\nsegments = 1200\nmaterial = \"m\"\n",
+    )
+    .unwrap();
+    let out = dir.join("out/x.png");
+    let o = run(
+        &[
+            "render",
+            "--technique",
+            "direct",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    one_line_error(
+        &o,
+        &[
+            "--scene ",
+            "1437600 triangles: the device holds at most 1398101",
+            "maxStorageBufferRange",
+        ],
+    );
+    assert!(!dir.join("out").exists(), "nothing created at --out");
+    let _ = std::fs::remove_dir_all(dir);
+}
