@@ -190,9 +190,21 @@ fn demo_without_a_display_says_so_in_one_line() {
     assert!(!e.contains(".cargo") && !e.contains(".rs:"), "{e}");
 }
 
-/// `render` of the default scene with `direct` at `size`, `frames` frames,
-/// into a fresh folder; with `fault` as `CAUSTICS_TEST_FAULT` (src/vk/fault.rs).
+/// `render` of ball_lens with `direct` at `size`, `frames` frames, into a
+/// fresh folder; with `fault` as `CAUSTICS_TEST_FAULT` (src/vk/fault.rs).
 fn render_direct(name: &str, size: u32, frames: u32, fault: Option<&str>) -> (Output, PathBuf) {
+    let scene = manifest("assets/scenes/ball_lens.toml");
+    render_direct_scene(name, &scene, size, frames, fault)
+}
+
+/// `render_direct` of `scene`.
+fn render_direct_scene(
+    name: &str,
+    scene: &str,
+    size: u32,
+    frames: u32,
+    fault: Option<&str>,
+) -> (Output, PathBuf) {
     let dir = out_dir(name);
     let out = dir.join("x.png");
     let size = size.to_string();
@@ -203,7 +215,7 @@ fn render_direct(name: &str, size: u32, frames: u32, fault: Option<&str>) -> (Ou
             "--technique",
             "direct",
             "--scene",
-            &manifest("assets/scenes/ball_lens.toml"),
+            scene,
             "--width",
             &size,
             "--height",
@@ -355,9 +367,10 @@ fn bench_samples_memory_over_the_timed_frames() {
 /// checked this limit.
 #[test]
 fn a_scene_over_the_storage_buffer_limit_is_refused() {
-    let dir = out_dir("triangles");
-    std::fs::create_dir_all(&dir).unwrap();
-    let scene = dir.join("sphere.toml");
+    let scene = std::env::temp_dir().join(format!(
+        "caustics-cli-errors-{}-sphere.toml",
+        std::process::id()
+    ));
     std::fs::write(
         &scene,
         "[camera]\neye = [0.0, 2.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n\n\
@@ -366,23 +379,7 @@ fn a_scene_over_the_storage_buffer_limit_is_refused() {
          [[object]]\nshape = \"sphere\"\nradius = 1.0\nsegments = 1200\nmaterial = \"m\"\n",
     )
     .unwrap();
-    let out = dir.join("out/x.png");
-    let o = run(
-        &[
-            "render",
-            "--technique",
-            "direct",
-            "--scene",
-            scene.to_str().unwrap(),
-            "--width",
-            "16",
-            "--height",
-            "16",
-            "--out",
-            out.to_str().unwrap(),
-        ],
-        &[],
-    );
+    let (o, dir) = render_direct_scene("triangles", scene.to_str().unwrap(), 16, 1, None);
     one_line_error(
         &o,
         &[
@@ -391,6 +388,6 @@ fn a_scene_over_the_storage_buffer_limit_is_refused() {
             "maxStorageBufferRange",
         ],
     );
-    assert!(!dir.join("out").exists(), "nothing created at --out");
-    let _ = std::fs::remove_dir_all(dir);
+    assert!(!dir.exists(), "nothing created at --out");
+    let _ = std::fs::remove_file(scene);
 }
