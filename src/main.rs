@@ -10,6 +10,12 @@ use cli::{check_size, Cli, Command, DemoArgs, SceneArgs};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    // Rust ignores SIGPIPE, so printing into a closed pipe (`| head`)
+    // panicked; with the default action the process ends quietly, as Unix
+    // tools do. Outputs are written under temporary names and renamed, so
+    // this cannot leave a partial file at an output name.
+    // SAFETY: called first, before any other thread exists.
+    unsafe { libc::signal(libc::SIGPIPE, libc::SIG_DFL) };
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
         .format_timestamp(None)
         .init();

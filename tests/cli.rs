@@ -387,6 +387,10 @@ fn bad_arguments_fail_cleanly() {
         (vec!["render", "--time", "nan"], vec!["--time", "finite"]),
         (vec!["render", "--frames", "0"], vec!["--frames"]),
         (vec!["bench", "--frames", "0"], vec!["--frames"]),
+        (
+            vec!["bench", "--frames", "2", "--memory-samples", "3"],
+            vec!["--memory-samples 3: at most --frames (2)"],
+        ),
         (vec!["reference", "--photons", "0"], vec!["--photons"]),
         (
             vec!["reference", "--component", "nope"],

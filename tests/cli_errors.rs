@@ -162,6 +162,22 @@ fn photons_rounded_to_whole_passes_say_so() {
     );
     assert!(stdout.contains("traced 262144 photons"), "{stdout}");
     let _ = std::fs::remove_dir_all(&dir);
+    // An absurd count (it overflowed the rounding and panicked) is refused.
+    let o = run(
+        &[
+            "reference",
+            "--photons",
+            "18446744073709551615",
+            "--out",
+            dir.join("r.png").to_str().unwrap(),
+        ],
+        &[],
+    );
+    one_line_error(
+        &o,
+        &["--photons 18446744073709551615: must be between 1 and 1e15"],
+    );
+    assert!(!dir.exists(), "nothing created at --out");
 }
 
 #[test]
@@ -172,4 +188,206 @@ fn demo_without_a_display_says_so_in_one_line() {
     );
     let e = one_line_error(&o, &["demo needs a display", "DISPLAY"]);
     assert!(!e.contains(".cargo") && !e.contains(".rs:"), "{e}");
+}
+
+/// `render` of ball_lens with `direct` at `size`, `frames` frames, into a
+/// fresh folder; with `fault` as `CAUSTICS_TEST_FAULT` (src/vk/fault.rs).
+fn render_direct(name: &str, size: u32, frames: u32, fault: Option<&str>) -> (Output, PathBuf) {
+    let scene = manifest("assets/scenes/ball_lens.toml");
+    render_direct_scene(name, &scene, size, frames, fault)
+}
+
+/// `render_direct` of `scene`.
+fn render_direct_scene(
+    name: &str,
+    scene: &str,
+    size: u32,
+    frames: u32,
+    fault: Option<&str>,
+) -> (Output, PathBuf) {
+    let dir = out_dir(name);
+    let out = dir.join("x.png");
+    let size = size.to_string();
+    let frames = frames.to_string();
+    let o = run(
+        &[
+            "render",
+            "--technique",
+            "direct",
+            "--scene",
+            scene,
+            "--width",
+            &size,
+            "--height",
+            &size,
+            "--frames",
+            &frames,
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[("CAUSTICS_TEST_FAULT", fault)],
+    );
+    (o, dir)
+}
+
+/// Device limits are checked before anything is allocated (src/vk/limits.rs):
+/// a 16384² RGBA32F target is over lavapipe's maxResourceSize (4 GiB - 1);
+/// at 11000² the radiance target (1.8 GiB) fits the 2 GiB heap and the
+/// display image after it does not (measured: 90 MB peak RSS, 0.2 s, so
+/// the check refuses before lavapipe's memory is touched). One line naming
+/// the arguments and the limit, exit 1, nothing at --out.
+#[test]
+fn requests_over_the_device_limits_name_the_argument_and_the_limit() {
+    let (o, dir) = render_direct("limit-resource", 16384, 1, None);
+    one_line_error(
+        &o,
+        &[
+            "--width 16384 --height 16384",
+            "\"radiance\"",
+            "maxResourceSize",
+        ],
+    );
+    assert!(!dir.exists(), "nothing created at --out");
+    let (o, dir) = render_direct("limit-heap", 11000, 1, None);
+    one_line_error(
+        &o,
+        &[
+            "--width 11000 --height 11000",
+            "memory heap 0 holds 2.0 GiB",
+        ],
+    );
+    assert!(!dir.exists(), "nothing created at --out");
+}
+
+/// VK_ERROR_DEVICE_LOST and VK_ERROR_OUT_OF_DEVICE_MEMORY, which lavapipe
+/// cannot produce, injected by the test hook: during set-up (the first
+/// queue operation), amid the frames (the 12th: set-up takes about 7, each
+/// frame a submit and a wait) and at an allocation. Each is one line, exit
+/// 1, nothing written.
+#[test]
+fn a_lost_device_or_its_memory_running_out_is_one_line_and_no_output() {
+    for (name, fault, frames, needle) in [
+        ("lost-setup", "device_lost:1", 1, "VK_ERROR_DEVICE_LOST"),
+        ("lost-frames", "device_lost:12", 10, "VK_ERROR_DEVICE_LOST"),
+        (
+            "oom",
+            "out_of_device_memory:3",
+            1,
+            "VK_ERROR_OUT_OF_DEVICE_MEMORY",
+        ),
+    ] {
+        let (o, dir) = render_direct(name, 32, frames, Some(fault));
+        one_line_error(&o, &[needle]);
+        assert!(!dir.exists(), "{name}: nothing created at --out");
+    }
+    // Without the fault the same command writes its pair.
+    let (o, dir) = render_direct("no-fault", 32, 10, None);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(dir.join("x.png").exists() && dir.join("x.exr").exists());
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// Output into a closed pipe (`caustics render --technique list | head -1`)
+/// ends the process by SIGPIPE, as Unix tools do, not by a panic in println!.
+#[test]
+fn a_closed_stdout_pipe_is_no_panic() {
+    use std::os::unix::process::ExitStatusExt as _;
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_caustics"))
+        .args(["render", "--technique", "list"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run caustics");
+    drop(child.stdout.take()); // the reader is gone before the first line
+    let o = child.wait_with_output().expect("wait");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(
+        o.status.signal(),
+        Some(13),
+        "SIGPIPE: {:?} {stderr}",
+        o.status
+    );
+}
+
+/// `bench --memory-samples N` (the soak's leak check, scripts/soak.sh):
+/// N samples evenly over the timed frames, in the JSON, each with the
+/// host's RSS and gpu-allocator's live device memory.
+#[test]
+fn bench_samples_memory_over_the_timed_frames() {
+    let dir = out_dir("memory");
+    let json = dir.join("b.json");
+    let o = run(
+        &[
+            "bench",
+            "--technique",
+            "direct",
+            "--scene",
+            &manifest("assets/scenes/ball_lens.toml"),
+            "--param",
+            "shadow_map_size=64",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--frames",
+            "6",
+            "--warmup",
+            "1",
+            "--memory-samples",
+            "3",
+            "--json",
+            json.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let samples = report["memory"].as_array().expect("memory samples");
+    let frames: Vec<u64> = samples
+        .iter()
+        .map(|s| s["frame"].as_u64().unwrap())
+        .collect();
+    assert_eq!(frames, vec![2, 4, 6]);
+    for s in samples {
+        assert!(s["host_rss"].as_u64().unwrap() > 1 << 20, "{s}");
+        assert!(s["device_allocated"].as_u64().unwrap() > 0, "{s}");
+        // Nothing is allocated per frame: every sample holds the same.
+        assert_eq!(s["device_allocated"], samples[0]["device_allocated"]);
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// A valid scene whose triangles do not fit one storage buffer (a sphere of
+/// 1200 segments: 1,437,600 triangles of 96 bytes, over lavapipe's
+/// maxStorageBufferRange of 128 MiB, 1,398,101 triangles) is refused before
+/// the BVH build, naming --scene, the count and the limit. Before, nothing
+/// checked this limit.
+#[test]
+fn a_scene_over_the_storage_buffer_limit_is_refused() {
+    let scene = std::env::temp_dir().join(format!(
+        "caustics-cli-errors-{}-sphere.toml",
+        std::process::id()
+    ));
+    std::fs::write(
+        &scene,
+        "[camera]\neye = [0.0, 2.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n\n\
+         [[light]]\nkind = \"point\"\nposition = [0.0, 5.0, 0.0]\nintensity = [10.0, 10.0, 10.0]\n\n\
+         [[material]]\nname = \"m\"\nkind = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n\n\
+         [[object]]\nshape = \"sphere\"\nradius = 1.0\nsegments = 1200\nmaterial = \"m\"\n",
+    )
+    .unwrap();
+    let (o, dir) = render_direct_scene("triangles", scene.to_str().unwrap(), 16, 1, None);
+    one_line_error(
+        &o,
+        &[
+            "--scene ",
+            "1437600 triangles: the device holds at most 1398101",
+            "maxStorageBufferRange",
+        ],
+    );
+    assert!(!dir.exists(), "nothing created at --out");
+    let _ = std::fs::remove_file(scene);
 }

@@ -207,7 +207,10 @@ fn bad_arguments_are_one_line_and_create_nothing() {
             &["--reference", small.to_str().unwrap()],
             "is 8x8, the comparison 64x64",
         ),
-        (&["--photons", "0"], "--photons must be at least 1"),
+        (
+            &["--photons", "0"],
+            "--photons 0: must be between 1 and 1e15",
+        ),
     ];
     for (extra, needle) in cases {
         let mut args = vec![

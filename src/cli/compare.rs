@@ -58,8 +58,8 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
     if args.frames == 0 {
         anyhow::bail!("--frames must be at least 1");
     }
-    if args.photons == Some(0) {
-        anyhow::bail!("--photons must be at least 1");
+    if let Some(photons) = args.photons {
+        super::check_photons(photons)?;
     }
     if let Some(s) = args.reference_time {
         if !(s.is_finite() && s > 0.0) {
@@ -406,7 +406,8 @@ fn run_technique(
     if let Err(e) = (info.check_scene)(scene) {
         return Ok(Err(format!("{e:#}")));
     }
-    let mut r = Renderer::new(ctx, scene.clone(), name, &params, width, height, time)?;
+    let mut r = Renderer::new(ctx, scene.clone(), name, &params, width, height, time)
+        .map_err(|e| super::name_arguments(e, &args.scene, name, &[]))?;
     r.set_frame_options(FrameOptions::default())?;
     *timing_source = Some(r.frames.source.describe().to_string());
     // Warm-up (pipeline compilation), then the timed frames, all at the

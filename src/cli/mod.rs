@@ -9,6 +9,7 @@ pub mod render;
 
 use caustics::output;
 use caustics::params::Params;
+use caustics::renderer::Stage;
 use caustics::scene::{Scene, DEFAULT_SCENE};
 use caustics::techniques;
 use caustics::vk::{Context, ContextOptions, FrameOptions, MAX_FRAMES_IN_FLIGHT};
@@ -138,7 +139,7 @@ pub struct RenderArgs {
 pub struct ReferenceArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// Photons to trace (rounded up to whole passes of 262,144).
+    /// Photons to trace (rounded up to whole passes of 262,144; at most 1e15).
     #[arg(
         long,
         allow_negative_numbers = true,
@@ -191,6 +192,11 @@ pub struct BenchArgs {
     /// Also write the results as JSON.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Sample host RSS and gpu-allocator's device memory this many times,
+    /// evenly over the timed frames (printed, and in the JSON): a soak
+    /// test's leak check (scripts/soak.sh).
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0)]
+    pub memory_samples: u32,
     #[command(flatten)]
     pub frame: FrameArgs,
     #[command(flatten)]
@@ -291,6 +297,27 @@ pub fn check_device_limits(ctx: &Context, args: &SceneArgs) -> anyhow::Result<()
     Ok(())
 }
 
+/// Names the arguments behind a failure of `Renderer::new` (a device limit
+/// met by the scene, the image size or the technique `technique` with the
+/// `--param`s `params`).
+pub fn name_arguments(
+    e: anyhow::Error,
+    scene: &SceneArgs,
+    technique: &str,
+    params: &[String],
+) -> anyhow::Error {
+    let what = match e.downcast_ref::<Stage>() {
+        Some(Stage::Scene) => format!("--scene {}", scene.scene.display()),
+        Some(Stage::Targets { .. }) => format!("--width {} --height {}", scene.width, scene.height),
+        Some(Stage::Technique) => {
+            let params: String = params.iter().map(|p| format!(" --param {p}")).collect();
+            format!("--technique {technique}{params}")
+        }
+        None => return e,
+    };
+    e.context(what)
+}
+
 /// Fails the command if the validation layer reported errors, leaked objects
 /// included: everything that used the device must be dropped before this.
 pub fn check_validation(ctx: Arc<Context>) -> anyhow::Result<()> {
@@ -310,6 +337,19 @@ pub fn load_scene(path: &Path, time: f32) -> anyhow::Result<Scene> {
     let scene = Scene::load(path)?;
     scene.check_at(time).map_err(anyhow::Error::msg)?;
     Ok(scene)
+}
+
+/// The most photons `reference` and `compare` trace: 10^15, years of
+/// tracing on any device today (lavapipe: about 2.5 M photons/s), and far
+/// from where counting them in whole passes would overflow.
+pub const MAX_PHOTONS: u64 = 1_000_000_000_000_000;
+
+/// Checks a photon count given as `--photons`.
+pub fn check_photons(photons: u64) -> anyhow::Result<()> {
+    if !(1..=MAX_PHOTONS).contains(&photons) {
+        anyhow::bail!("--photons {photons}: must be between 1 and {MAX_PHOTONS:e}");
+    }
+    Ok(())
 }
 
 pub fn check_size(args: &SceneArgs) -> anyhow::Result<()> {

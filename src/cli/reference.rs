@@ -22,9 +22,7 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
     check_size(&scene)?;
     output::format_of(&out)?;
     let component = Component::parse(&component)?;
-    if photons == 0 {
-        anyhow::bail!("--photons must be at least 1");
-    }
+    super::check_photons(photons)?;
     if let Some(seconds) = seconds {
         if !(seconds.is_finite() && seconds > 0.0) {
             anyhow::bail!("--seconds must be a positive number, got {seconds}");

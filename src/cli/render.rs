@@ -6,14 +6,15 @@ use super::{
     RenderArgs, TechniqueArgs,
 };
 use caustics::compare::report::{
-    median, pass_stats, per_pass, BenchReport, RunInfo, Timing, SCHEMA,
+    extend_per_pass, median, per_pass, stats_per_pass, BenchReport, MemorySample, RunInfo, Timing,
+    SCHEMA,
 };
 use caustics::output;
 use caustics::params::Params;
 use caustics::renderer::Renderer;
 use caustics::scene::Scene;
 use caustics::techniques;
-use caustics::vk::{Context, FrameOptions, PassTiming};
+use caustics::vk::{bytes, Context, FrameOptions, PassTiming};
 use std::collections::BTreeMap;
 use std::io::Write as _;
 use std::sync::Arc;
@@ -99,7 +100,8 @@ fn start(
         s.width,
         s.height,
         s.time,
-    )?;
+    )
+    .map_err(|e| super::name_arguments(e, s, &run.technique, &run.params))?;
     renderer.set_frame_options(options)?;
     Ok((ctx, renderer))
 }
@@ -110,10 +112,14 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
         frames,
         warmup,
         json,
+        memory_samples,
         frame,
         device,
     } = args;
     let (loaded, params) = checked_technique_run(&mut run, frames)?;
+    if memory_samples > frames {
+        anyhow::bail!("--memory-samples {memory_samples}: at most --frames ({frames})");
+    }
     let options = frame.options()?;
     if let Some(path) = &json {
         output::check_writable(path, "--json")?;
@@ -127,10 +133,35 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
     let waited_before = renderer.frames.host_wait;
     let submit_before = renderer.frames.host_submit;
     let start = Instant::now();
+    // Timings are taken as numbers every so often, so a long run's host
+    // memory does not grow with per-frame records.
+    let (mut by_pass, mut submit_to_done) = (Vec::new(), Vec::new());
+    let mut take = |done: Vec<caustics::vk::FrameTiming>| {
+        submit_to_done.extend(done.iter().map(|f| f.submit_to_done_ms));
+        extend_per_pass(&mut by_pass, per_pass(&done));
+    };
+    let mut memory = Vec::new();
     for i in 0..frames {
         renderer.submit_frame(scene.time + (warmup + i) as f32 / 60.0)?;
+        if i % 64 == 63 {
+            take(renderer.take_timings());
+        }
+        // After frames k * frames / samples, k = 1..=samples.
+        let n = u64::from(memory_samples);
+        if n > 0
+            && (u64::from(i) + 1) * n / u64::from(frames) > u64::from(i) * n / u64::from(frames)
+        {
+            let device = ctx.memory_report();
+            memory.push(MemorySample {
+                frame: i + 1,
+                host_rss: host_rss()?,
+                device_allocated: device.allocated,
+                device_allocations: device.allocations,
+                device_capacity: device.capacity,
+            });
+        }
     }
-    let done = renderer.finish()?;
+    take(renderer.finish()?);
     // Wall clock over the timed frames, the final wait included: what a
     // frame costs when frames overlap.
     let interval_ms = start.elapsed().as_secs_f64() * 1e3 / frames as f64;
@@ -143,8 +174,7 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
     let counters: BTreeMap<_, _> = renderer.technique_counters().into_iter().collect();
     drop(renderer);
     check_validation(ctx)?;
-    let passes = pass_stats(&done);
-    let submit_to_done: Vec<f64> = done.iter().map(|f| f.submit_to_done_ms).collect();
+    let passes = stats_per_pass(by_pass);
     println!(
         "bench {} on {} at {}x{}, {} frames after {} warm-up, {} in flight ({}):",
         technique,
@@ -177,6 +207,16 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
         "  {:<28} {:>9.3} ms per frame (host inside vkQueueSubmit2)",
         "host submit", submit_ms
     );
+    for m in &memory {
+        println!(
+            "  memory after frame {:>7}: host RSS {:>10}, device {:>10} in {} allocations ({} in blocks)",
+            m.frame,
+            bytes(m.host_rss),
+            bytes(m.device_allocated),
+            m.device_allocations,
+            bytes(m.device_capacity)
+        );
+    }
     if let Some(path) = json {
         let report = BenchReport {
             run: RunInfo {
@@ -206,6 +246,7 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
                 .into_iter()
                 .map(|(k, v)| (k.to_string(), v))
                 .collect(),
+            memory,
         };
         let text = serde_json::to_string_pretty(&report)?;
         output::write_files(vec![output::OutputFile {
@@ -215,4 +256,17 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
         println!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// The process's resident set size (VmRSS in /proc/self/status), bytes.
+fn host_rss() -> anyhow::Result<u64> {
+    let status = std::fs::read_to_string("/proc/self/status")
+        .map_err(|e| anyhow::anyhow!("--memory-samples: cannot read /proc/self/status: {e}"))?;
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmRSS:"))
+        .and_then(|v| v.trim().strip_suffix("kB"))
+        .and_then(|kb| kb.trim().parse::<u64>().ok())
+        .map(|kb| kb * 1024)
+        .ok_or_else(|| anyhow::anyhow!("--memory-samples: no VmRSS in /proc/self/status"))
 }

@@ -193,6 +193,22 @@ pub struct BenchReport {
     pub geometry: crate::frame::GeometryStats,
     /// The technique's named counts of its last frame (`Technique::counters`).
     pub counters: BTreeMap<String, u64>,
+    /// Memory sampled over the timed frames (`bench --memory-samples`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub memory: Vec<MemorySample>,
+}
+
+/// Host and device memory after `frame` timed frames were submitted.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct MemorySample {
+    pub frame: u32,
+    /// The process's resident set (VmRSS), bytes.
+    pub host_rss: u64,
+    /// gpu-allocator's live allocations: bytes, count, and the bytes of
+    /// its memory blocks.
+    pub device_allocated: u64,
+    pub device_allocations: usize,
+    pub device_capacity: u64,
 }
 
 /// Each pass's times over `frames`, in the order of the first frame (a
@@ -211,9 +227,25 @@ pub fn per_pass(frames: &[crate::vk::FrameTiming]) -> Vec<(String, Vec<f64>)> {
     by_name
 }
 
+/// Appends `more` (a [`per_pass`] of later frames) to `all`, pass by pass:
+/// long runs keep their timings as numbers, not as frames.
+pub fn extend_per_pass(all: &mut Vec<(String, Vec<f64>)>, more: Vec<(String, Vec<f64>)>) {
+    for (name, ms) in more {
+        match all.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, v)) => v.extend(ms),
+            None => all.push((name, ms)),
+        }
+    }
+}
+
 /// Each pass's median and minimum over `frames` ([`per_pass`]).
 pub fn pass_stats(frames: &[crate::vk::FrameTiming]) -> Vec<PassStats> {
-    per_pass(frames)
+    stats_per_pass(per_pass(frames))
+}
+
+/// Each pass's median and minimum of its times.
+pub fn stats_per_pass(by_name: Vec<(String, Vec<f64>)>) -> Vec<PassStats> {
+    by_name
         .into_iter()
         .map(|(name, ms)| PassStats {
             name,

@@ -12,7 +12,7 @@ use crate::scene::{Camera, Density, MaterialKind, Scene, Triangle};
 use crate::shader_bindings as b;
 use crate::vk::{
     BindingKind, Buffer, BufferUsage, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder,
-    VkResult,
+    VkError, VkResult,
 };
 use glam::{Mat4, Vec3};
 use std::cell::Cell;
@@ -122,6 +122,17 @@ impl SceneGpu {
     pub fn new(ctx: &Arc<Context>, scene: &Scene, time: f32) -> VkResult<SceneGpu> {
         let start = std::time::Instant::now();
         let triangles = scene.triangles(time);
+        // Every shader binds the triangle buffer whole: a scene it cannot
+        // hold is refused here, before the BVH build (seconds at millions).
+        let size = std::mem::size_of::<GpuTriangle>() as u64;
+        let most = ctx.limits.max_storage_buffer_range as u64 / size;
+        if triangles.len() as u64 > most {
+            return Err(VkError::OverLimit(format!(
+                "{} triangles: the device holds at most {most} ({size} bytes each in one storage buffer, maxStorageBufferRange {})",
+                triangles.len(),
+                crate::vk::bytes(ctx.limits.max_storage_buffer_range as u64)
+            )));
+        }
         let world_ms = start.elapsed().as_secs_f64() * 1e3;
         let bvh = Bvh::build(&triangles);
         let gpu_triangles = Self::gpu_triangles(scene, &bvh, &triangles);

@@ -14,7 +14,32 @@ use crate::vk::{
     Context, FrameOptions, FrameRecorder, FrameSync, FrameTiming, Frames, Image, PassTiming,
     VkError, VkResult,
 };
+use anyhow::Context as _;
 use std::sync::Arc;
+
+/// What `Renderer::new` was making when it failed, as the error's context
+/// (`anyhow::Error::downcast_ref::<Stage>()`), so a caller can name the
+/// argument behind it: a device limit met by the scene, the image size or
+/// the technique's parameters (the command line does).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// The scene's geometry, materials, lights and textures on the device.
+    Scene,
+    /// The frame targets and the display image.
+    Targets { width: u32, height: u32 },
+    /// The technique's own resources.
+    Technique,
+}
+
+impl std::fmt::Display for Stage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Stage::Scene => write!(f, "the scene on the device"),
+            Stage::Targets { width, height } => write!(f, "the {width}x{height} frame targets"),
+            Stage::Technique => write!(f, "the technique's resources"),
+        }
+    }
+}
 
 pub struct Renderer {
     /// First, so it drops first: `Frames::drop` waits for the frames in
@@ -48,11 +73,11 @@ impl Renderer {
         height: u32,
         time: f32,
     ) -> anyhow::Result<Self> {
-        let scene_gpu = SceneGpu::new(ctx, &scene, time)?;
-        let targets = FrameTargets::new(ctx, width, height)?;
-        let tonemap = Tonemap::new(ctx, &targets.radiance)?;
+        let scene_gpu = SceneGpu::new(ctx, &scene, time).context(Stage::Scene)?;
+        let (targets, tonemap) = Self::targets(ctx, width, height)?;
         let technique =
-            techniques::create_named(ctx, technique, params, &scene, &scene_gpu, width, height)?;
+            techniques::create_named(ctx, technique, params, &scene, &scene_gpu, width, height)
+                .context(Stage::Technique)?;
         Ok(Self {
             ctx: ctx.clone(),
             scene,
@@ -80,9 +105,13 @@ impl Renderer {
     /// size (the demo's window resize). All three are built before any is
     /// replaced, so on an error the renderer keeps the old size whole; the
     /// old ones are released after the frames in flight that use them.
+    /// A zero width or height (a minimised window) is refused: the caller
+    /// skips such frames (the demo does) and the renderer keeps its size.
     pub fn resize(&mut self, width: u32, height: u32) -> anyhow::Result<()> {
-        let targets = FrameTargets::new(&self.ctx, width, height)?;
-        let tonemap = Tonemap::new(&self.ctx, &targets.radiance)?;
+        if width == 0 || height == 0 {
+            anyhow::bail!("cannot render at {width}x{height}: nothing to draw (minimised)");
+        }
+        let (targets, tonemap) = Self::targets(&self.ctx, width, height)?;
         let technique = techniques::create_named(
             &self.ctx,
             self.technique.name(),
@@ -98,6 +127,18 @@ impl Renderer {
         let old_targets = std::mem::replace(&mut self.targets, targets);
         self.frames.defer_release(old_targets);
         Ok(())
+    }
+
+    /// The frame targets and the tonemap's display image at a size.
+    fn targets(
+        ctx: &Arc<Context>,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<(FrameTargets, Tonemap)> {
+        let stage = Stage::Targets { width, height };
+        let targets = FrameTargets::new(ctx, width, height).context(stage)?;
+        let tonemap = Tonemap::new(ctx, &targets.radiance).context(stage)?;
+        Ok((targets, tonemap))
     }
 
     /// Switches to technique `name` with `params` (keeps the current one on error).
@@ -126,7 +167,10 @@ impl Renderer {
 
     /// Frames have completed: hands each one's read-backs to the technique
     /// that recorded it, if that is still the current one, and keeps their
-    /// timings. (Fields, not `&mut self`: a frame recorder may hold `frames`.)
+    /// timings, all of them even when an `after_frame` fails (its first
+    /// error is returned; the timings were read already and stay for
+    /// `take_timings`). (Fields, not `&mut self`: a frame recorder may hold
+    /// `frames`.)
     fn frames_done(
         technique: &mut dyn Technique,
         generation: u64,
@@ -134,13 +178,16 @@ impl Renderer {
         completed: &mut Vec<FrameTiming>,
         done: Vec<FrameTiming>,
     ) -> VkResult<()> {
+        let mut first_error = None;
         for done in done {
             if slot_generation.get(done.slot) == Some(&generation) {
-                technique.after_frame(done.slot)?;
+                if let Err(e) = technique.after_frame(done.slot) {
+                    first_error.get_or_insert(e);
+                }
             }
             completed.push(done);
         }
-        Ok(())
+        first_error.map_or(Ok(()), Err)
     }
 
     /// New parameter values for the current technique. When every changed
@@ -316,5 +363,60 @@ impl Renderer {
     /// The last frame tonemapped to 8-bit sRGB RGBA.
     pub fn display(&self) -> VkResult<Vec<u8>> {
         self.tonemap.display.download_bytes(4)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A technique whose `after_frame` fails for one slot.
+    struct FailsIn(usize, Vec<usize>);
+
+    impl Technique for FailsIn {
+        fn name(&self) -> &'static str {
+            "fails_in"
+        }
+        fn record(
+            &mut self,
+            _: &mut FrameRecorder,
+            _: &SceneGpu,
+            _: &FrameTargets,
+        ) -> VkResult<()> {
+            Ok(())
+        }
+        fn after_frame(&mut self, slot: usize) -> VkResult<()> {
+            self.1.push(slot);
+            if slot == self.0 {
+                return Err(VkError::DeviceLost);
+            }
+            Ok(())
+        }
+    }
+
+    fn timing(slot: usize) -> FrameTiming {
+        FrameTiming {
+            slot,
+            passes: vec![PassTiming {
+                name: format!("pass {slot}"),
+                ms: slot as f64,
+            }],
+            submit_to_done_ms: 1.0,
+        }
+    }
+
+    /// Issue 18: an error from `after_frame` keeps every completed frame's
+    /// timings (they were read already) and still hands the later frames to
+    /// the technique; the first error is returned.
+    #[test]
+    fn after_frame_errors_keep_the_timings() {
+        let mut technique = FailsIn(1, Vec::new());
+        let mut completed = Vec::new();
+        let done = (0..3).map(timing).collect();
+        let result = Renderer::frames_done(&mut technique, 7, &[7, 7, 7], &mut completed, done);
+        assert!(matches!(result, Err(VkError::DeviceLost)));
+        assert_eq!(technique.1, vec![0, 1, 2]);
+        let slots: Vec<usize> = completed.iter().map(|t| t.slot).collect();
+        assert_eq!(slots, vec![0, 1, 2]);
     }
 }

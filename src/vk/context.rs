@@ -3,8 +3,9 @@
 //! `Arc<Context>` so the device is destroyed last.
 
 use super::device::{enumerate_devices, pick_device, query_device, DeviceInfo};
+use super::limits::{MemoryHeaps, MemoryReport};
 use super::pipeline_store::PipelineStore;
-use super::{VkError, VkResult};
+use super::{fault, VkError, VkResult};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use std::ffi::{c_void, CStr};
@@ -56,6 +57,9 @@ pub struct Context {
     /// Valid bits of a timestamp on the queue (for wrapping subtraction).
     pub timestamp_valid_bits: u32,
     pub limits: vk::PhysicalDeviceLimits,
+    /// The memory heaps and what this process holds in each: every
+    /// allocation is checked against them first (`limits.rs`).
+    pub memory: MemoryHeaps,
     /// Synchronization validation is on (`ContextOptions::sync_validation`
     /// asked for it and the layer offers it).
     pub sync_validation: bool,
@@ -366,7 +370,7 @@ impl Context {
                             drop(a);
                             pool.err()
                                 .map(VkError::from)
-                                .unwrap_or(VkError::OutOfMemory)
+                                .unwrap_or(VkError::OutOfHostMemory)
                         }
                     };
                     device.destroy_device(None);
@@ -384,6 +388,9 @@ impl Context {
             info.driver
         );
         let pipelines = PipelineStore::new(&device, &props);
+        let memory = MemoryHeaps::new(&unsafe {
+            instance.get_physical_device_memory_properties(physical_device)
+        });
         Ok(Arc::new(Context {
             entry,
             instance,
@@ -394,6 +401,7 @@ impl Context {
             timestamp_period: props.limits.timestamp_period as f64,
             timestamp_valid_bits,
             limits: props.limits,
+            memory,
             sync_validation,
             info,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
@@ -500,13 +508,24 @@ impl Context {
                 self.device
                     .queue_submit2(self.queue, &[submit], fence)
                     .and_then(|_| self.device.wait_for_fences(&[fence], true, u64::MAX))
-            };
+            }
+            .and_then(|_| fault::queue_op());
             unsafe { self.device.destroy_fence(fence, None) };
             waited?;
             Ok(r)
         })();
         self.free_command_buffer(cmd);
         result
+    }
+
+    /// Device memory in use now, from gpu-allocator's report.
+    pub fn memory_report(&self) -> MemoryReport {
+        let report = self.allocator().generate_report();
+        MemoryReport {
+            allocated: report.total_allocated_bytes,
+            capacity: report.total_capacity_bytes,
+            allocations: report.allocations.len(),
+        }
     }
 
     /// The pipeline store: reuse across rebuilds, counts, the disk cache.

@@ -32,7 +32,7 @@
 use super::pass::Pass;
 use super::ring::Ring;
 use super::sync::ResourceState;
-use super::{Access, Buffer, Context, VkError, VkResult};
+use super::{fault, Access, Buffer, Context, VkError, VkResult};
 use ash::vk;
 use std::any::Any;
 use std::collections::VecDeque;
@@ -256,7 +256,14 @@ impl Frames {
         let mut done = std::mem::take(&mut self.completed_early);
         if self.slots[index].pending.is_some() {
             self.order.retain(|&s| s != index);
-            done.push(self.complete(index)?);
+            match self.complete(index) {
+                Ok(t) => done.push(t),
+                Err(e) => {
+                    // Frames completed before keep their timings.
+                    self.completed_early = done;
+                    return Err(e);
+                }
+            }
         }
         let ctx = self.ctx.clone();
         let slot = &mut self.slots[index];
@@ -294,11 +301,15 @@ impl Frames {
         let ctx = self.ctx.clone();
         let slot = &mut self.slots[index];
         let start = Instant::now();
-        unsafe {
+        let waited = (|| unsafe {
             ctx.device.wait_for_fences(&[slot.fence], true, u64::MAX)?;
+            fault::queue_op()?;
             ctx.device.reset_fences(&[slot.fence])?;
-        }
+            Ok::<(), VkError>(())
+        })();
+        // Not pending any more, even when the wait failed (a lost device).
         ctx.frames_pending.fetch_sub(1, Ordering::Relaxed);
+        waited?;
         let waited = start.elapsed();
         self.host_wait += waited;
         let done = Instant::now();
@@ -333,7 +344,14 @@ impl Frames {
     pub fn wait_all(&mut self) -> VkResult<Vec<FrameTiming>> {
         let mut out = std::mem::take(&mut self.completed_early);
         while let Some(index) = self.order.pop_front() {
-            out.push(self.complete(index)?);
+            match self.complete(index) {
+                Ok(t) => out.push(t),
+                Err(e) => {
+                    // Frames completed before keep their timings.
+                    self.completed_early = out;
+                    return Err(e);
+                }
+            }
         }
         Ok(out)
     }
@@ -371,8 +389,12 @@ fn timings(ctx: &Context, names: Vec<String>, ticks: &[u64]) -> Vec<PassTiming> 
 
 impl Drop for Frames {
     fn drop(&mut self) {
-        // Nothing a slot owns may go while its frame runs.
-        let _ = self.wait_all();
+        // Nothing a slot owns may go while its frame runs. After a failed
+        // wait (a lost device) the frames behind it are not waited for one
+        // by one: idle the device instead.
+        if self.wait_all().is_err() {
+            self.ctx.wait_idle();
+        }
         let mut slots = std::mem::take(&mut self.slots);
         for slot in &mut slots {
             self.destroy_slot(slot);
@@ -624,6 +646,7 @@ impl<'a> FrameRecorder<'a> {
             .command_buffer_infos(&cmds)
             .signal_semaphore_infos(&signals);
         let start = Instant::now();
+        fault::queue_op()?;
         unsafe { ctx.device.queue_submit2(ctx.queue, &[submit], slot.fence) }?;
         ctx.frames_pending.fetch_add(1, Ordering::Relaxed);
         self.frames.host_submit += start.elapsed();

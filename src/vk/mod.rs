@@ -14,7 +14,9 @@
 
 mod context;
 mod device;
+mod fault;
 mod frame;
+mod limits;
 mod pass;
 mod pipeline;
 mod pipeline_create;
@@ -31,6 +33,7 @@ pub use frame::{
     FrameOptions, FrameRecorder, FrameSync, FrameTiming, Frames, PassTiming, TimingSource,
     MAX_FRAMES_IN_FLIGHT,
 };
+pub use limits::{bytes, MemoryHeaps, MemoryReport};
 pub use pass::{step, Pass, Resource, Sync};
 pub use pipeline::{
     begin_rendering, begin_rendering_with_depth, end_rendering, BindingKind, ComputePipeline,
@@ -58,10 +61,16 @@ pub enum VkError {
     MissingFeatures { device: String, missing: String },
     #[error("the Khronos validation layer (VK_LAYER_KHRONOS_validation) is not installed: `apt-get install vulkan-validationlayers`")]
     NoValidationLayer,
-    #[error("out of device or host memory")]
-    OutOfMemory,
-    #[error("the device was lost")]
+    #[error("the device ran out of memory (VK_ERROR_OUT_OF_DEVICE_MEMORY)")]
+    OutOfDeviceMemory,
+    #[error("the host ran out of memory (VK_ERROR_OUT_OF_HOST_MEMORY)")]
+    OutOfHostMemory,
+    #[error("the device was lost (VK_ERROR_DEVICE_LOST: the GPU hung, faulted or was reset)")]
     DeviceLost,
+    /// A request over one of the device's limits, refused before anything
+    /// was made or allocated (`limits.rs`): names the resource and the limit.
+    #[error("{0}")]
+    OverLimit(String),
     #[error("memory allocation failed: {0}")]
     Allocation(#[from] gpu_allocator::AllocationError),
     #[error("{0} object(s) still held the Vulkan device at shutdown (leaked resources)")]
@@ -73,9 +82,8 @@ pub enum VkError {
 impl From<vk::Result> for VkError {
     fn from(r: vk::Result) -> Self {
         match r {
-            vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => {
-                VkError::OutOfMemory
-            }
+            vk::Result::ERROR_OUT_OF_DEVICE_MEMORY => VkError::OutOfDeviceMemory,
+            vk::Result::ERROR_OUT_OF_HOST_MEMORY => VkError::OutOfHostMemory,
             vk::Result::ERROR_DEVICE_LOST => VkError::DeviceLost,
             other => VkError::Vulkan(other),
         }

@@ -3,12 +3,43 @@
 //! note in `vk/mod.rs`.
 
 use super::sync::ResourceState;
-use super::{Context, VkResult};
+use super::{fault, limits, Context, VkResult};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
 use std::cell::Cell;
 use std::sync::Arc;
+
+/// Allocates memory for a buffer or image after checking that its heap can
+/// hold it (`limits.rs`: on lavapipe an allocation beyond memory meets the
+/// OOM killer, not an error code), and accounts for it there.
+fn allocate(
+    ctx: &Context,
+    name: &str,
+    requirements: vk::MemoryRequirements,
+    location: MemoryLocation,
+    linear: bool,
+) -> VkResult<Allocation> {
+    ctx.memory.check(name, &requirements, location)?;
+    fault::allocation()?;
+    let allocation = ctx.allocator().allocate(&AllocationCreateDesc {
+        name,
+        requirements,
+        location,
+        linear,
+        allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+    })?;
+    ctx.memory
+        .allocated(allocation.memory_properties(), allocation.size());
+    Ok(allocation)
+}
+
+/// Returns an allocation made by `allocate`.
+fn free(ctx: &Context, allocation: Allocation) {
+    ctx.memory
+        .freed(allocation.memory_properties(), allocation.size());
+    let _ = ctx.allocator().free(allocation);
+}
 
 /// What a buffer is for, which decides its usage flags and memory location.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -71,24 +102,20 @@ impl Buffer {
             // Also a copy destination: frames copy their timestamps into the ring.
             BufferUsage::Upload => (transfer, MemoryLocation::CpuToGpu),
         };
+        if flags.contains(vk::BufferUsageFlags::STORAGE_BUFFER) {
+            limits::check_storage_buffer(&ctx.limits, name, size)?;
+        }
         let info = vk::BufferCreateInfo::default()
             .size(size)
             .usage(flags)
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
         let raw = unsafe { ctx.device.create_buffer(&info, None) }?;
         let requirements = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
-        let allocation = ctx.allocator().allocate(&AllocationCreateDesc {
-            name,
-            requirements,
-            location,
-            linear: true,
-            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-        });
-        let allocation = match allocation {
+        let allocation = match allocate(ctx, name, requirements, location, true) {
             Ok(a) => a,
             Err(e) => {
                 unsafe { ctx.device.destroy_buffer(raw, None) };
-                return Err(e.into());
+                return Err(e);
             }
         };
         unsafe {
@@ -260,7 +287,7 @@ impl Buffer {
 impl Drop for Buffer {
     fn drop(&mut self) {
         if let Some(a) = self.allocation.take() {
-            let _ = self.ctx.allocator().free(a);
+            free(&self.ctx, a);
         }
         unsafe { self.ctx.device.destroy_buffer(self.raw, None) };
     }
@@ -453,6 +480,7 @@ impl Image {
         array: bool,
         mip_levels: u32,
     ) -> VkResult<Image> {
+        limits::check_image(&ctx.limits, name, desc.width, desc.height, desc.layers)?;
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(desc.format)
@@ -469,19 +497,14 @@ impl Image {
                 desc.usage | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST,
             )
             .initial_layout(vk::ImageLayout::UNDEFINED);
+        limits::check_image_format(ctx, name, &info)?;
         let raw = unsafe { ctx.device.create_image(&info, None) }?;
         let requirements = unsafe { ctx.device.get_image_memory_requirements(raw) };
-        let allocation = match ctx.allocator().allocate(&AllocationCreateDesc {
-            name,
-            requirements,
-            location: MemoryLocation::GpuOnly,
-            linear: false,
-            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-        }) {
+        let allocation = match allocate(ctx, name, requirements, MemoryLocation::GpuOnly, false) {
             Ok(a) => a,
             Err(e) => {
                 unsafe { ctx.device.destroy_image(raw, None) };
-                return Err(e.into());
+                return Err(e);
             }
         };
         unsafe {
@@ -641,7 +664,7 @@ impl Drop for Image {
             self.ctx.device.destroy_image_view(self.view, None);
         }
         if let Some(a) = self.allocation.take() {
-            let _ = self.ctx.allocator().free(a);
+            free(&self.ctx, a);
         }
         unsafe { self.ctx.device.destroy_image(self.raw, None) };
     }

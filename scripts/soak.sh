@@ -1,0 +1,86 @@
+#!/usr/bin/env bash
+# Soak test (issue 18; not part of the suite): DIRECT_FRAMES (10,000) frames
+# of `direct` and CAUSTICS_FRAMES (500) of each caustics technique at SIZE²
+# (32), time advancing 1/60 s a frame (animated scenes move), two frames in
+# flight, with validation and synchronization validation on (any error
+# fails the run). `caustics bench --memory-samples SAMPLES` (10) samples the
+# host's RSS and gpu-allocator's live device memory evenly over the timed
+# frames (after WARMUP, 10, untimed); each must stay flat: max over min of the samples at most 1 + TOL
+# (0.01). Prints a table (BENCHMARKS.md, "Soak"); JSON in out/soak/.
+#   scripts/soak.sh                    everything at the default counts
+#   DIRECT_FRAMES=2000 CAUSTICS_FRAMES=50 scripts/soak.sh direct image_space
+# BIN picks the binary (default target/release/caustics, built if missing).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+DIRECT_FRAMES=${DIRECT_FRAMES:-10000}
+CAUSTICS_FRAMES=${CAUSTICS_FRAMES:-500}
+SIZE=${SIZE:-32}
+SAMPLES=${SAMPLES:-10}
+TOL=${TOL:-0.01}
+BIN=${BIN:-target/release/caustics}
+[ -x "$BIN" ] || cargo build --release --quiet
+out=out/soak
+mkdir -p "$out"
+techniques=("$@")
+[ ${#techniques[@]} -eq 0 ] && techniques=(direct image_space volume_lines water_photons beams pinhole)
+
+# The scene each technique soaks on (animated where the technique allows)
+# and small maps and buffers: a leak check, not a benchmark (at their
+# defaults the caustics techniques take 0.4-5 s a frame on lavapipe).
+scene_of() {
+    case "$1" in
+        direct | image_space | beams) echo assets/scenes/gemstone.toml ;;
+        volume_lines) echo assets/scenes/volume_cone.toml ;;
+        water_photons) echo assets/scenes/water_pool.toml ;;
+        pinhole) echo assets/scenes/ring.toml ;;
+        *) echo "soak.sh: unknown technique $1" >&2; exit 2 ;;
+    esac
+}
+params_of() {
+    local p="shadow_map_size=256"
+    case "$1" in
+        image_space) p="$p photon_buffer_size=64 caustic_map_size=64" ;;
+        volume_lines) p="$p photon_buffer_size=64 caustic_map_size=64 volume_buffer_size=64 airlight_steps=16" ;;
+        water_photons) p="$p ccm_size=64" ;;
+        beams) p="$p light_view_size=64 grid_size=4" ;;
+        pinhole) p="$p samples=60 cube_size=16" ;;
+    esac
+    for x in $p; do printf -- '--param %s ' "$x"; done
+}
+
+echo "| technique | scene | frames | frame ms | host RSS first → last (max/min) | device memory first → last (max/min) | flat |"
+echo "|---|---|---|---|---|---|---|"
+failed=0
+for t in "${techniques[@]}"; do
+    frames=$CAUSTICS_FRAMES
+    [ "$t" = direct ] && frames=$DIRECT_FRAMES
+    scene=$(scene_of "$t")
+    json="$out/$t.json"
+    log="$out/$t.log"
+    # shellcheck disable=SC2046
+    if ! "$BIN" bench --technique "$t" --scene "$scene" --width "$SIZE" --height "$SIZE" \
+        $(params_of "$t") --frames "$frames" --warmup "${WARMUP:-10}" --memory-samples "$SAMPLES" --validate-sync \
+        --json "$json" >"$log" 2>&1; then
+        echo "| $t | $scene | $frames | failed: $(tail -n 1 "$log") | | | no |"
+        failed=1
+        continue
+    fi
+    python3 - "$json" "$t" "$scene" "$TOL" <<'EOF' || failed=1
+import json, sys
+path, technique, scene, tol = sys.argv[1], sys.argv[2], sys.argv[3], float(sys.argv[4])
+r = json.load(open(path))
+m = r["memory"]
+mib = lambda b: f"{b / 2**20:.2f} MiB"
+def spread(key):
+    v = [s[key] for s in m]
+    return v[0], v[-1], max(v) / max(min(v), 1)
+rss = spread("host_rss")
+dev = spread("device_allocated")
+flat = rss[2] <= 1 + tol and dev[2] <= 1 + tol
+print(f"| {technique} | {scene.split('/')[-1]} | {r['frames']} | {r['frame_ms']:.2f} | "
+      f"{mib(rss[0])} → {mib(rss[1])} ({rss[2]:.4f}) | {mib(dev[0])} → {mib(dev[1])} ({dev[2]:.4f}) | "
+      f"{'yes' if flat else 'NO'} |")
+sys.exit(0 if flat else 1)
+EOF
+done
+exit $failed
