@@ -262,9 +262,9 @@ impl State {
                 // display image's tracked state (write-after-read).
                 step(&ctx, cmd).read(display, Access::TransferRead).emit();
                 let draw_overlay = overlay.visible();
-                swapchain.blit_to_image(cmd, index, display.raw, display.extent(), draw_overlay);
+                swapchain.blit_to_image(cmd, index, display, draw_overlay);
                 if draw_overlay {
-                    let view = swapchain.views[index as usize];
+                    let view = swapchain.images[index as usize].view;
                     begin_rendering(&ctx, cmd, swapchain.extent, &[(view, None)], None);
                     let drawn = overlay.record(cmd, swapchain.extent);
                     end_rendering(&ctx, cmd);

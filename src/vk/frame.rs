@@ -29,9 +29,8 @@
 //! (submit to observed completion), frames still overlap, and per-pass numbers
 //! come only on request (`per_pass`): one submission per pass, each waited for.
 
-use super::pass::Pass;
+use super::pass::{step, Pass};
 use super::ring::Ring;
-use super::sync::ResourceState;
 use super::{fault, Access, Buffer, Context, VkError, VkResult};
 use ash::vk;
 use std::any::Any;
@@ -511,10 +510,11 @@ impl<'a> FrameRecorder<'a> {
     }
 
     /// Writes `bytes` to the start of `dst` for this frame: into the frame's
-    /// ring, then a copy in the frame's command buffer. The copy waits for
-    /// every earlier use of `dst` (all stages: reads by shaders that bind it
-    /// through a set and declare no barrier, such as set 0's frame constants,
-    /// are not tracked), and every later command sees the new contents.
+    /// ring, then a copy in the frame's command buffer, declared through the
+    /// same barrier engine as the passes: it waits for `dst`'s last write
+    /// and for every read since the last upload (`Access::AnyRead`: shaders
+    /// reading it through a set, such as set 0's frame constants, declare
+    /// nothing), and every later command sees the new contents.
     pub fn upload(&mut self, dst: &Buffer, bytes: &[u8]) {
         if bytes.is_empty() || self.error.is_some() {
             return;
@@ -531,47 +531,27 @@ impl<'a> FrameRecorder<'a> {
                 return;
             }
         };
-        let copy = |cmd: vk::CommandBuffer| unsafe {
-            let before = vk::MemoryBarrier2::default()
-                .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
-                .src_access_mask(vk::AccessFlags2::MEMORY_WRITE)
-                .dst_stage_mask(vk::PipelineStageFlags2::COPY)
-                .dst_access_mask(vk::AccessFlags2::TRANSFER_WRITE);
-            ctx.device.cmd_pipeline_barrier2(
-                cmd,
-                &vk::DependencyInfo::default().memory_barriers(&[before]),
-            );
+        // Declared like a pass's accesses: the copy waits for the previous
+        // upload's readers (`AnyRead`: passes read these buffers through
+        // their sets without declaring it) and the buffer's last write; the
+        // new contents are then made visible to every later command.
+        let copy = |cmd: vk::CommandBuffer| {
+            step(&ctx, cmd).write(dst, Access::TransferWrite).emit();
             let region = vk::BufferCopy::default()
                 .src_offset(offset)
                 .size(bytes.len() as u64);
-            ctx.device.cmd_copy_buffer(cmd, src, dst.raw, &[region]);
-            let after = vk::MemoryBarrier2::default()
-                .src_stage_mask(vk::PipelineStageFlags2::COPY)
-                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-                .dst_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
-                .dst_access_mask(vk::AccessFlags2::MEMORY_READ);
-            ctx.device.cmd_pipeline_barrier2(
-                cmd,
-                &vk::DependencyInfo::default().memory_barriers(&[after]),
-            );
+            unsafe { ctx.device.cmd_copy_buffer(cmd, src, dst.raw, &[region]) };
+            step(&ctx, cmd).read(dst, Access::AnyRead).emit();
         };
         if self.per_pass() {
             // Passes are separate submissions here: the copy must run before
             // the next one, so it is a submission of its own.
             if let Err(e) = ctx.submit_and_wait(copy) {
                 self.error = Some(e);
-                return;
             }
         } else {
             copy(self.cmd());
         }
-        // The copy's write is visible to all later reads (the barrier above);
-        // a pass that declares an access to `dst` still gets its own barrier.
-        dst.state.set(ResourceState {
-            layout: vk::ImageLayout::UNDEFINED,
-            last_write: Access::TransferWrite,
-            current: Access::TransferWrite,
-        });
     }
 
     /// Waits for every other frame in flight. For the rare descriptor-set

@@ -333,6 +333,8 @@ pub struct Image {
     pub(super) state: Cell<ResourceState>,
     /// As `Buffer::id`.
     pub(super) id: u64,
+    /// A swapchain's image: the swapchain owns `raw` (only the view is ours).
+    presentable: bool,
     allocation: Option<Allocation>,
 }
 
@@ -542,6 +544,7 @@ impl Image {
             mip_levels,
             state: Cell::new(ResourceState::default()),
             id: next_id(),
+            presentable: false,
             allocation: Some(allocation),
         };
         image.view = make_view(0, desc.layers, ty, mip_levels)?;
@@ -551,6 +554,59 @@ impl Image {
                 .push(make_view(layer, 1, vk::ImageViewType::TYPE_2D, 1)?);
         }
         Ok(image)
+    }
+
+    /// A swapchain's image `raw` (the swapchain owns and destroys it) with a
+    /// colour view of its own, tracked like any image so that its layout
+    /// transitions come from the same declarations (`vk/swapchain.rs`).
+    pub(super) fn presentable(
+        ctx: &Arc<Context>,
+        raw: vk::Image,
+        format: vk::Format,
+        extent: vk::Extent2D,
+    ) -> VkResult<Image> {
+        let info = vk::ImageViewCreateInfo::default()
+            .image(raw)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(format)
+            .subresource_range(vk::ImageSubresourceRange {
+                aspect_mask: vk::ImageAspectFlags::COLOR,
+                base_mip_level: 0,
+                level_count: 1,
+                base_array_layer: 0,
+                layer_count: 1,
+            });
+        let view = unsafe { ctx.device.create_image_view(&info, None) }?;
+        Ok(Image {
+            ctx: ctx.clone(),
+            raw,
+            view,
+            layer_views: Vec::new(),
+            level_views: Vec::new(),
+            desc: ImageDesc::new_2d(
+                extent.width,
+                extent.height,
+                format,
+                vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::COLOR_ATTACHMENT,
+            ),
+            mip_levels: 1,
+            state: Cell::new(ResourceState::default()),
+            id: next_id(),
+            presentable: true,
+            allocation: None,
+        })
+    }
+
+    /// A swapchain image was just acquired: its contents are undefined, and
+    /// its first barrier must start at the stage the acquire semaphore is
+    /// waited at (transfer: the blit), so that the layout transition waits
+    /// for the presentation engine.
+    pub(super) fn acquired(&self) {
+        self.state.set(ResourceState {
+            layout: vk::ImageLayout::UNDEFINED,
+            last_write: super::Access::Undefined,
+            current: super::Access::TransferRead,
+        });
     }
 
     pub fn extent(&self) -> vk::Extent2D {
@@ -666,6 +722,8 @@ impl Drop for Image {
         if let Some(a) = self.allocation.take() {
             free(&self.ctx, a);
         }
-        unsafe { self.ctx.device.destroy_image(self.raw, None) };
+        if !self.presentable {
+            unsafe { self.ctx.device.destroy_image(self.raw, None) };
+        }
     }
 }

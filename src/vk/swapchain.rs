@@ -1,13 +1,14 @@
 //! Presentation: a `VkSurfaceKHR` and a `VkSwapchainKHR` over it. Generic: it
 //! knows windows only through raw-window-handle and nothing of caustics.
 //!
-//! Swapchain images are owned by the swapchain, not by `Image`, so their
-//! layout is tracked here (`blit_to_image` records the barriers around a copy
-//! into one). Recreation (resize) passes the old swapchain to the new one and
+//! Swapchain images are owned by the swapchain; each is wrapped in an
+//! `Image` (`Image::presentable`: its own view, tracked state) so that the
+//! blit into it and its transition to presentation are declared like any
+//! pass's accesses (`vk::step`). Recreation (resize) passes the old swapchain to the new one and
 //! destroys the old one only after the caller has waited for the frames that
 //! used it.
 
-use super::{Context, VkError, VkResult};
+use super::{step, Access, Context, Image, VkError, VkResult};
 use ash::vk;
 use std::sync::Arc;
 
@@ -84,9 +85,9 @@ pub struct Swapchain {
     ctx: Arc<Context>,
     pub loader: ash::khr::swapchain::Device,
     pub raw: vk::SwapchainKHR,
-    pub images: Vec<vk::Image>,
-    /// One colour view per image, for drawing on top of a blit (an overlay).
-    pub views: Vec<vk::ImageView>,
+    /// The swapchain's images, each with a colour view (for drawing on top
+    /// of a blit: an overlay).
+    pub images: Vec<Image>,
     pub format: vk::Format,
     pub extent: vk::Extent2D,
     pub present_mode: vk::PresentModeKHR,
@@ -182,23 +183,16 @@ impl Swapchain {
             loader,
             raw,
             images: Vec::new(),
-            views: Vec::new(),
             format: format.format,
             extent,
             present_mode,
         };
         // From here `swapchain` owns what was made: an error drops it whole.
-        for &image in &images {
-            let info = vk::ImageViewCreateInfo::default()
-                .image(image)
-                .view_type(vk::ImageViewType::TYPE_2D)
-                .format(format.format)
-                .subresource_range(COLOR_RANGE);
+        for image in images {
             swapchain
-                .views
-                .push(unsafe { ctx.device.create_image_view(&info, None) }?);
+                .images
+                .push(Image::presentable(ctx, image, format.format, extent)?);
         }
-        swapchain.images = images;
         Ok(swapchain)
     }
 
@@ -231,42 +225,20 @@ impl Swapchain {
         }
     }
 
-    /// Records a blit of `src` (in TRANSFER_SRC_OPTIMAL, `src_extent`) into
-    /// swapchain image `index`, leaving it in PRESENT_SRC, or, with
-    /// `then_draw`, in COLOR_ATTACHMENT_OPTIMAL for drawing on top (then
-    /// `attachment_to_present`). The image's old
-    /// contents are discarded (UNDEFINED), and the first barrier waits on the
-    /// transfer stage, the stage the acquire semaphore is waited at.
-    /// A blit, not a copy, so RGBA sources reach BGRA swapchains with their
-    /// channels in place and mismatched sizes are scaled.
-    pub fn blit_to_image(
-        &self,
-        cmd: vk::CommandBuffer,
-        index: u32,
-        src: vk::Image,
-        src_extent: vk::Extent2D,
-        then_draw: bool,
-    ) {
-        let image = self.images[index as usize];
-        let range = COLOR_RANGE;
-        let to_dst = [vk::ImageMemoryBarrier2::default()
-            .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
-            .src_access_mask(vk::AccessFlags2::NONE)
-            .dst_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
-            .dst_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-            .old_layout(vk::ImageLayout::UNDEFINED)
-            .new_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .image(image)
-            .subresource_range(range)];
-        let device = &self.ctx.device;
-        unsafe {
-            device.cmd_pipeline_barrier2(
-                cmd,
-                &vk::DependencyInfo::default().image_memory_barriers(&to_dst),
-            )
-        };
+    /// Records a blit of `src` (already declared as read by transfer) into
+    /// swapchain image `index`, just acquired, leaving it ready to present,
+    /// or, with `then_draw`, as a colour attachment for drawing on top (then
+    /// `attachment_to_present`). The image's old contents are discarded,
+    /// and its first barrier waits on the transfer stage, the stage the
+    /// acquire semaphore is waited at (`Image::acquired`). A blit, not a
+    /// copy, so RGBA sources reach BGRA swapchains with their channels in
+    /// place and mismatched sizes are scaled.
+    pub fn blit_to_image(&self, cmd: vk::CommandBuffer, index: u32, src: &Image, then_draw: bool) {
+        let image = &self.images[index as usize];
+        image.acquired();
+        step(&self.ctx, cmd)
+            .overwrite(image, Access::TransferWrite)
+            .emit();
         let layers = vk::ImageSubresourceLayers {
             aspect_mask: vk::ImageAspectFlags::COLOR,
             mip_level: 0,
@@ -280,90 +252,42 @@ impl Swapchain {
         };
         let region = vk::ImageBlit::default()
             .src_subresource(layers)
-            .src_offsets([vk::Offset3D::default(), corner(src_extent)])
+            .src_offsets([vk::Offset3D::default(), corner(src.extent())])
             .dst_subresource(layers)
             .dst_offsets([vk::Offset3D::default(), corner(self.extent)]);
         unsafe {
-            device.cmd_blit_image(
+            self.ctx.device.cmd_blit_image(
                 cmd,
-                src,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                image,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                src.raw,
+                src.layout(),
+                image.raw,
+                image.layout(),
                 &[region],
                 vk::Filter::LINEAR,
             )
         };
         // Presentation needs no access mask: the render-finished semaphore
         // signalled at the end of the submission makes the writes visible.
-        let (dst_stage, dst_access, new_layout) = if then_draw {
-            (
-                vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
-                vk::AccessFlags2::COLOR_ATTACHMENT_READ | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-            )
+        let next = step(&self.ctx, cmd);
+        if then_draw {
+            next.write(image, Access::ColorAttachment).emit();
         } else {
-            (
-                vk::PipelineStageFlags2::NONE,
-                vk::AccessFlags2::NONE,
-                vk::ImageLayout::PRESENT_SRC_KHR,
-            )
-        };
-        let to_present = [vk::ImageMemoryBarrier2::default()
-            .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
-            .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-            .dst_stage_mask(dst_stage)
-            .dst_access_mask(dst_access)
-            .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-            .new_layout(new_layout)
-            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .image(image)
-            .subresource_range(range)];
-        unsafe {
-            device.cmd_pipeline_barrier2(
-                cmd,
-                &vk::DependencyInfo::default().image_memory_barriers(&to_present),
-            )
-        };
+            next.read(image, Access::Present).emit();
+        }
     }
 
-    /// After drawing on image `index` (see `blit_to_image`'s `then_draw`):
-    /// COLOR_ATTACHMENT_OPTIMAL -> PRESENT_SRC.
+    /// After drawing on top of a blit: swapchain image `index` to presentation.
     pub fn attachment_to_present(&self, cmd: vk::CommandBuffer, index: u32) {
-        let barrier = [vk::ImageMemoryBarrier2::default()
-            .src_stage_mask(vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)
-            .src_access_mask(vk::AccessFlags2::COLOR_ATTACHMENT_WRITE)
-            .dst_stage_mask(vk::PipelineStageFlags2::NONE)
-            .dst_access_mask(vk::AccessFlags2::NONE)
-            .old_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-            .new_layout(vk::ImageLayout::PRESENT_SRC_KHR)
-            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .image(self.images[index as usize])
-            .subresource_range(COLOR_RANGE)];
-        unsafe {
-            self.ctx.device.cmd_pipeline_barrier2(
-                cmd,
-                &vk::DependencyInfo::default().image_memory_barriers(&barrier),
-            )
-        };
+        step(&self.ctx, cmd)
+            .read(&self.images[index as usize], Access::Present)
+            .emit();
     }
 }
 
-const COLOR_RANGE: vk::ImageSubresourceRange = vk::ImageSubresourceRange {
-    aspect_mask: vk::ImageAspectFlags::COLOR,
-    base_mip_level: 0,
-    level_count: 1,
-    base_array_layer: 0,
-    layer_count: 1,
-};
-
 impl Drop for Swapchain {
     fn drop(&mut self) {
-        for v in &self.views {
-            unsafe { self.ctx.device.destroy_image_view(*v, None) };
-        }
+        // The images' views first, then the swapchain that owns the images.
+        self.images.clear();
         unsafe { self.loader.destroy_swapchain(self.raw, None) };
     }
 }

@@ -37,6 +37,11 @@ pub enum Access {
     TransferWrite,
     /// Read by the host after the submission's fence.
     HostRead,
+    /// Read by any command without a declaration of its own: a buffer the
+    /// frame uploads and every pass may read through set 0 (frame
+    /// constants, light views). `FrameRecorder::upload` leaves it so, and
+    /// its next upload waits for all of those reads.
+    AnyRead,
     /// Handed to the presentation engine.
     Present,
 }
@@ -86,6 +91,7 @@ impl Access {
             Access::IndirectRead => S::DRAW_INDIRECT,
             Access::TransferRead | Access::TransferWrite => S::ALL_TRANSFER,
             Access::HostRead => S::HOST,
+            Access::AnyRead => S::ALL_COMMANDS,
             Access::Present => S::NONE,
         }
     }
@@ -107,6 +113,7 @@ impl Access {
             Access::TransferRead => A::TRANSFER_READ,
             Access::TransferWrite => A::TRANSFER_WRITE,
             Access::HostRead => A::HOST_READ,
+            Access::AnyRead => A::MEMORY_READ,
         }
     }
 
@@ -145,7 +152,7 @@ impl Access {
             }
             Access::ColorAttachment => L::COLOR_ATTACHMENT_OPTIMAL,
             Access::DepthAttachment => L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
-            Access::IndirectRead | Access::HostRead => L::GENERAL,
+            Access::IndirectRead | Access::HostRead | Access::AnyRead => L::GENERAL,
             Access::TransferRead => L::TRANSFER_SRC_OPTIMAL,
             Access::TransferWrite => L::TRANSFER_DST_OPTIMAL,
             Access::Present => L::PRESENT_SRC_KHR,
