@@ -111,7 +111,6 @@ void main() {
     bool filtered = (pc.flags & PINHOLE_FLAG_FILTER) != 0u;
     bool visibility = (pc.flags & PINHOLE_FLAG_VISIBILITY) != 0u;
     float offset = 1e-4 * max(1.0, bvh_max_abs(pd));
-    // Map normalisation per (cluster, slot): exact / sampled solid angle.
     vec3 e = vec3(0.0);
     for (uint s = 0u; s < count; ++s) {
         Sample smp = samples[s];
@@ -149,12 +148,12 @@ void main() {
         vec3 l = vec3(0.0);
         for (uint slot = 0u; slot < pc.slots; ++slot) {
             if ((mask & (1u << slot)) == 0u) continue;
-            vec2 norm = state.map_norm[k * pc.slots + slot];
-            if (norm.x <= 0.0) continue;
+            float scale = map_scale(k, slot);
+            if (scale == 0.0) continue;
             vec3 radiance_map = filtered
                 ? lookup_footprint(k, slot, r, 2.0 * fp_u, 2.0 * fp_v)
                 : lookup_point(k, slot, r);
-            l += norm.y / norm.x * radiance_map;
+            l += scale * radiance_map;
         }
         vec3 term = reflectance * l * (cos_s * cos_d / (dist2 + eps));
         if (all(equal(term, vec3(0.0)))) continue;
