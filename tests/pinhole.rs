@@ -93,6 +93,7 @@ fn mirror(name: &str, reflectance: f32) -> Material {
         absorption: Vec3::ZERO,
         texture: None,
         emission: Vec3::ZERO,
+        specular: Vec3::ZERO,
     }
 }
 
@@ -317,6 +318,27 @@ fn flat_mirror_reflects_sky_sphere_and_rect_lights() {
             "{name}: mirrored irradiance off by {rel:+.4}"
         );
     }
+    assert_validation_clean(&ctx);
+}
+
+/// The same plate as a `mixed` material (albedo 0.3, mirror part 0.6): a
+/// reflector through its mirror part, so the wall receives 0.6 E.
+#[test]
+fn flat_mixed_plate_reflects_its_mirror_part() {
+    let ctx = validated_context();
+    let plate = Material {
+        color: Vec3::splat(0.3),
+        specular: Vec3::splat(0.6),
+        ..diffuse("plate", 0.3)
+    };
+    let (centre, _, _) = flat_reflector(&ctx, plate);
+    let expected = 0.6 * SUN_E as f64;
+    let rel = centre / expected - 1.0;
+    println!("mixed plate: reflected irradiance {centre:.4} W/m² vs {expected} ({rel:+.4})");
+    assert!(
+        rel.abs() < 0.02,
+        "mixed plate's mirror part off by {rel:+.4}"
+    );
     assert_validation_clean(&ctx);
 }
 

@@ -72,8 +72,13 @@ float map_scale(uint k, uint slot) {
     return norm.y == PINHOLE_MAP_EXACT ? 1.0 : norm.y / norm.x;
 }
 
-bool reflector_kind(uint kind) {
+// Whether material m reflects specularly: a mirror, a `mixed` material's
+// mirror part (which is also a diffuse receiver: the paper's self-reflecting
+// cup), a dielectric with the DIELECTRICS flag.
+bool reflector_material(uint m) {
+    uint kind = material_kind(m);
     return kind == MATERIAL_MIRROR
+        || (kind == MATERIAL_DIFFUSE && any(greaterThan(material_specular(m), vec3(0.0))))
         || ((pc.flags & PINHOLE_FLAG_DIELECTRICS) != 0u && kind == MATERIAL_DIELECTRIC);
 }
 

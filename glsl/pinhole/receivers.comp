@@ -15,7 +15,8 @@
 // region)^2 = epsilon x 4 A / (pi N) ("in the range of the diameter of the
 // surface region that is represented by one sample point squared"), and
 // A/N "the total surface area by the number of sample points". R_s: the
-// mirror's reflectance, or a dielectric's Fresnel reflectance at <n_s,-d_n>
+// mirror's reflectance (a `mixed` material's mirror part: the receivers
+// include the reflector itself, the paper's self-reflecting cup), or a dielectric's Fresnel reflectance at <n_s,-d_n>
 // (Sect. 5: "a simple modulation of the reflected intensity depending on
 // the incident angle (e.g. for a Fresnel term) is straightforward"; the
 // light must arrive from outside, the side the geometric normal faces).
@@ -128,7 +129,9 @@ void main() {
             if (cos_s <= 0.0) continue;
             reflectance = vec3(fresnel_dielectric(cos_s, 1.0 / materials[material].absorption_ior.w));
         } else {
-            reflectance = materials[material].color.rgb;
+            // A mirror, or a mixed material's mirror part.
+            reflectance = material_kind(material) == MATERIAL_MIRROR
+                ? materials[material].color.rgb : material_specular(material);
             if (cos_s < 0.0) { ns = -ns; cos_s = -cos_s; }
         }
         if (cos_s <= 0.0) continue;

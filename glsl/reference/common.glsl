@@ -107,6 +107,19 @@ struct SpecularState {
     vec3 inside_absorption;  // that dielectric's absorption, 1/m
 };
 
+// Mirror reflection of reflectance `reflectance` on the side the ray
+// arrives at (a mirror, or a `mixed` material's mirror part), about the
+// shading normal, or the geometric one where the shading normal would send
+// the ray below the surface.
+void mirror_bounce(inout SpecularState s, vec3 x, vec3 ng, vec3 ns, bool front, vec3 reflectance) {
+    vec3 ng_in = front ? ng : -ng;                   // facing the arriving ray
+    vec3 ns_in = dot(ns, ng_in) > 0.0 ? ns : -ns;
+    s.weight *= reflectance;
+    vec3 r = reflect(s.dir, ns_in);
+    s.dir = dot(r, ng_in) > 0.0 ? r : reflect(s.dir, ng_in);
+    s.origin = offset_origin(x, ng_in);
+}
+
 // Reflects at a mirror or reflects/refracts at a dielectric (exact Fresnel;
 // reflection chosen with probability F keeps the weight unchanged; total
 // internal reflection always reflects). `front`: the ray arrived on the side
@@ -119,16 +132,13 @@ struct SpecularState {
 // entering water from the air sees L_water / n^2. Photons carry flux, which
 // no such factor touches.
 void specular_bounce(inout SpecularState s, vec3 x, vec3 ng, vec3 ns, bool front, Material m, float u, bool carries_radiance) {
-    vec3 ng_in = front ? ng : -ng;                   // facing the arriving ray
-    vec3 ns_in = dot(ns, ng_in) > 0.0 ? ns : -ns;
     uint kind = floatBitsToUint(m.color.w);
     if (kind == MATERIAL_MIRROR) {
-        s.weight *= m.color.rgb;
-        vec3 r = reflect(s.dir, ns_in);
-        s.dir = dot(r, ng_in) > 0.0 ? r : reflect(s.dir, ng_in);
-        s.origin = offset_origin(x, ng_in);
+        mirror_bounce(s, x, ng, ns, front, m.color.rgb);
         return;
     }
+    vec3 ng_in = front ? ng : -ng;                   // facing the arriving ray
+    vec3 ns_in = dot(ns, ng_in) > 0.0 ? ns : -ns;
     float ior = m.absorption_ior.w;
     float eta = front ? 1.0 / ior : ior;
     vec3 n = ns_in;

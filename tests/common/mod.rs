@@ -46,6 +46,7 @@ pub fn diffuse(name: &str, albedo: f32) -> Material {
         absorption: Vec3::ZERO,
         texture: None,
         emission: glam::Vec3::ZERO,
+        specular: glam::Vec3::ZERO,
     }
 }
 
@@ -58,6 +59,7 @@ pub fn dielectric(name: &str, ior: f32) -> Material {
         absorption: Vec3::ZERO,
         texture: None,
         emission: glam::Vec3::ZERO,
+        specular: glam::Vec3::ZERO,
     }
 }
 

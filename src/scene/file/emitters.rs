@@ -183,6 +183,7 @@ pub(super) fn add_geometry(
                 absorption: Vec3::ZERO,
                 texture: None,
                 emission: radiance,
+                specular: Vec3::ZERO,
             });
             let mut mesh = match shape {
                 EmitterShape::Rect {
