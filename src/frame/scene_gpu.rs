@@ -67,6 +67,18 @@ pub struct SceneGpu {
     bvh: Bvh,
 }
 
+/// The area lights at `time` (`Scene::emitter_at`), one zeroed entry when
+/// there are none (a buffer is never empty).
+fn gpu_emitters(scene: &Scene, time: f32) -> Vec<GpuEmitter> {
+    let mut emitters: Vec<GpuEmitter> = (0..scene.emitters.len())
+        .map(|i| GpuEmitter::new(&scene.emitter_at(i, time)))
+        .collect();
+    if emitters.is_empty() {
+        emitters.push(bytemuck::Zeroable::zeroed());
+    }
+    emitters
+}
+
 fn gpu_medium(scene: &Scene) -> GpuMedium {
     scene
         .medium
@@ -174,11 +186,8 @@ impl SceneGpu {
         let albedo_textures = AlbedoTextures::new(ctx, &scene.textures)?;
         let nodes_buf = Buffer::with_data(ctx, "bvh nodes", &bvh.nodes, storage)?;
         let materials_buf = Buffer::with_data(ctx, "materials", &materials, storage)?;
-        let mut emitters: Vec<GpuEmitter> = scene.emitters.iter().map(GpuEmitter::new).collect();
-        let emitter_count = emitters.len() as u32;
-        if emitters.is_empty() {
-            emitters.push(bytemuck::Zeroable::zeroed());
-        }
+        let emitter_count = scene.emitters.len() as u32;
+        let emitters = gpu_emitters(scene, time);
         let emitters_buf = Buffer::with_data(ctx, "area lights", &emitters, storage)?;
         let environment = EnvironmentGpu::new(ctx, scene.environment.as_ref(), sphere.1)?;
         let lights_buf = Buffer::with_data(ctx, "lights", &lights, storage)?;
@@ -276,6 +285,13 @@ impl SceneGpu {
         }
         rec.upload(&self.triangles, bytemuck::cast_slice(&gpu_triangles));
         rec.upload(&self.bvh_nodes, bytemuck::cast_slice(&self.bvh.nodes));
+        // Sphere lights with `animate` move with their geometry.
+        if self.emitter_count > 0 {
+            rec.upload(
+                &self.emitters,
+                bytemuck::cast_slice(&gpu_emitters(scene, time)),
+            );
+        }
         self.sphere = scene.bounding_sphere(time);
         self.geometry_time = time;
     }

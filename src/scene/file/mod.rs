@@ -317,12 +317,14 @@ fn material(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Material> {
             }
             m.absorption = non_negative_rgb(t, "absorption", Some(Vec3::ZERO))?;
         }
-        other => return Err(t.err(
-            "kind",
-            format!(
+        other => {
+            return Err(t.err(
+                "kind",
+                format!(
                 "unknown material kind `{other}`; expected diffuse, mirror, mixed or dielectric"
             ),
-        )),
+            ))
+        }
     }
     Ok(m)
 }
