@@ -153,16 +153,7 @@ fn direct_on_ring_sky_with_sky_occlusion() {
     let mask = first_hit_mask(&scene, SIZE, false, |k| {
         k == caustics::scene::MaterialKind::Diffuse
     });
-    let mut reference = ReferenceRenderer::new(
-        &ctx,
-        scene.clone(),
-        SIZE,
-        SIZE,
-        0.0,
-        ReferenceSettings::default(),
-    )
-    .unwrap();
-    reference.trace(PHOTONS, |_, _| {}).unwrap();
+    let mut reference = traced_reference(&ctx, scene.clone(), SIZE, PHOTONS);
     let truth = masked(&reference.resolve(Component::Direct).unwrap(), &mask);
     drop(reference);
     let ldr = |img: &[f32]| caustics::compare::metrics::tonemap(img, exposure);

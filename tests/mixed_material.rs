@@ -15,7 +15,7 @@
 mod common;
 
 use caustics::params::{ParamSet, Params};
-use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
+use caustics::reference::Component;
 use caustics::renderer::Renderer;
 use caustics::scene::{MaterialKind, Scene};
 use caustics::techniques;
@@ -103,16 +103,7 @@ fn mixed_floor_under_a_constant_sky() {
          [[object]]\nshape = \"plane\"\nsize = [20.0, 20.0]\nmaterial = \"floor\"\n"
     );
     let ctx = validated_context();
-    let mut reference = ReferenceRenderer::new(
-        &ctx,
-        load(&text),
-        SIZE,
-        SIZE,
-        0.0,
-        ReferenceSettings::default(),
-    )
-    .unwrap();
-    reference.trace(2_000_000, |_, _| {}).unwrap();
+    let mut reference = traced_reference(&ctx, load(&text), SIZE, 2_000_000);
     let all = reference.resolve(Component::All).unwrap();
     let emitted = reference.resolve(Component::Emitted).unwrap();
     drop(reference);
@@ -163,16 +154,7 @@ fn mixed_plate_reflects_its_mirror_part() {
          [[object]]\nshape = \"plane\"\ncenter = [2.0, 0.0, 0.0]\nnormal = [-1.0, 0.0, 0.0]\nsize = [4.0, 4.0]\nmaterial = \"wall\"\n"
     );
     let ctx = validated_context();
-    let mut reference = ReferenceRenderer::new(
-        &ctx,
-        load(&text),
-        SIZE,
-        SIZE,
-        0.0,
-        ReferenceSettings::default(),
-    )
-    .unwrap();
-    reference.trace(4_000_000, |_, _| {}).unwrap();
+    let mut reference = traced_reference(&ctx, load(&text), SIZE, 4_000_000);
     let caustic = reference.resolve(Component::SurfaceCaustics).unwrap();
     drop(reference);
     assert_finite(&caustic);

@@ -534,3 +534,18 @@ pub fn block_errors(
     b.mean /= b.used.max(1) as f64;
     b
 }
+
+/// The reference of `scene` at `size`² with the default settings, traced
+/// with `photons` photons.
+pub fn traced_reference(
+    ctx: &Arc<Context>,
+    scene: Scene,
+    size: u32,
+    photons: u64,
+) -> caustics::reference::ReferenceRenderer {
+    let settings = caustics::reference::ReferenceSettings::default();
+    let mut reference =
+        caustics::reference::ReferenceRenderer::new(ctx, scene, size, size, 0.0, settings).unwrap();
+    reference.trace(photons, |_, _| {}).unwrap();
+    reference
+}
