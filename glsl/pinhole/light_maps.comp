@@ -30,8 +30,8 @@ layout(set = 1, binding = PINHOLE_BINDING_LIGHT_MAP_LEVEL0, rgba32f) uniform wri
 //   [L, L + E)    its rect and sphere area lights (glsl/common/emitters.glsl),
 //                 E = frame.components.y;
 //   L + E         the environment's table (an image, or a sky's gradient),
-//   L + E + 1     a sky's sun disc (0 for an image, whose sun is in its table),
-//                 both present only with an environment light.
+//   L + E + 1     a sky's sun disc (no slot for an image, whose sun is in
+//                 its table); both present only with an environment light.
 // The environment is distant (Sect. 5: "one environment map assumes
 // distant light sources"), so its maps are the same from every cluster.
 

@@ -62,7 +62,7 @@ use crate::params::{ParamSet, Params};
 use crate::passes::camera_refraction::RefractionPush;
 use crate::passes::surface_frame::SurfaceFrame;
 use crate::radiometry::Component;
-use crate::scene::Scene;
+use crate::scene::{EnvironmentKind, Scene};
 use crate::shader_bindings as sb;
 use crate::vk::{
     barrier, Access, BindingKind, Buffer, BufferAccess, BufferUsage, ComputePipeline, Context,
@@ -105,9 +105,14 @@ const MAX_LIGHT_MAP_BYTES: u64 = 1 << 30;
 
 /// The emitter slots of the light cube maps, in light_maps.comp's order:
 /// the scene's punctual lights, its area lights, then (with an environment)
-/// the environment's table and a sky's sun disc; at least one.
+/// the environment's table and a sky's sun disc (an image's sun is in its
+/// table); at least one.
 pub fn emitter_slots(scene: &Scene) -> u32 {
-    let environment = if scene.environment.is_some() { 2 } else { 0 };
+    let environment = match scene.environment.as_ref().map(|e| &e.kind) {
+        Some(EnvironmentKind::Sky(_)) => 2,
+        Some(EnvironmentKind::Image(_)) => 1,
+        None => 0,
+    };
     ((scene.lights.len() + scene.emitters.len()) as u32 + environment).max(1)
 }
 
