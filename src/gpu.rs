@@ -69,6 +69,9 @@ pub struct GpuMaterial {
     pub texture: [f32; 4],
     /// rgb radiance emitted from front faces (area lights' own material); w unused.
     pub emission: [f32; 4],
+    /// rgb mirror reflectance of a `mixed` material's specular part (kind
+    /// diffuse; 0 otherwise); w unused.
+    pub specular: [f32; 4],
 }
 
 /// An area light (glsl/common/scene.glsl `Emitter`): what the reference
@@ -195,9 +198,10 @@ const _: () = {
     assert!(offset_of!(GpuBvhNode, count) == 28);
     assert!(size_of::<GpuTriangleUv>() == 32);
     assert!(offset_of!(GpuTriangleUv, uv2) == 16);
-    assert!(size_of::<GpuMaterial>() == 64);
+    assert!(size_of::<GpuMaterial>() == 80);
     assert!(offset_of!(GpuMaterial, texture) == 32);
     assert!(offset_of!(GpuMaterial, emission) == 48);
+    assert!(offset_of!(GpuMaterial, specular) == 64);
     assert!(size_of::<GpuEmitter>() == 64);
     assert!(size_of::<GpuEnvironment>() == 112);
     assert!(size_of::<GpuLight>() == 64);
@@ -281,6 +285,7 @@ impl GpuMaterial {
                 alpha_cutoff,
             ],
             emission: v4(m.emission, 0.0),
+            specular: v4(m.specular, 0.0),
         }
     }
 }

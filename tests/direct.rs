@@ -44,6 +44,7 @@ fn diffuse(name: &str) -> Material {
         absorption: Vec3::ZERO,
         texture: None,
         emission: glam::Vec3::ZERO,
+        specular: glam::Vec3::ZERO,
     }
 }
 

@@ -981,6 +981,7 @@ fn mirror_ring_cardioid_cusp() {
         absorption: Vec3::ZERO,
         texture: None,
         emission: glam::Vec3::ZERO,
+        specular: glam::Vec3::ZERO,
     };
     let mut ring = caustics::scene::shapes::cylinder(
         Vec3::ZERO,

@@ -559,6 +559,7 @@ fn mirror_reflects_the_floor() {
         absorption: Vec3::ZERO,
         texture: None,
         emission: glam::Vec3::ZERO,
+        specular: glam::Vec3::ZERO,
     };
     let s = scene(
         camera(Vec3::new(0.3, 2.5, 4.0), Vec3::new(0.0, 0.5, -1.0), 45.0),

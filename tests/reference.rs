@@ -320,6 +320,7 @@ fn glass_slab_transmits_one_minus_fresnel_squared() {
                 absorption: Vec3::new(0.0, absorption, 0.0),
                 texture: None,
                 emission: glam::Vec3::ZERO,
+                specular: glam::Vec3::ZERO,
                 ..dielectric("glass", n)
             },
         ],
@@ -588,6 +589,7 @@ fn mirror_shows_the_reflected_floor_times_its_reflectance() {
         absorption: Vec3::ZERO,
         texture: None,
         emission: glam::Vec3::ZERO,
+        specular: glam::Vec3::ZERO,
     };
     let s = scene(
         cam,

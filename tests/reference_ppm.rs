@@ -23,6 +23,7 @@ fn mirror(name: &str, reflectance: f32) -> Material {
         absorption: Vec3::ZERO,
         texture: None,
         emission: glam::Vec3::ZERO,
+        specular: glam::Vec3::ZERO,
     }
 }
 

@@ -140,28 +140,98 @@ vec3 sphere_irradiance(Emitter em, vec3 x, vec3 n) {
     return em.radiance.rgb * (PI * r * r / d2) * max(dot(n, v * inversesqrt(d2)), 0.0);
 }
 
-// The unoccluded irradiance from area light e, the direction toward the
-// point its shadow is taken from (its centre) and how far a shadow ray may
-// go before it would meet the light's own geometry.
-vec3 emitter_irradiance(uint e, vec3 x, vec3 n, out vec3 to_light, out float reach) {
+// The point area light e's shadow is taken from (its centre; an emissive
+// triangle's centroid) as seen from x: the direction toward it and how far
+// a shadow ray may go before it would meet the light's own geometry.
+void emitter_shadow_target(uint e, vec3 x, out vec3 to_light, out float reach) {
     Emitter em = emitters[e];
     uint kind = floatBitsToUint(em.position.w);
-    if (kind == EMITTER_TRIANGLE) {
-        vec3 v = em.position.xyz + (em.normal.xyz + em.tangent.xyz) / 3.0 - x; // to the centroid
-        float d = length(v);
-        to_light = v / max(d, 1e-30);
-        reach = d * (1.0 - 1e-3);
-        return triangle_irradiance(em, x, n);
-    }
-    vec3 v = em.position.xyz - x;
+    vec3 target = kind == EMITTER_TRIANGLE
+        ? em.position.xyz + (em.normal.xyz + em.tangent.xyz) / 3.0
+        : em.position.xyz;
+    vec3 v = target - x;
     float d = length(v);
     to_light = v / max(d, 1e-30);
-    if (kind == EMITTER_RECT) {
-        reach = d * (1.0 - 1e-3);
-        return rect_irradiance(em, x, n);
-    }
-    reach = d - em.normal.w * 1.001; // short of the inscribed tessellation
+    reach = kind == EMITTER_RECT || kind == EMITTER_TRIANGLE
+        ? d * (1.0 - 1e-3)
+        : d - em.normal.w * 1.001; // short of the inscribed tessellation
+}
+
+// The unoccluded irradiance from area light e, with its shadow target
+// (emitter_shadow_target).
+vec3 emitter_irradiance(uint e, vec3 x, vec3 n, out vec3 to_light, out float reach) {
+    emitter_shadow_target(e, x, to_light, reach);
+    Emitter em = emitters[e];
+    uint kind = floatBitsToUint(em.position.w);
+    if (kind == EMITTER_TRIANGLE) return triangle_irradiance(em, x, n);
+    if (kind == EMITTER_RECT) return rect_irradiance(em, x, n);
     return sphere_irradiance(em, x, n);
+}
+
+// Whether the ray origin + t dir (unit dir, t > 0) meets the sphere of
+// radius r around `centre`.
+bool ray_meets_sphere(vec3 origin, vec3 dir, vec3 centre, float r) {
+    vec3 oc = centre - origin;
+    float tc = dot(oc, dir);
+    return tc > 0.0 && dot(oc, oc) - tc * tc <= r * r;
+}
+
+// Solid angle of the sphere of radius r around `centre` seen from `origin`:
+// the cap 2 pi (1 - sqrt(1 - r^2/D^2)); 4 pi from inside.
+float sphere_solid_angle(vec3 origin, vec3 centre, float r) {
+    float d2 = dot(centre - origin, centre - origin);
+    if (d2 <= r * r) return 4.0 * PI;
+    float s2 = r * r / d2;
+    // 1 - sqrt(1 - s2) without cancellation.
+    return 2.0 * PI * s2 / (1.0 + sqrt(1.0 - s2));
+}
+
+// Radiance of area light e seen from `origin` along unit `dir`: its
+// radiance where the ray meets it (a rect only from its emitting side),
+// else 0. The light's own geometry is not consulted: what an environment
+// map of the emitters holds (glsl/pinhole/light_maps.comp).
+vec3 area_emitter_radiance(uint e, vec3 origin, vec3 dir) {
+    Emitter em = emitters[e];
+    if (floatBitsToUint(em.position.w) == EMITTER_SPHERE) {
+        return ray_meets_sphere(origin, dir, em.position.xyz, em.normal.w) ? em.radiance.rgb : vec3(0.0);
+    }
+    vec3 nr = em.normal.xyz;
+    float facing = -dot(dir, nr);
+    float h = dot(origin - em.position.xyz, nr); // height above the emitting side
+    if (facing <= 0.0 || h <= 0.0) return vec3(0.0);
+    vec3 q = origin + dir * (h / facing) - em.position.xyz;
+    vec3 t = em.tangent.xyz;
+    bool inside = abs(dot(q, t)) <= 0.5 * em.normal.w && abs(dot(q, cross(nr, t))) <= 0.5 * em.tangent.w;
+    return inside ? em.radiance.rgb : vec3(0.0);
+}
+
+// Solid angle of the triangle (a, b, c) (vectors from the viewpoint):
+// tan(Omega / 2) = |a . (b x c)| / (|a||b||c| + (a.b)|c| + (a.c)|b| +
+// (b.c)|a|) (Van Oosterom & Strackee 1983, "The Solid Angle of a Plane
+// Triangle", IEEE Trans. Biomed. Eng. 30(2)).
+float triangle_solid_angle(vec3 a, vec3 b, vec3 c) {
+    float la = length(a), lb = length(b), lc = length(c);
+    float num = abs(dot(a, cross(b, c)));
+    float den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
+    return 2.0 * atan(num, den);
+}
+
+// Solid angle area light e subtends from `origin`: the sphere's cap, the
+// rect's two triangles (0 behind its emitting side, which is dark).
+float area_emitter_solid_angle(uint e, vec3 origin) {
+    Emitter em = emitters[e];
+    if (floatBitsToUint(em.position.w) == EMITTER_SPHERE) return sphere_solid_angle(origin, em.position.xyz, em.normal.w);
+    vec3 c = em.position.xyz - origin, nr = em.normal.xyz, t = em.tangent.xyz;
+    if (dot(c, nr) >= 0.0) return 0.0;
+    vec3 hu = t * (0.5 * em.normal.w), hv = cross(nr, t) * (0.5 * em.tangent.w);
+    vec3 p0 = c - hu - hv, p1 = c + hu - hv, p2 = c + hu + hv, p3 = c - hu + hv;
+    return triangle_solid_angle(p0, p1, p2) + triangle_solid_angle(p0, p2, p3);
+}
+
+// The solid angle of a sky's sun disc, 2 pi (1 - cos alpha); 0 without one.
+float environment_sun_solid_angle() {
+    if (!environment_present() || environment.sun.w > 1.0) return 0.0;
+    return 2.0 * PI * (1.0 - environment.sun.w);
 }
 
 // The environment's sun as a directional light: a sky's sun, E = L 2 pi

@@ -11,6 +11,8 @@
 #ifndef COMMON_PUNCTUAL_EMITTERS_GLSL
 #define COMMON_PUNCTUAL_EMITTERS_GLSL
 
+#include "emitters.glsl"
+
 // Radiance of light l seen from `origin` along unit `dir`, 0 where the ray
 // misses it. `radius`: r of point and spot lights (m); `sun_cos`: cos alpha.
 vec3 light_emitter_radiance(uint l, vec3 origin, vec3 dir, float radius, float sun_cos) {
@@ -21,14 +23,10 @@ vec3 light_emitter_radiance(uint l, vec3 origin, vec3 dir, float radius, float s
         float sin2 = max(1.0 - sun_cos * sun_cos, 1e-12);
         return light.intensity.rgb / (PI * sin2);
     }
-    // Ray-sphere: |origin + t dir - P|^2 = r^2 with t > 0.
-    vec3 oc = light.position.xyz - origin;
-    float tc = dot(oc, dir);
-    float d2 = dot(oc, oc) - tc * tc;
-    if (tc <= 0.0 || d2 > radius * radius) return vec3(0.0);
+    if (!ray_meets_sphere(origin, dir, light.position.xyz, radius)) return vec3(0.0);
     vec3 intensity = light.intensity.rgb;
     if (kind == LIGHT_SPOT) {
-        vec3 to_origin = -oc / max(length(oc), 1e-30);
+        vec3 to_origin = normalize(origin - light.position.xyz);
         intensity *= spot_falloff(dot(to_origin, light.direction.xyz), light.direction.w, light.intensity.w);
     }
     return intensity / (PI * radius * radius);
@@ -39,11 +37,7 @@ vec3 light_emitter_radiance(uint l, vec3 origin, vec3 dir, float radius, float s
 float light_emitter_solid_angle(uint l, vec3 origin, float radius, float sun_cos) {
     Light light = lights[l];
     if (floatBitsToUint(light.position.w) == LIGHT_DIRECTIONAL) return 2.0 * PI * (1.0 - sun_cos);
-    float d2 = dot(light.position.xyz - origin, light.position.xyz - origin);
-    if (d2 <= radius * radius) return 4.0 * PI;
-    float s2 = radius * radius / d2;
-    // 1 - sqrt(1 - s2) without cancellation.
-    return 2.0 * PI * s2 / (1.0 + sqrt(1.0 - s2));
+    return sphere_solid_angle(origin, light.position.xyz, radius);
 }
 
 #endif

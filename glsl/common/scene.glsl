@@ -37,6 +37,7 @@ struct Material {
     vec4 absorption_ior; // rgb absorption 1/m; w: ior
     vec4 albedo_texture; // x: layer in bits 0-15, wrap u/v (WRAP_*) in bits 16-17/18-19 (int bits, -1: none); yz: uv_scale; w: alpha cutoff
     vec4 emission;       // rgb radiance emitted from front faces (area lights)
+    vec4 specular;       // rgb mirror reflectance of a `mixed` material (kind diffuse); 0 otherwise
 };
 
 // An area light (src/gpu.rs GpuEmitter); its geometry is ordinary
@@ -116,6 +117,10 @@ layout(set = SCENE_SET, binding = BINDING_ENVIRONMENT_DATA, std430) readonly buf
 uint triangle_material(uint tri) { return floatBitsToUint(triangles[tri].p0.w); }
 uint material_kind(uint m) { return floatBitsToUint(materials[m].color.w); }
 uint light_kind(uint l) { return floatBitsToUint(lights[l].position.w); }
+
+// The mirror part of material m: a `mixed` material's specular reflectance
+// (its kind is diffuse: the Lambertian part), 0 for every other material.
+vec3 material_specular(uint m) { return materials[m].specular.rgb; }
 
 // UV at barycentric b (weights of vertices 1 and 2) of triangle `tri`.
 vec2 triangle_uv(uint tri, vec2 b) {

@@ -36,6 +36,7 @@ layout(push_constant) uniform Push {
     uint light_count; // lights with shadow maps (<= MAX_LIGHTS)
     int pcf_radius;   // PCF window half-width in texels
     uint medium_steps; // midpoint steps of inhomogeneous transmittance
+    uint sky_rays;     // rays of the environment's visibility (0: unoccluded)
 } pc;
 
 // A_l L_lm of the environment's table (environment_sh.comp).
@@ -47,20 +48,51 @@ vec3 shadow_origin(vec3 x, vec3 n) {
     return x + n * (1e-4 * (1.0 + max(abs(x.x), max(abs(x.y), abs(x.z)))));
 }
 
+// The fraction of the environment's table that x (normal n) sees, weighted
+// as its irradiance weighs it: over K = sky_rays cosine-weighted directions
+// w_k, V = sum_k l_k v_k / sum_k l_k, with l_k the luminance of the table
+// along w_k (an image's sun texels excluded: the sun has its own shadow
+// ray) and v_k = 1 where a BVH ray from x along w_k escapes. The
+// directions are a stratified (Hammersley-like: k + 1/2 over K in one
+// dimension, a golden-ratio sequence in the other) set, rotated per pixel
+// by a random offset (Cranley-Patterson), so the noise is a fixed pattern,
+// not flicker. The cosine-weighted estimate of E = int L v cos dw is
+// pi/K sum_k L_k v_k; dividing by the same estimate without v leaves the
+// occluded fraction, which scales the noise-free SH irradiance. Exact
+// unoccluded (V = 1) and for a sky of constant radiance as K grows; 1
+// without rays or for a black table.
+float sky_visibility(vec3 x, vec3 n, ivec2 p) {
+    if (pc.sky_rays == 0u) return 1.0;
+    uint rng = rng_seed(uint(p.y) * 65536u + uint(p.x), 0x5bd1e995u);
+    vec2 shift = vec2(rng_next(rng), rng_next(rng));
+    vec3 o = shadow_origin(x, n);
+    float seen = 0.0, total = 0.0;
+    for (uint k = 0u; k < pc.sky_rays; ++k) {
+        vec2 u = fract(vec2((float(k) + 0.5) / float(pc.sky_rays), float(k) * 0.6180339887) + shift);
+        vec3 w = cosine_hemisphere(u, n);
+        vec3 l = environment_table_radiance(w);
+        if (environment_image_sun_texel(w, l)) continue;
+        float weight = luminance(l);
+        total += weight;
+        if (weight > 0.0 && !trace_any(o, w, 0.0, 1e30)) seen += weight;
+    }
+    return total > 0.0 ? seen / total : 1.0;
+}
+
 // Irradiance at x (normal n, facing the camera) from the environment and the
 // area lights (docs/ARCHITECTURE.md, "Environment and area lights in
 // direct"): the environment's table by its order-2 spherical-harmonic
-// irradiance, unoccluded; the environment's sun (a sky's, or the one found in
+// irradiance times its visibility (sky_visibility); the environment's sun (a sky's, or the one found in
 // an image) as a directional light with a BVH shadow ray toward its centre; each area light's exact unoccluded
 // irradiance (emitters.glsl) times one BVH shadow ray toward its centre.
-vec3 extended_irradiance(vec3 x, vec3 n) {
+vec3 extended_irradiance(vec3 x, vec3 n, ivec2 p) {
     vec3 e = vec3(0.0);
     if (environment_present()) {
         float y[9];
         sh_basis(n, y);
         vec3 sky = vec3(0.0);
         for (int k = 0; k < 9; ++k) sky += sh[k].rgb * y[k];
-        e += max(sky, vec3(0.0));
+        e += max(sky, vec3(0.0)) * sky_visibility(x, n, p);
         vec3 to_sun;
         vec3 sun = environment_sun_irradiance(to_sun);
         float cos_sun = dot(n, to_sun);
@@ -116,7 +148,7 @@ void main() {
         if (v == 0.0) continue;
         e_sum += e * v * medium_transmittance_steps(x, to_light, light_travel(dist, x), pc.medium_steps);
     }
-    e_sum += extended_irradiance(x, n);
+    e_sum += extended_irradiance(x, n, p);
     vec4 albedo = imageLoad(g_albedo, p);
     // An area light's front face (albedo.a: the camera sees the front).
     vec3 emission = albedo.a > 0.5 ? materials[material].emission.rgb : vec3(0.0);

@@ -20,7 +20,7 @@ void main() {
     for (uint base = 0u; base < n; base += PINHOLE_GROUP) {
         uint i = base + tid;
         float a = 0.0;
-        if (i < n && reflector_kind(material_kind(triangle_material(i)))) {
+        if (i < n && reflector_material(triangle_material(i))) {
             vec3 p0 = triangles[i].p0.xyz;
             a = 0.5 * length(cross(triangles[i].p1.xyz - p0, triangles[i].p2.xyz - p0));
         }

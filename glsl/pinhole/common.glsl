@@ -31,9 +31,13 @@ layout(set = 1, binding = PINHOLE_BINDING_STATE, std430) buffer StateBlock {
     uint kept_rounds; // neighbourhood stratification: rounds run
     vec4 centres[PINHOLE_MAX_CLUSTERS];  // cluster centres (cube-map origins)
     // per (cluster, emitter slot): x = sum of coverage x texel solid angle,
-    // y = the emitter's exact solid angle from the centre
+    // y = the emitter's exact solid angle from the centre, or
+    // PINHOLE_MAP_EXACT for a map that needs no renormalisation
     vec2 map_norm[];
 } state;
+
+const float PINHOLE_MAP_EXACT = -1.0;
+
 layout(set = 1, binding = PINHOLE_BINDING_CDF, std430) buffer CdfBlock { float cdf[]; };
 layout(set = 1, binding = PINHOLE_BINDING_CANDIDATES, std430) buffer CandidateBlock { Candidate candidates[]; };
 layout(set = 1, binding = PINHOLE_BINDING_HEADS, std430) buffer HeadBlock { uint heads[]; };
@@ -44,7 +48,7 @@ layout(push_constant) uniform Push {
     uint strategy;      // PINHOLE_STRATEGY_*
     uint candidates;    // M dense candidates
     uint clusters;      // K
-    uint slots;         // emitter slots per cluster (the scene's lights)
+    uint slots;         // emitter slots per cluster (light_maps.comp)
     uint cube_size;     // texels per cube face side
     uint flags;         // PINHOLE_FLAG_*
     uint hash_size;     // entries of heads[] (power of two)
@@ -59,8 +63,22 @@ layout(push_constant) uniform Push {
 
 const uint NONE = 0xffffffffu;
 
-bool reflector_kind(uint kind) {
+// The factor a cluster-k map of `slot` is scaled by (light_maps.comp): the
+// emitter's exact solid angle over the map's sampled coverage; 0 when the
+// emitter covers none of the map.
+float map_scale(uint k, uint slot) {
+    vec2 norm = state.map_norm[k * pc.slots + slot];
+    if (norm.x <= 0.0) return 0.0;
+    return norm.y == PINHOLE_MAP_EXACT ? 1.0 : norm.y / norm.x;
+}
+
+// Whether material m reflects specularly: a mirror, a `mixed` material's
+// mirror part (which is also a diffuse receiver: the paper's self-reflecting
+// cup), a dielectric with the DIELECTRICS flag.
+bool reflector_material(uint m) {
+    uint kind = material_kind(m);
     return kind == MATERIAL_MIRROR
+        || (kind == MATERIAL_DIFFUSE && any(greaterThan(material_specular(m), vec3(0.0))))
         || ((pc.flags & PINHOLE_FLAG_DIELECTRICS) != 0u && kind == MATERIAL_DIELECTRIC);
 }
 

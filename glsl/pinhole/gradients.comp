@@ -16,10 +16,12 @@
 // directions at angle theta = atan2(2 S01, S00 - S11) / 2; u, v and the
 // derivatives are rotated onto them.
 // Light visibility (beyond the paper, which has none): one shadow ray per
-// sample point and light, from the side of the surface the light is on;
-// bit l of the mask gates light l's cube map at this sample.
+// sample point and emitter slot, from the side of the surface the light is
+// on; bit s of the mask gates slot s's cube map at this sample.
 #include "common.glsl"
+#include "optics.glsl"
 #include "bvh.glsl"
+#include "emitters.glsl"
 
 layout(local_size_x = 64) in;
 
@@ -85,20 +87,35 @@ void main() {
     if ((pc.flags & PINHOLE_FLAG_LIGHT_VISIBILITY) == 0u) {
         mask = 0xffffffffu;
     } else {
-        for (uint l = 0u; l < frame.counts.x; ++l) {
+        // Slots as in light_maps.comp: one ray to each punctual light, to
+        // each area light's centre and toward a sky's sun; the
+        // environment's table, light from every direction, is not gated.
+        uint punctual = frame.counts.x, env = punctual + frame.components.y;
+        for (uint slot = 0u; slot < pc.slots; ++slot) {
             vec3 to_light;
             float dist;
-            if (light_kind(l) == LIGHT_DIRECTIONAL) {
-                to_light = -lights[l].direction.xyz;
+            if (slot < punctual) {
+                if (light_kind(slot) == LIGHT_DIRECTIONAL) {
+                    to_light = -lights[slot].direction.xyz;
+                    dist = 1e30;
+                } else {
+                    vec3 dl = lights[slot].position.xyz - p;
+                    dist = length(dl);
+                    to_light = dl / dist;
+                }
+            } else if (slot < env) {
+                emitter_shadow_target(slot - punctual, p, to_light, dist);
+            } else if (slot == env + 1u) {
+                if (environment_sun_solid_angle() == 0.0) continue; // no sun disc
+                to_light = environment.sun.xyz;
                 dist = 1e30;
             } else {
-                vec3 dl = lights[l].position.xyz - p;
-                dist = length(dl);
-                to_light = dl / dist;
+                mask |= 1u << slot;
+                continue;
             }
             vec3 side = dot(n, to_light) >= 0.0 ? n : -n;
             float eps = 1e-4 * max(1.0, bvh_max_abs(p));
-            if (!trace_any(p + side * eps, to_light, 0.0, dist)) mask |= 1u << l;
+            if (!trace_any(p + side * eps, to_light, 0.0, dist)) mask |= 1u << slot;
         }
     }
     samples[i].tangent = vec4(u2, uintBitsToFloat(mask));

@@ -8,11 +8,13 @@
 // angle is off by the sub-texel sampling; each map's coverage integral
 // (sum of covered fraction x texel solid angle) goes to map_norm[].x and
 // the emitter's exact solid angle to .y: the receivers scale the map by
-// y / x, so the map carries exactly L * Omega_emitter.
+// y / x, so the map carries exactly L * Omega_emitter (y =
+// PINHOLE_MAP_EXACT: the map is taken as it is).
 #extension GL_EXT_shader_atomic_float : require
 #include "common.glsl"
 #include "optics.glsl"
 #include "lights.glsl"
+#include "emitters.glsl"
 #include "punctual_emitters.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -21,19 +23,39 @@ layout(set = 1, binding = PINHOLE_BINDING_LIGHT_MAP_LEVEL0, rgba32f) uniform wri
 
 #define PINHOLE_SUBSAMPLES 4
 
+// The emitter slots of every cluster's maps (src/techniques/pinhole
+// `emitter_slots`), each one glsl/common radiance function:
+//   [0, L)        the scene's point, spot and directional lights
+//                 (glsl/common/punctual_emitters.glsl), L = frame.counts.x;
+//   [L, L + E)    its rect and sphere area lights (glsl/common/emitters.glsl),
+//                 E = frame.components.y;
+//   L + E         the environment's table (an image, or a sky's gradient),
+//   L + E + 1     a sky's sun disc (no slot for an image, whose sun is in
+//                 its table); both present only with an environment light.
+// The environment is distant (Sect. 5: "one environment map assumes
+// distant light sources"), so its maps are the same from every cluster.
+
 // Radiance of emitter slot `slot` seen from `origin` along `dir`.
-// THE place where emitters enter the cube maps: slots 0 .. lights-1 are the
-// scene's point, spot and directional lights (glsl/common/punctual_emitters.glsl).
-// Environment and area lights (the `lights` branch) become further slots
-// here, each one call of its glsl/common radiance function.
 vec3 emitter_radiance(uint slot, vec3 origin, vec3 dir) {
-    if (slot >= frame.counts.x) return vec3(0.0);
-    return light_emitter_radiance(slot, origin, dir, pc.light_radius, pc.sun_cos);
+    uint punctual = frame.counts.x, areas = frame.components.y;
+    if (slot < punctual) return light_emitter_radiance(slot, origin, dir, pc.light_radius, pc.sun_cos);
+    if (slot < punctual + areas) return area_emitter_radiance(slot - punctual, origin, dir);
+    if (!environment_present()) return vec3(0.0);
+    if (slot == punctual + areas) return environment_table_radiance(dir);
+    if (slot == punctual + areas + 1u) return environment_sun_radiance(dir);
+    return vec3(0.0);
 }
 
+// The exact solid angle of slot `slot`'s emitter from `origin`, or
+// PINHOLE_MAP_EXACT for the environment's table, which covers whole texels
+// and needs no renormalisation.
 float emitter_solid_angle(uint slot, vec3 origin) {
-    if (slot >= frame.counts.x) return 0.0;
-    return light_emitter_solid_angle(slot, origin, pc.light_radius, pc.sun_cos);
+    uint punctual = frame.counts.x, areas = frame.components.y;
+    if (slot < punctual) return light_emitter_solid_angle(slot, origin, pc.light_radius, pc.sun_cos);
+    if (slot < punctual + areas) return area_emitter_solid_angle(slot - punctual, origin);
+    if (slot == punctual + areas) return PINHOLE_MAP_EXACT;
+    if (slot == punctual + areas + 1u) return environment_sun_solid_angle();
+    return 0.0;
 }
 
 void main() {

@@ -15,7 +15,8 @@
 // region)^2 = epsilon x 4 A / (pi N) ("in the range of the diameter of the
 // surface region that is represented by one sample point squared"), and
 // A/N "the total surface area by the number of sample points". R_s: the
-// mirror's reflectance, or a dielectric's Fresnel reflectance at <n_s,-d_n>
+// mirror's reflectance (a `mixed` material's mirror part: the receivers
+// include the reflector itself, the paper's self-reflecting cup), or a dielectric's Fresnel reflectance at <n_s,-d_n>
 // (Sect. 5: "a simple modulation of the reflected intensity depending on
 // the incident angle (e.g. for a Fresnel term) is straightforward"; the
 // light must arrive from outside, the side the geometric normal faces).
@@ -111,7 +112,6 @@ void main() {
     bool filtered = (pc.flags & PINHOLE_FLAG_FILTER) != 0u;
     bool visibility = (pc.flags & PINHOLE_FLAG_VISIBILITY) != 0u;
     float offset = 1e-4 * max(1.0, bvh_max_abs(pd));
-    // Map normalisation per (cluster, slot): exact / sampled solid angle.
     vec3 e = vec3(0.0);
     for (uint s = 0u; s < count; ++s) {
         Sample smp = samples[s];
@@ -129,7 +129,9 @@ void main() {
             if (cos_s <= 0.0) continue;
             reflectance = vec3(fresnel_dielectric(cos_s, 1.0 / materials[material].absorption_ior.w));
         } else {
-            reflectance = materials[material].color.rgb;
+            // A mirror, or a mixed material's mirror part.
+            reflectance = material_kind(material) == MATERIAL_MIRROR
+                ? materials[material].color.rgb : material_specular(material);
             if (cos_s < 0.0) { ns = -ns; cos_s = -cos_s; }
         }
         if (cos_s <= 0.0) continue;
@@ -149,12 +151,12 @@ void main() {
         vec3 l = vec3(0.0);
         for (uint slot = 0u; slot < pc.slots; ++slot) {
             if ((mask & (1u << slot)) == 0u) continue;
-            vec2 norm = state.map_norm[k * pc.slots + slot];
-            if (norm.x <= 0.0) continue;
+            float scale = map_scale(k, slot);
+            if (scale == 0.0) continue;
             vec3 radiance_map = filtered
                 ? lookup_footprint(k, slot, r, 2.0 * fp_u, 2.0 * fp_v)
                 : lookup_point(k, slot, r);
-            l += norm.y / norm.x * radiance_map;
+            l += scale * radiance_map;
         }
         vec3 term = reflectance * l * (cos_s * cos_d / (dist2 + eps));
         if (all(equal(term, vec3(0.0)))) continue;

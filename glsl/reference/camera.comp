@@ -72,15 +72,34 @@ void main() {
             vec3 tr = s.inside ? exp(-s.inside_absorption * hit.t) : medium_transmittance(s.origin, s.dir, hit.t, rng);
             add_pass(index, COMPONENT_EMITTED, s.weight * tr * m.emission.rgb);
         }
-        // The first hit is diffuse: the light tracer covers this sample.
-        if (diffuse && depth == 0u) break;
+        // A `mixed` material: a diffuse one with a mirror part.
+        vec3 mirror = diffuse ? m.specular.rgb : vec3(0.0);
+        bool mixed = any(greaterThan(mirror, vec3(0.0)));
+        // The first hit is diffuse: the light tracer covers this sample (of
+        // a mixed material, its diffuse part; the mirror part goes on below).
+        if (diffuse && depth == 0u && !mixed) break;
         vec3 x = s.origin + hit.t * s.dir;
         // Every segment's attenuation: absorption inside glass, the medium outside.
         if (s.inside) s.weight *= exp(-s.inside_absorption * hit.t);
         else s.weight *= medium_transmittance(s.origin, s.dir, hit.t, rng);
         if (diffuse) {
-            vec3 seen_side = front ? ng : -ng;
             vec3 albedo = hit_albedo(hit);
+            // Past the first hit a mixed material's diffuse part (the visible
+            // point) is taken with probability p = lum(albedo) / (lum(albedo)
+            // + lum(specular)), else its mirror part, the weight divided by
+            // the choice's probability; at the first hit only the mirror
+            // part (weight specular), the light tracer having the rest.
+            bool take_diffuse = depth > 0u;
+            if (mixed && take_diffuse) {
+                float p = luminance(albedo) / (luminance(albedo) + luminance(mirror));
+                take_diffuse = rng_next(rng) < p;
+                s.weight /= take_diffuse ? p : 1.0 - p;
+            }
+            if (!take_diffuse) {
+                mirror_bounce(s, x, ng, hit_normal(hit), front, mirror);
+                continue;
+            }
+            vec3 seen_side = front ? ng : -ng;
             add_pass(index, COMPONENT_DIRECT, s.weight * direct_light(x, seen_side, albedo, rng));
             vec3 weight = s.weight * albedo / PI;
             if (pc.gather != 0u && any(greaterThan(weight, vec3(0.0)))) {

@@ -113,10 +113,17 @@ void main() {
         }
         if (!found) break;
         Material m = materials[hit_material(hit)];
-        if (floatBitsToUint(m.color.w) == MATERIAL_DIFFUSE) break;
         vec3 x = s.origin + hit.t * s.dir;
         vec3 ng = hit_geometric_normal(hit);
-        specular_bounce(s, x, ng, hit_normal(hit), dot(s.dir, ng) < 0.0, m, rng_next(rng), true);
+        bool front = dot(s.dir, ng) < 0.0;
+        if (floatBitsToUint(m.color.w) == MATERIAL_DIFFUSE) {
+            // A `mixed` material's mirror part continues the chain (its
+            // diffuse part is camera.comp's and the light tracer's).
+            if (all(equal(m.specular.rgb, vec3(0.0)))) break;
+            mirror_bounce(s, x, ng, hit_normal(hit), front, m.specular.rgb);
+        } else {
+            specular_bounce(s, x, ng, hit_normal(hit), front, m, rng_next(rng), true);
+        }
         if (luminance(s.weight) <= 0.0) break;
     }
 }

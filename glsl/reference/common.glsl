@@ -107,6 +107,19 @@ struct SpecularState {
     vec3 inside_absorption;  // that dielectric's absorption, 1/m
 };
 
+// Mirror reflection of reflectance `reflectance` on the side the ray
+// arrives at (a mirror, or a `mixed` material's mirror part), about the
+// shading normal, or the geometric one where the shading normal would send
+// the ray below the surface.
+void mirror_bounce(inout SpecularState s, vec3 x, vec3 ng, vec3 ns, bool front, vec3 reflectance) {
+    vec3 ng_in = front ? ng : -ng;                   // facing the arriving ray
+    vec3 ns_in = dot(ns, ng_in) > 0.0 ? ns : -ns;
+    s.weight *= reflectance;
+    vec3 r = reflect(s.dir, ns_in);
+    s.dir = dot(r, ng_in) > 0.0 ? r : reflect(s.dir, ng_in);
+    s.origin = offset_origin(x, ng_in);
+}
+
 // Reflects at a mirror, reflects or passes a thin dielectric sheet, or
 // reflects/refracts at a dielectric (exact Fresnel;
 // reflection chosen with probability F keeps the weight unchanged; total
@@ -120,16 +133,13 @@ struct SpecularState {
 // entering water from the air sees L_water / n^2. Photons carry flux, which
 // no such factor touches.
 void specular_bounce(inout SpecularState s, vec3 x, vec3 ng, vec3 ns, bool front, Material m, float u, bool carries_radiance) {
-    vec3 ng_in = front ? ng : -ng;                   // facing the arriving ray
-    vec3 ns_in = dot(ns, ng_in) > 0.0 ? ns : -ns;
     uint kind = floatBitsToUint(m.color.w);
     if (kind == MATERIAL_MIRROR) {
-        s.weight *= m.color.rgb;
-        vec3 r = reflect(s.dir, ns_in);
-        s.dir = dot(r, ng_in) > 0.0 ? r : reflect(s.dir, ng_in);
-        s.origin = offset_origin(x, ng_in);
+        mirror_bounce(s, x, ng, ns, front, m.color.rgb);
         return;
     }
+    vec3 ng_in = front ? ng : -ng;                   // facing the arriving ray
+    vec3 ns_in = dot(ns, ng_in) > 0.0 ? ns : -ns;
     if (kind == MATERIAL_THIN_DIELECTRIC) {
         // A thin sheet (optics.glsl thin_sheet_reflectance): reflected with
         // probability R_sheet (about the shading normal, as a mirror), else

@@ -391,14 +391,30 @@ void main() {
             if (pc.gather != 0u && (specular > 0u || scattered_or_bounced || extended)) {
                 gather_surface(x, ng_in, s.weight, tag);
             }
-            if (diffuse_left == 0u) return;
-            diffuse_left -= 1u;
-            float survive = clamp(luminance(albedo), 0.05, 1.0);
-            if (rng_next(rng) >= survive) return;
-            s.weight *= albedo / survive;
-            s.dir = cosine_hemisphere(vec2(rng_next(rng), rng_next(rng)), ng_in);
-            s.origin = offset_origin(x, ng_in);
-            scattered_or_bounced = true;
+            // The photon goes on by a `mixed` material's mirror part with
+            // probability lum(specular), or diffusely (while diffuse bounces
+            // are left) with lum(albedo) (a plain diffuse surface:
+            // clamp(lum(albedo), 0.05, 1)), else stops; dividing the weight
+            // by the probability of the choice keeps the estimate unbiased
+            // (Russian roulette over the two lobes; their sum is at most 1).
+            vec3 mirror = m.specular.rgb;
+            float p_mirror = luminance(mirror);
+            float p_diffuse = diffuse_left == 0u ? 0.0
+                : p_mirror > 0.0 ? luminance(albedo) : clamp(luminance(albedo), 0.05, 1.0);
+            float u = rng_next(rng);
+            if (u < p_mirror) {
+                s.weight /= p_mirror;
+                mirror_bounce(s, x, ng, hit_normal(hit), front, mirror);
+                specular += 1u;
+            } else if (u < p_mirror + p_diffuse) {
+                diffuse_left -= 1u;
+                s.weight *= albedo / p_diffuse;
+                s.dir = cosine_hemisphere(vec2(rng_next(rng), rng_next(rng)), ng_in);
+                s.origin = offset_origin(x, ng_in);
+                scattered_or_bounced = true;
+            } else {
+                return;
+            }
         } else {
             specular_bounce(s, x, ng, hit_normal(hit), front, m, rng_next(rng), false);
             specular += 1u;

@@ -66,6 +66,16 @@ pub struct SceneGpu {
     bvh: Bvh,
 }
 
+/// The area lights at `time` (`Scene::emitter_at`), one zeroed entry when
+/// there are none (a buffer is never empty).
+/// The area lights' records at `time` (the first records of the emitter
+/// buffer; the emissive triangles follow them).
+fn gpu_area_lights(scene: &Scene, time: f32) -> Vec<GpuEmitter> {
+    (0..scene.emitters.len())
+        .map(|i| GpuEmitter::new(&scene.emitter_at(i, time)))
+        .collect()
+}
+
 fn gpu_medium(scene: &Scene) -> GpuMedium {
     scene
         .medium
@@ -186,7 +196,7 @@ impl SceneGpu {
         let materials_buf = Buffer::with_data(ctx, "materials", &materials, storage)?;
         // The area lights, then the emissive triangles (at `time`: an
         // animated one's records stay where it was then).
-        let mut emitters: Vec<GpuEmitter> = scene.emitters.iter().map(GpuEmitter::new).collect();
+        let mut emitters = gpu_area_lights(scene, time);
         emitters.extend(GpuEmitter::emissive_triangles(scene, &triangles));
         let emitter_count = emitters.len() as u32;
         if emitters.is_empty() {
@@ -287,6 +297,12 @@ impl SceneGpu {
         }
         rec.upload(&self.triangles, bytemuck::cast_slice(&gpu_triangles));
         rec.upload(&self.bvh_nodes, bytemuck::cast_slice(&self.bvh.nodes));
+        // Sphere lights with `animate` move with their geometry (the
+        // buffer's first records; the emissive triangles' stay).
+        rec.upload(
+            &self.emitters,
+            bytemuck::cast_slice(&gpu_area_lights(scene, time)),
+        );
         self.sphere = scene.bounding_sphere(time);
         self.geometry_time = time;
     }

@@ -55,6 +55,8 @@ crate::declare_params! {
             "percentage-closer filter half-width in shadow texels (0: one tap)";
         medium_steps: u32 [1, 256] = 16, rebuild,
             "midpoint steps of the transmittance through noise/grid media (constant density is exact)";
+        sky_rays: u32 [0, 256] = 16, live,
+            "BVH rays per pixel (cosine-weighted, stratified) that occlude the environment's SH irradiance, weighted by the sky's radiance along them; 0: unoccluded";
     }
 }
 
@@ -65,6 +67,7 @@ struct LightingPush {
     light_count: u32,
     pcf_radius: i32,
     medium_steps: u32,
+    sky_rays: u32,
 }
 
 pub struct DirectLight {
@@ -72,6 +75,7 @@ pub struct DirectLight {
     pub gbuffer: GBuffer,
     pcf_radius: i32,
     medium_steps: u32,
+    sky_rays: u32,
     light_count: u32,
     lighting: ComputePipeline,
     /// Projects the environment onto spherical harmonics (glsl/direct/environment_sh.comp).
@@ -170,6 +174,7 @@ impl DirectLight {
             gbuffer,
             pcf_radius: params.pcf_radius,
             medium_steps: params.medium_steps,
+            sky_rays: params.sky_rays,
             lighting,
             environment_sh,
             sh,
@@ -181,9 +186,10 @@ impl DirectLight {
         })
     }
 
-    /// Takes the live parameters of `params` (`pcf_radius`).
+    /// Takes the live parameters of `params` (`pcf_radius`, `sky_rays`).
     pub fn set_live(&mut self, params: &DirectParams) {
         self.pcf_radius = params.pcf_radius;
+        self.sky_rays = params.sky_rays;
     }
 
     /// Records "shadow maps", "gbuffer" and "direct lighting" into
@@ -200,6 +206,7 @@ impl DirectLight {
             light_count: self.light_count,
             pcf_radius: self.pcf_radius,
             medium_steps: self.medium_steps,
+            sky_rays: self.sky_rays,
         };
         if !self.sh_done {
             let set = &self.sh_set;

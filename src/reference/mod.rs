@@ -81,14 +81,15 @@ pub fn default_radius(camera: &crate::scene::Camera, height: u32) -> f32 {
     1.5 * footprint
 }
 
-/// A sphere around every mirror and dielectric triangle of `scene` at
+/// A sphere around every mirror, dielectric and `mixed` triangle of `scene` at
 /// `time` (the box's centre and half diagonal), or None without any.
 pub fn specular_sphere(scene: &crate::scene::Scene, time: f32) -> Option<(glam::Vec3, f32)> {
     use crate::scene::MaterialKind;
     let mut lo = glam::Vec3::splat(f32::INFINITY);
     let mut hi = glam::Vec3::splat(f32::NEG_INFINITY);
     for t in scene.triangles(time) {
-        if scene.materials[t.material as usize].kind != MaterialKind::Diffuse {
+        let m = &scene.materials[t.material as usize];
+        if m.kind != MaterialKind::Diffuse || m.specular != glam::Vec3::ZERO {
             for p in t.positions {
                 lo = lo.min(p);
                 hi = hi.max(p);

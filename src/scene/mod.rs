@@ -113,6 +113,24 @@ impl Scene {
         }
     }
 
+    /// Area light `index` at `time` seconds: a sphere light with an
+    /// `animate` table is where its object's transform puts its centre
+    /// (the sphere's mesh is built about its object's origin); the rest do
+    /// not move.
+    ///
+    /// Panics if `index` is not an area-light index.
+    pub fn emitter_at(&self, index: usize, time: f32) -> Emitter {
+        let mut e = self.emitters[index];
+        if let EmitterShape::Sphere { center, .. } = &mut e.shape {
+            if self.objects[e.object as usize].animation.is_some() {
+                *center = self
+                    .object_transform(e.object as usize, time)
+                    .transform_point3(Vec3::ZERO);
+            }
+        }
+        e
+    }
+
     /// All triangles in world space at `time`: positions by the object
     /// transform, normals by its inverse transpose (normalised). Winding is
     /// kept counter-clockwise about the normal when a transform mirrors.

@@ -55,6 +55,7 @@ pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
             absorption: Vec3::ZERO,
             texture: None,
             emission: Vec3::ZERO,
+            specular: Vec3::ZERO,
         }
     } else if m.illumination_model == Some(3) {
         Material {
@@ -65,6 +66,7 @@ pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
             absorption: Vec3::ZERO,
             texture: None,
             emission: Vec3::ZERO,
+            specular: Vec3::ZERO,
         }
     } else {
         Material {
@@ -75,6 +77,7 @@ pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
             absorption: Vec3::ZERO,
             texture: None,
             emission: Vec3::ZERO,
+            specular: Vec3::ZERO,
         }
     }
 }

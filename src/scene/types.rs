@@ -75,6 +75,9 @@ pub enum MaterialKind {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub name: String,
+    /// A `mixed` material (docs/SCENES.md) is `Diffuse` with a non-zero
+    /// `specular`: every pass that knows only diffuse surfaces renders its
+    /// diffuse part.
     pub kind: MaterialKind,
     /// Diffuse: albedo. Mirror: reflectance per channel. Dielectric: unused (1).
     pub color: Vec3,
@@ -91,6 +94,11 @@ pub struct Material {
     /// material, whose every triangle is then an area light of its own
     /// (`GpuEmitter::emissive_triangles`).
     pub emission: Vec3,
+    /// Diffuse only: the mirror reflectance per channel of a `mixed`
+    /// material's specular part (a perfect mirror reflection added to the
+    /// Lambertian `color`; `color + specular` <= 1 per channel). 0 for a
+    /// plain diffuse surface and for other kinds.
+    pub specular: Vec3,
 }
 
 /// An environment light: radiance arriving from every direction at

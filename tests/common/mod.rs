@@ -46,6 +46,7 @@ pub fn diffuse(name: &str, albedo: f32) -> Material {
         absorption: Vec3::ZERO,
         texture: None,
         emission: glam::Vec3::ZERO,
+        specular: glam::Vec3::ZERO,
     }
 }
 
@@ -58,6 +59,7 @@ pub fn dielectric(name: &str, ior: f32) -> Material {
         absorption: Vec3::ZERO,
         texture: None,
         emission: glam::Vec3::ZERO,
+        specular: glam::Vec3::ZERO,
     }
 }
 
@@ -553,4 +555,19 @@ pub fn ball_lens_rect_light(size: f32) -> String {
         "[[light]]\nkind = \"rect\"\ncenter = [0.0, 8.0, 0.0]\nnormal = [0.0, -1.0, 0.0]\nsize = [{size}, {size}]\nradiance = {}\n",
         60.0 / (size * size)
     )
+}
+
+/// The reference of `scene` at `size`² with the default settings, traced
+/// with `photons` photons.
+pub fn traced_reference(
+    ctx: &Arc<Context>,
+    scene: Scene,
+    size: u32,
+    photons: u64,
+) -> caustics::reference::ReferenceRenderer {
+    let settings = caustics::reference::ReferenceSettings::default();
+    let mut reference =
+        caustics::reference::ReferenceRenderer::new(ctx, scene, size, size, 0.0, settings).unwrap();
+    reference.trace(photons, |_, _| {}).unwrap();
+    reference
 }

@@ -121,8 +121,9 @@ pub fn load_hdr(path: &Path) -> Result<Texture, String> {
     })
 }
 
-/// A `rect` or `sphere` light's shape and radiance.
-pub(super) fn area_light(t: &Tbl) -> R<(EmitterShape, Vec3)> {
+/// A `rect` or `sphere` light's shape, radiance and (a sphere's) `animate`
+/// motion.
+pub(super) fn area_light(t: &Tbl) -> R<(EmitterShape, Vec3, Option<Animation>)> {
     let shape = match t.str("kind")? {
         "rect" => {
             t.check_keys(
@@ -153,27 +154,37 @@ pub(super) fn area_light(t: &Tbl) -> R<(EmitterShape, Vec3)> {
             }
         }
         _ => {
-            t.check_keys(&["kind", "center", "radius", "radiance"], "a sphere light")?;
+            t.check_keys(
+                &["kind", "center", "radius", "radiance", "animate"],
+                "a sphere light",
+            )?;
             EmitterShape::Sphere {
                 center: t.vec3("center")?,
                 radius: positive(t, "radius")?,
             }
         }
     };
-    Ok((shape, non_negative_rgb(t, "radiance", None)?))
+    let motion = match shape {
+        EmitterShape::Sphere { .. } => super::objects::animation(t)?,
+        EmitterShape::Rect { .. } => None,
+    };
+    Ok((shape, non_negative_rgb(t, "radiance", None)?, motion))
 }
 
 /// Appends each area light's geometry (an object named `light[i]`) and
-/// material (black diffuse emitting its radiance from the front faces).
+/// material (black diffuse emitting its radiance from the front faces). A
+/// sphere's mesh is built about the origin and placed by its object's
+/// transform, a translation to `center`, so that its `animate` motion
+/// moves it as it moves any object (`Scene::emitter_at`).
 pub(super) fn add_geometry(
-    lights: Vec<(EmitterShape, Vec3)>,
+    lights: Vec<(EmitterShape, Vec3, Option<Animation>)>,
     materials: &mut Vec<Material>,
     objects: &mut Vec<Object>,
 ) -> Vec<Emitter> {
     lights
         .into_iter()
         .enumerate()
-        .map(|(i, (shape, radiance))| {
+        .map(|(i, (shape, radiance, animation))| {
             let material = materials.len() as u32;
             materials.push(Material {
                 name: format!("area light {i}"),
@@ -183,25 +194,30 @@ pub(super) fn add_geometry(
                 absorption: Vec3::ZERO,
                 texture: None,
                 emission: radiance,
+                specular: Vec3::ZERO,
             });
-            let mut mesh = match shape {
+            let (mut mesh, transform) = match shape {
                 EmitterShape::Rect {
                     center,
                     normal,
                     tangent,
                     size,
-                } => shapes::plane(center, normal, Some(tangent), size),
-                EmitterShape::Sphere { center, radius } => {
-                    shapes::sphere(center, radius, EMITTER_SPHERE_SEGMENTS)
-                }
+                } => (
+                    shapes::plane(center, normal, Some(tangent), size),
+                    Mat4::IDENTITY,
+                ),
+                EmitterShape::Sphere { center, radius } => (
+                    shapes::sphere(Vec3::ZERO, radius, EMITTER_SPHERE_SEGMENTS),
+                    Mat4::from_translation(center),
+                ),
             };
             mesh.materials = vec![material; mesh.indices.len()];
             let object = objects.len() as u32;
             objects.push(Object {
                 name: format!("area light {i}"),
                 mesh,
-                transform: Mat4::IDENTITY,
-                animation: None,
+                transform,
+                animation,
                 water: None,
             });
             Emitter {

@@ -265,6 +265,7 @@ fn material(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Material> {
         absorption: Vec3::ZERO,
         texture: None,
         emission: Vec3::ZERO,
+        specular: Vec3::ZERO,
     };
     match kind {
         "diffuse" => {
@@ -283,6 +284,21 @@ fn material(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Material> {
             // With a texture, `albedo` scales it (glTF's baseColorFactor).
             let default = if m.texture.is_some() { 1.0 } else { 0.8 };
             m.color = unit_rgb(t, "albedo", Vec3::splat(default))?;
+        }
+        "mixed" => {
+            t.check_keys(
+                &["name", "kind", "reflectance", "albedo"],
+                "a mixed material",
+            )?;
+            m.specular = unit_rgb(t, "reflectance", Vec3::splat(0.5))?;
+            m.color = unit_rgb(t, "albedo", Vec3::splat(0.3))?;
+            let sum = m.specular + m.color;
+            if sum.max_element() > 1.0 {
+                return Err(t.err(
+                    "albedo",
+                    format!("reflectance + albedo must be at most 1 per channel (energy conservation), got {sum}"),
+                ));
+            }
         }
         "mirror" => {
             t.check_keys(&["name", "kind", "reflectance"], "a mirror material")?;
@@ -312,7 +328,9 @@ fn material(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Material> {
         other => {
             return Err(t.err(
                 "kind",
-                format!("unknown material kind `{other}`; expected diffuse, mirror, dielectric or thin_dielectric"),
+                format!(
+                    "unknown material kind `{other}`; expected diffuse, mirror, mixed, dielectric or thin_dielectric"
+                ),
             ))
         }
     }

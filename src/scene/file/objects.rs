@@ -353,7 +353,8 @@ fn transform(t: &Tbl) -> R<Mat4> {
     Ok(Mat4::from_translation(translate) * Mat4::from_quat(q) * Mat4::from_scale(scale))
 }
 
-fn animation(t: &Tbl) -> R<Option<Animation>> {
+/// An `animate` table (objects and sphere lights; docs/SCENES.md).
+pub(super) fn animation(t: &Tbl) -> R<Option<Animation>> {
     let Some(a) = t.opt_table("animate")? else {
         return Ok(None);
     };

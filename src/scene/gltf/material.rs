@@ -67,6 +67,7 @@ pub(super) fn convert_material(
     let mut out = Material {
         texture: None,
         emission: Vec3::ZERO,
+        specular: Vec3::ZERO,
         name,
         kind: MaterialKind::Diffuse,
         color: base,

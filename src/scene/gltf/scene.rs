@@ -87,6 +87,7 @@ pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError
         materials.push(Material {
             texture: None,
             emission: Vec3::ZERO,
+            specular: Vec3::ZERO,
             name: "floor".into(),
             kind: MaterialKind::Diffuse,
             color: Vec3::splat(FLOOR_ALBEDO),

@@ -34,3 +34,5 @@ pub const PINHOLE_FLAG_DIELECTRICS: u32 = 8;
 pub const PINHOLE_GROUP: u32 = 256;
 /// Candidates one dispatch of the selection (select.comp) visits.
 pub const PINHOLE_SELECT_CHUNK: u32 = 4096;
+/// Most emitter slots (light-visibility mask bits per sample point).
+pub const PINHOLE_MAX_SLOTS: u32 = 32;

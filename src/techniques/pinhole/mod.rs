@@ -19,14 +19,13 @@
 //!    `clusters` clusters (Sect. 5's suggestion for lights near the
 //!    reflector).
 //! 6. "pinhole light maps" (light_maps.comp) and "pinhole light mips"
-//!    (mips.comp): one cube map per cluster and emitter slot, from the
-//!    cluster's centre: point and spot lights as spheres of radius
-//!    `light_radius` with L = I / (pi r^2), a directional light as a sun
-//!    disc of `sun_radius` with L = E / (pi sin^2 alpha)
-//!    (glsl/common/punctual_emitters.glsl), with their mip chains. Environment and
-//!    area lights come with the `lights` branch: each will be one more
-//!    emitter slot, rendered in `emitter_radiance` of light_maps.comp by its
-//!    glsl/common function.
+//!    (mips.comp): one cube map per cluster and emitter slot
+//!    (`emitter_slots`), from the cluster's centre, with their mip chains:
+//!    point and spot lights as spheres of radius `light_radius` with
+//!    L = I / (pi r^2), a directional light as a sun disc of `sun_radius`
+//!    with L = E / (pi sin^2 alpha) (glsl/common/punctual_emitters.glsl);
+//!    rect and sphere area lights as they are; the environment's table and
+//!    a sky's sun disc (glsl/common/emitters.glsl).
 //! 7. "pinhole receivers" (receivers.comp): per diffuse pixel of the opaque
 //!    frame, Sect. 3.1's sum over sample points (the equation is written in
 //!    the shader), each lookup filtered over its Sect. 3.3 footprint with
@@ -63,7 +62,7 @@ use crate::params::{ParamSet, Params};
 use crate::passes::camera_refraction::RefractionPush;
 use crate::passes::surface_frame::SurfaceFrame;
 use crate::radiometry::Component;
-use crate::scene::Scene;
+use crate::scene::{EnvironmentKind, Scene};
 use crate::shader_bindings as sb;
 use crate::vk::{step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageDesc, Sampler, VkResult};
 use ash::vk;
@@ -99,6 +98,19 @@ const STATE_HEADER_BYTES: u64 = 16 + 16 * b::PINHOLE_MAX_CLUSTERS as u64;
 const LIGHT_MAP_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 /// Largest light-map image `build` accepts (its mips included).
 const MAX_LIGHT_MAP_BYTES: u64 = 1 << 30;
+
+/// The emitter slots of the light cube maps, in light_maps.comp's order:
+/// the scene's punctual lights, its area lights, then (with an environment)
+/// the environment's table and a sky's sun disc (an image's sun is in its
+/// table); at least one.
+pub fn emitter_slots(scene: &Scene) -> u32 {
+    let environment = match scene.environment.as_ref().map(|e| &e.kind) {
+        Some(EnvironmentKind::Sky(_)) => 2,
+        Some(EnvironmentKind::Image(_)) => 1,
+        None => 0,
+    };
+    ((scene.lights.len() + scene.emitters.len()) as u32 + environment).max(1)
+}
 
 pub struct Pinhole {
     /// Shadows, G-buffers, direct light on the opaque scene, camera refraction.
@@ -161,7 +173,7 @@ impl Pinhole {
         let n = params.samples;
         let m = n * params.oversample;
         let hash_size = (2 * m).next_power_of_two();
-        let slots = (scene.lights.len() as u32).max(1);
+        let slots = emitter_slots(scene);
         let k = params.clusters;
         let triangles = scene_gpu.triangle_count.max(1) as u64;
         let samples = Buffer::new(ctx, "pinhole samples", n as u64 * SAMPLE_BYTES, BufferUsage::Storage)?;
@@ -447,14 +459,20 @@ impl TechniqueBuild for Pinhole {
         width: u32,
         height: u32,
     ) -> anyhow::Result<Self> {
-        // The light maps: clusters x lights x 6 faces, RGBA32F with mips.
-        let slots = scene.lights.len().max(1) as u64;
+        // The light maps: clusters x emitter slots x 6 faces, RGBA32F with mips.
+        let slots = emitter_slots(scene) as u64;
+        if slots > b::PINHOLE_MAX_SLOTS as u64 {
+            anyhow::bail!(
+                "pinhole: the scene has {slots} emitters (lights, area lights, environment table and sun), more than the {} it handles",
+                b::PINHOLE_MAX_SLOTS
+            );
+        }
         let layers = params.clusters as u64 * slots * 6;
         let size = params.cube_size as u64;
         let bytes = layers * size * size * 16 * 4 / 3;
         if layers > ctx.limits.max_image_array_layers as u64 || bytes > MAX_LIGHT_MAP_BYTES {
             anyhow::bail!(
-                "pinhole: {} clusters x {slots} lights x 6 faces of {size}² texels ({layers} layers, {} MiB) exceed the device's {} layers or {} MiB: lower `clusters` or `cube_size`",
+                "pinhole: {} clusters x {slots} emitters x 6 faces of {size}² texels ({layers} layers, {} MiB) exceed the device's {} layers or {} MiB: lower `clusters` or `cube_size`",
                 params.clusters,
                 bytes >> 20,
                 ctx.limits.max_image_array_layers,
