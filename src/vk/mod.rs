@@ -13,9 +13,11 @@
 //! lets go.
 
 mod context;
+mod descriptors;
 mod device;
 mod fault;
 mod frame;
+mod image;
 mod limits;
 mod pass;
 mod pipeline;
@@ -28,20 +30,22 @@ mod swapchain;
 mod sync;
 
 pub use context::{Context, ContextOptions, ValidationCounts};
+pub use descriptors::{BindingKind, DescriptorSet, DescriptorSetLayout, Sampler};
 pub use device::{DeviceInfo, RequiredFeature};
 pub use frame::{
     FrameOptions, FrameRecorder, FrameSync, FrameTiming, Frames, PassTiming, TimingSource,
     MAX_FRAMES_IN_FLIGHT,
 };
+pub use image::{Image, ImageDesc};
 pub use limits::{bytes, MemoryHeaps, MemoryReport};
 pub use pass::{step, Pass, Resource, Sync};
 pub use pipeline::{
-    begin_rendering, begin_rendering_with_depth, end_rendering, BindingKind, ComputePipeline,
-    DescriptorSet, DescriptorSetLayout, GraphicsPipeline, GraphicsPipelineDesc, Sampler,
+    begin_rendering, begin_rendering_with_depth, end_rendering, ComputePipeline, GraphicsPipeline,
+    GraphicsPipelineDesc,
 };
 pub use pipeline_store::{CacheLoad, PipelineCounts, PipelineStore, Specialization};
 pub use profiler::Profiler;
-pub use resources::{Buffer, BufferUsage, Image, ImageDesc};
+pub use resources::{Buffer, BufferUsage};
 pub use swapchain::{Acquired, Surface, Swapchain};
 pub use sync::{copy_image, Access, BufferAccess, ImageAccess};
 

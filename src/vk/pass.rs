@@ -23,7 +23,7 @@
 //! reading what the previous dispatch wrote) is ordered by `step`, a
 //! declaration of the same kind: `step(ctx, cmd).read(..).write(..).emit()`.
 
-use super::pipeline::Bound;
+use super::descriptors::Bound;
 use super::sync::{barrier, ImageAccess};
 use super::{Access, Buffer, BufferAccess, Context, DescriptorSet, FrameRecorder, Image, Sampler};
 use ash::vk;

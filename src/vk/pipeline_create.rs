@@ -3,8 +3,9 @@
 //! `PipelineStore` shares them by. `pipeline.rs`'s `ComputePipeline` and
 //! `GraphicsPipeline` call these through the store.
 
-use super::pipeline::{DescriptorSetLayout, GraphicsPipelineDesc};
+use super::pipeline::GraphicsPipelineDesc;
 use super::pipeline_store::{PipelineKey, Specialization, Stages};
+use super::DescriptorSetLayout;
 use super::{Context, VkResult};
 use crate::shaders;
 use ash::vk;
