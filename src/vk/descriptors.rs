@@ -98,6 +98,22 @@ pub(super) struct Bound {
 }
 
 impl Bound {
+    /// `image` through `view` in `layout`, with `sampler` (null for a
+    /// storage image).
+    pub(super) fn image(
+        image: &Image,
+        view: vk::ImageView,
+        layout: vk::ImageLayout,
+        sampler: vk::Sampler,
+    ) -> Bound {
+        Bound {
+            id: image.id,
+            view,
+            layout,
+            sampler,
+        }
+    }
+
     pub(super) fn buffer(buffer: &Buffer) -> Bound {
         Bound {
             id: buffer.id,
@@ -203,12 +219,7 @@ impl DescriptorSet {
         );
         self.write_image(
             binding,
-            Bound {
-                id: image.id,
-                view: image.view,
-                layout,
-                sampler: sampler.raw,
-            },
+            Bound::image(image, image.view, layout, sampler.raw),
         );
         self
     }

@@ -90,6 +90,31 @@ impl<'a> Accesses<'a> {
     }
 }
 
+/// `read`, `write` and `overwrite`, shared by a pass (`Pass`) and a step
+/// within one (`Sync`): both gather `Accesses` in a field `accesses`.
+macro_rules! declarations {
+    () => {
+        /// Reads `resource` (for a pass: bound elsewhere, such as set 0, an
+        /// attachment or an indirect argument buffer).
+        pub fn read(mut self, resource: impl Into<Resource<'a>>, access: Access) -> Self {
+            self.accesses.read(resource.into(), access);
+            self
+        }
+
+        /// Writes `resource`, keeping what is not overwritten.
+        pub fn write(mut self, resource: impl Into<Resource<'a>>, access: Access) -> Self {
+            self.accesses.write(resource.into(), access, false);
+            self
+        }
+
+        /// Overwrites every texel of `image`: its contents need not be kept.
+        pub fn overwrite(mut self, image: &'a Image, access: Access) -> Self {
+            self.accesses.write(Resource::Image(image), access, true);
+            self
+        }
+    };
+}
+
 /// One binding a pass declares, written before its commands are recorded.
 struct Binding<'a> {
     set: &'a DescriptorSet,
@@ -118,24 +143,7 @@ impl<'r, 'f, 'a> Pass<'r, 'f, 'a> {
         }
     }
 
-    /// The pass reads `resource` (bound elsewhere: set 0, an attachment, an
-    /// indirect argument buffer).
-    pub fn read(mut self, resource: impl Into<Resource<'a>>, access: Access) -> Self {
-        self.accesses.read(resource.into(), access);
-        self
-    }
-
-    /// The pass writes `resource` and keeps what it does not overwrite.
-    pub fn write(mut self, resource: impl Into<Resource<'a>>, access: Access) -> Self {
-        self.accesses.write(resource.into(), access, false);
-        self
-    }
-
-    /// The pass overwrites every texel of `image`: its contents need not be kept.
-    pub fn overwrite(mut self, image: &'a Image, access: Access) -> Self {
-        self.accesses.write(Resource::Image(image), access, true);
-        self
-    }
+    declarations!();
 
     fn declare(&mut self, resource: Resource<'a>, access: Access) {
         if access.is_write() {
@@ -210,12 +218,7 @@ impl<'r, 'f, 'a> Pass<'r, 'f, 'a> {
         self.bind_image(
             set,
             binding,
-            Bound {
-                id: image.id,
-                view,
-                layout,
-                sampler: vk::Sampler::null(),
-            },
+            Bound::image(image, view, layout, vk::Sampler::null()),
         );
     }
 
@@ -230,16 +233,10 @@ impl<'r, 'f, 'a> Pass<'r, 'f, 'a> {
         access: Access,
     ) -> Self {
         self.accesses.read(Resource::Image(image), access);
-        let layout = access.layout_of(image);
         self.bind_image(
             set,
             binding,
-            Bound {
-                id: image.id,
-                view: image.view,
-                layout,
-                sampler: sampler.raw,
-            },
+            Bound::image(image, image.view, access.layout_of(image), sampler.raw),
         );
         self
     }
@@ -326,20 +323,7 @@ pub struct Sync<'c, 'a> {
 }
 
 impl<'a> Sync<'_, 'a> {
-    pub fn read(mut self, resource: impl Into<Resource<'a>>, access: Access) -> Self {
-        self.accesses.read(resource.into(), access);
-        self
-    }
-
-    pub fn write(mut self, resource: impl Into<Resource<'a>>, access: Access) -> Self {
-        self.accesses.write(resource.into(), access, false);
-        self
-    }
-
-    pub fn overwrite(mut self, image: &'a Image, access: Access) -> Self {
-        self.accesses.write(Resource::Image(image), access, true);
-        self
-    }
+    declarations!();
 
     pub fn emit(self) {
         self.accesses.emit(self.ctx, self.cmd);
