@@ -31,7 +31,7 @@ use crate::passes::shadow::ShadowMaps;
 use crate::scene::Scene;
 use crate::shader_bindings as b;
 use crate::vk::{
-    Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    groups_8x8, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
     FrameRecorder, Image, Sampler, VkResult,
 };
 use ash::vk;
@@ -146,7 +146,7 @@ impl Airlight {
                 Access::ComputeWrite,
             )
             .record(|cmd| {
-                let groups = [width.div_ceil(8), height.div_ceil(8), 1];
+                let groups = groups_8x8(width, height);
                 self.pipeline.dispatch(
                     cmd,
                     &[&scene.set, &self.set],

@@ -12,7 +12,7 @@ use crate::passes::gbuffer::GBuffer;
 use crate::passes::specular_gbuffer::{SpecularGBuffer, Viewpoint};
 use crate::shader_bindings as b;
 use crate::vk::{
-    Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    groups_8x8, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
     FrameRecorder, Image, VkResult,
 };
 use bytemuck::{Pod, Zeroable};
@@ -148,7 +148,7 @@ impl CameraRefraction {
             Access::ComputeWrite,
         )
         .record(|cmd| {
-            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
+            let groups = groups_8x8(targets.width, targets.height);
             self.pipeline.dispatch(
                 cmd,
                 &[&scene.set, set],

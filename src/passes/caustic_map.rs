@@ -76,8 +76,8 @@ use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::scene::{Light, LightKind};
 use crate::shader_bindings as b;
 use crate::vk::{
-    begin_rendering, end_rendering, Access, BindingKind, Buffer, BufferUsage, ComputePipeline,
-    Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
+    begin_rendering, end_rendering, groups_8x8, Access, BindingKind, Buffer, BufferUsage,
+    ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
     GraphicsPipelineDesc, Image, ImageDesc, Sampler, Specialization, VkResult,
 };
 use ash::vk;
@@ -487,7 +487,7 @@ impl CausticMap {
                 Access::ComputeWrite,
             )
             .record(|cmd| {
-                let groups = [extent.width.div_ceil(8), extent.height.div_ceil(8), 1];
+                let groups = groups_8x8(extent.width, extent.height);
                 self.apply.dispatch(
                     cmd,
                     &[&scene.set, &self.apply_set],
@@ -543,11 +543,7 @@ impl LightViewConsumer for CausticMap {
                 ],
             )
             .record(|cmd| {
-                let groups = [
-                    self.photon_size.div_ceil(8),
-                    self.photon_size.div_ceil(8),
-                    1,
-                ];
+                let groups = groups_8x8(self.photon_size, self.photon_size);
                 self.photon_pipeline.dispatch(
                     cmd,
                     &[&scene.set, &self.set],

@@ -38,7 +38,7 @@ use crate::passes::shadow::ShadowMaps;
 use crate::scene::Scene;
 use crate::shader_bindings as b;
 use crate::vk::{
-    Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    groups_8x8, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
     DescriptorSetLayout, FrameRecorder, Sampler, VkResult,
 };
 use ash::vk;
@@ -248,7 +248,7 @@ impl DirectLight {
                 Access::ComputeWrite,
             )
             .record(|cmd| {
-                let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
+                let groups = groups_8x8(targets.width, targets.height);
                 self.lighting
                     .dispatch(cmd, &[&scene.set, set], bytemuck::bytes_of(&push), groups);
             });

@@ -1,7 +1,7 @@
 //! Tonemap: the frame's linear radiance to 8-bit sRGB for PNG and display.
 
 use crate::vk::{
-    Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    groups_8x8, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
     FrameRecorder, Image, ImageDesc, VkResult,
 };
 use ash::vk;
@@ -48,11 +48,7 @@ impl Tonemap {
             .storage_image(&self.set, 0, radiance, Access::ComputeRead)
             .overwrite_storage_image(&self.set, 1, &self.display, Access::ComputeWrite)
             .record(|cmd| {
-                let groups = [
-                    radiance.desc.width.div_ceil(8),
-                    radiance.desc.height.div_ceil(8),
-                    1,
-                ];
+                let groups = groups_8x8(radiance.desc.width, radiance.desc.height);
                 self.pipeline
                     .dispatch(cmd, &[&self.set], bytemuck::bytes_of(&exposure), groups);
             });

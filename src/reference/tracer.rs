@@ -7,8 +7,8 @@ use crate::frame::{FrameTargets, SceneGpu};
 use crate::radiometry::Component;
 use crate::shader_bindings as b;
 use crate::vk::{
-    step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
-    DescriptorSetLayout, FrameRecorder, VkResult,
+    groups_8x8, step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context,
+    DescriptorSet, DescriptorSetLayout, FrameRecorder, VkResult,
 };
 use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
@@ -254,7 +254,7 @@ impl Reference {
         let push = self.push(seed, Component::All);
         let push = bytemuck::bytes_of(&push);
         let sets = [&scene_gpu.set, &self.set];
-        let pixel_groups = [self.width.div_ceil(8), self.height.div_ceil(8), 1];
+        let pixel_groups = groups_8x8(self.width, self.height);
         rec.pass("reference visible points").record(|cmd| {
             fill(&ctx, cmd, &[&self.surface_heads], b::REFERENCE_GRID_NONE);
             step(&ctx, cmd)
@@ -358,7 +358,7 @@ impl Reference {
                     cmd,
                     &sets,
                     bytemuck::bytes_of(&push),
-                    [self.width.div_ceil(8), self.height.div_ceil(8), 1],
+                    groups_8x8(self.width, self.height),
                 );
             });
     }

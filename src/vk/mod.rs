@@ -40,8 +40,8 @@ pub use image::{Image, ImageDesc};
 pub use limits::{bytes, MemoryHeaps, MemoryReport};
 pub use pass::{step, Pass, Resource, Sync};
 pub use pipeline::{
-    begin_rendering, begin_rendering_with_depth, end_rendering, ComputePipeline, GraphicsPipeline,
-    GraphicsPipelineDesc,
+    begin_rendering, begin_rendering_with_depth, end_rendering, groups_8x8, ComputePipeline,
+    GraphicsPipeline, GraphicsPipelineDesc,
 };
 pub use pipeline_store::{CacheLoad, PipelineCounts, PipelineStore, Specialization};
 pub use profiler::Profiler;

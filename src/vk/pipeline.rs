@@ -36,6 +36,12 @@ fn push(ctx: &Context, cmd: vk::CommandBuffer, layout: vk::PipelineLayout, data:
 
 /// A compute pipeline; equal ones are shared through the context's
 /// `PipelineStore`.
+/// Workgroups of 8x8 invocations covering a `width` x `height` grid (the
+/// local size of every per-pixel and per-texel compute shader here).
+pub fn groups_8x8(width: u32, height: u32) -> [u32; 3] {
+    [width.div_ceil(8), height.div_ceil(8), 1]
+}
+
 pub struct ComputePipeline {
     // Declared before `ctx`: fields drop in order, and the shared pipeline
     // must go while the device it was made on is still held.

@@ -13,7 +13,7 @@ use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::passes::surface_frame::SurfaceFrame;
 use crate::passes::light_views::photon_view;
 use crate::scene::{Density, Light, LightKind, Scene};
-use crate::vk::{begin_rendering, end_rendering, step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, MAX_FRAMES_IN_FLIGHT, VkResult};
+use crate::vk::{begin_rendering, end_rendering, step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, MAX_FRAMES_IN_FLIGHT, VkResult, groups_8x8};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
@@ -550,7 +550,7 @@ impl BeamTracer {
             )
             .write(&self.receivers, Access::ComputeWrite)
             .record(|cmd| {
-            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
+            let groups = groups_8x8(targets.width, targets.height);
             self.receivers_pipeline
                 .dispatch(cmd, &[&scene.set, set], &[], groups);
         });
@@ -585,7 +585,7 @@ impl BeamTracer {
         let ctx = rec.ctx().clone();
         if self.surface_filter > 0 {
             let e = self.surface.extent();
-            let groups = [e.width.div_ceil(8), e.height.div_ceil(8), 1];
+            let groups = groups_8x8(e.width, e.height);
             // x: the volumes' blended irradiance -> the intermediate
             // (overwritten after last frame's y pass read it). Both
             // images are bound writable in both passes (one shader
@@ -633,7 +633,7 @@ impl BeamTracer {
             .storage_image(set, bb::BEAMS_BINDING_OPAQUE_RADIANCE, surface.opaque(), Access::ComputeWrite)
             .record(|cmd| {
             let e = surface.opaque().extent();
-            let groups = [e.width.div_ceil(8), e.height.div_ceil(8), 1];
+            let groups = groups_8x8(e.width, e.height);
             self.apply_pipeline.dispatch(
                 cmd,
                 &[&scene.set, set],
@@ -656,7 +656,7 @@ impl BeamTracer {
             .read(&self.counters, Access::TransferRead)
             .write(readback, Access::TransferWrite)
             .record(|cmd| {
-            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
+            let groups = groups_8x8(targets.width, targets.height);
             self.composite_pipeline
                 .dispatch(cmd, &[&scene.set, set], &[], groups);
             let region = vk::BufferCopy::default().size(self.counters.size);

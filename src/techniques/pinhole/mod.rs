@@ -64,7 +64,7 @@ use crate::passes::surface_frame::SurfaceFrame;
 use crate::radiometry::Component;
 use crate::scene::{EnvironmentKind, Scene};
 use crate::shader_bindings as sb;
-use crate::vk::{step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageDesc, Sampler, VkResult};
+use crate::vk::{step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageDesc, Sampler, VkResult, groups_8x8};
 use ash::vk;
 use bindings as b;
 use bytemuck::{Pod, Zeroable};
@@ -429,7 +429,7 @@ impl Pinhole {
             .read(&self.state, r)
             .record(|cmd| {
                 let extent = opaque.extent();
-                let groups = [extent.width.div_ceil(8), extent.height.div_ceil(8), 1];
+                let groups = groups_8x8(extent.width, extent.height);
                 self.receivers
                     .dispatch(cmd, &[&scene.set, set], push, groups);
             });

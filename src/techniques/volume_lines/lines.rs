@@ -9,7 +9,7 @@ use crate::passes::light_views::{LightView, LightViewConsumer};
 use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::passes::surface_frame::SurfaceFrame;
 use crate::scene::{Density, Scene};
-use crate::vk::{begin_rendering, end_rendering, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, VkResult};
+use crate::vk::{begin_rendering, end_rendering, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, VkResult, groups_8x8};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
@@ -286,7 +286,7 @@ impl VolumeRays {
             )
             .write(&self.visibility, Access::ComputeWrite)
             .record(|cmd| {
-            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
+            let groups = groups_8x8(targets.width, targets.height);
             self.visibility_pipeline
                 .dispatch(cmd, &[&scene.set, set], &[], groups);
         });
@@ -314,7 +314,7 @@ impl VolumeRays {
             .storage_image(set, bindings::VOLUME_LINES_BINDING_VOLUME, &self.volume, Access::ComputeRead)
             .storage_image(set, bindings::VOLUME_LINES_BINDING_RADIANCE, &targets.radiance, Access::ComputeWrite)
             .record(|cmd| {
-            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
+            let groups = groups_8x8(targets.width, targets.height);
             self.composite_pipeline
                 .dispatch(cmd, &[&scene.set, set], &[], groups);
         });
@@ -362,11 +362,7 @@ impl LightViewConsumer for VolumeRays {
                 ],
             )
             .record(|cmd| {
-            let groups = [
-                self.buffer_size.div_ceil(8),
-                self.buffer_size.div_ceil(8),
-                1,
-            ];
+            let groups = groups_8x8(self.buffer_size, self.buffer_size);
             self.segment_pipeline.dispatch(
                 cmd,
                 &[&scene.set, &self.set],

@@ -16,7 +16,7 @@ use super::WpParamsBuffer;
 use crate::frame::SceneGpu;
 use crate::passes::gbuffer::{GBuffer, DEPTH_FORMAT};
 use super::bindings;
-use crate::vk::{begin_rendering_with_depth, end_rendering, Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, Sampler, VkResult};
+use crate::vk::{begin_rendering_with_depth, end_rendering, Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, Sampler, VkResult, groups_8x8};
 use ash::vk;
 use std::sync::Arc;
 
@@ -180,7 +180,7 @@ impl Composite {
             .storage_image(set, bindings::WP_BINDING_RADIANCE, radiance, Access::ComputeWrite)
             .record(|cmd| {
             let e = radiance.extent();
-            let groups = [e.width.div_ceil(8), e.height.div_ceil(8), 1];
+            let groups = groups_8x8(e.width, e.height);
             self.pipeline
                 .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
         });

@@ -12,7 +12,7 @@ use crate::frame::{FrameTargets, SceneGpu};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::specular_gbuffer::SpecularGBuffer;
 use super::bindings;
-use crate::vk::{Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, VkResult};
+use crate::vk::{Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, VkResult, groups_8x8};
 use std::sync::Arc;
 
 pub struct WaterView {
@@ -89,7 +89,7 @@ impl WaterView {
             .storage_image(set, bindings::WP_BINDING_RADIANCE, &targets.radiance, Access::ComputeWrite)
             .read(photons, Access::ComputeRead)
             .record(|cmd| {
-            let groups = [targets.width.div_ceil(8), targets.height.div_ceil(8), 1];
+            let groups = groups_8x8(targets.width, targets.height);
             self.pipeline
                 .dispatch(cmd, &[&scene.set, set], &[], groups);
         });
