@@ -12,7 +12,7 @@ use crate::frame::{FrameTargets, SceneGpu};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::specular_gbuffer::SpecularGBuffer;
 use super::bindings;
-use crate::vk::{Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, VkResult, groups_8x8};
+use crate::vk::{Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, Specialization, VkResult, groups_8x8};
 use std::sync::Arc;
 
 pub struct WaterView {
@@ -27,6 +27,7 @@ impl WaterView {
         scene_gpu: &SceneGpu,
         params: &WpParamsBuffer,
         photons: &Buffer,
+        specialization: &Specialization,
     ) -> VkResult<Self> {
         let layout = DescriptorSetLayout::new(
             ctx,
@@ -45,9 +46,10 @@ impl WaterView {
         let set = DescriptorSet::new(ctx, &layout)?;
         set.write_buffer(bindings::WP_BINDING_PARAMS, &params.0)
             .write_buffer(bindings::WP_BINDING_PHOTONS, photons);
-        let pipeline = ComputePipeline::new(
+        let pipeline = ComputePipeline::specialized(
             ctx,
             "water_photons/view.comp",
+            specialization,
             &[&scene_gpu.layout, &layout],
             0,
         )?;
