@@ -6,6 +6,9 @@
 //! (direct + splatted caustics), a hit hidden from it (behind a wall,
 //! outside the view) is shaded there, its caustic gathered from the
 //! photons through the trace's slot image with the splat's kernel.
+//! The cascade count and the splat mode are specialisation constants
+//! (`WP_SPEC_*`): as uniform reads they made lavapipe recompile the shader
+//! at every bind, +1.85 MB host memory a frame (BENCHMARKS.md, "Soak").
 
 use super::WpParamsBuffer;
 use crate::frame::{FrameTargets, SceneGpu};
