@@ -99,6 +99,8 @@ pub const DIRECT_SH_GROUP_SIZE: u32 = 64;
 pub const PROBE_BINDING_RAYS: u32 = 10;
 pub const PROBE_BINDING_RESULTS: u32 = 11;
 pub const PROBE_BINDING_ANY: u32 = 12;
+/// A uniform block (glsl/tests/uniform_branch.comp, examples/lavapipe_rebind.rs).
+pub const PROBE_BINDING_PARAMS: u32 = 13;
 
 // Caustic maps (src/passes/caustic_map.rs, glsl/caustic_map/), descriptor set 1.
 pub const CAUSTIC_BINDING_PHOTONS: u32 = 0;

@@ -18,19 +18,24 @@ float splat_weight(vec2 local, float r) {
 // h: the kernel's ramp half-width in cascade-0 texels (splat.vert).
 const float RAMP_TEXELS = 0.25;
 
+// The splat mode (WP_SPLAT_*, also wp.modes.w), fixed when the pipeline is
+// created (WP_SPEC_SPLAT_MODE): read from the uniform block, it makes
+// lavapipe recompile view.comp at every bind (water_photons/bindings.rs).
+layout(constant_id = WP_SPEC_SPLAT_MODE) const uint SPLAT_MODE = WP_SPLAT_DIFFERENTIAL;
+
 // The quad x = hit + a U + b V, (a, b) in [-1, 1]^2, of photon p, and
 // r, the ramp half-width in units of the box's half-width (at most 1).
 void splat_axes(Photon p, out vec3 u, out vec3 v, out float r) {
     vec3 n = p.normal.xyz;
     // The box's half-width B in cascade-0 texels.
     float half_texels;
-    if (wp.modes.w == WP_SPLAT_DIFFERENTIAL) {
+    if (SPLAT_MODE == WP_SPLAT_DIFFERENTIAL) {
         u = 0.5 * p.axis_u.xyz;
         v = 0.5 * p.axis_v.xyz;
         half_texels = 0.5 * pow(wp.cascade.x, p.position.w);
     } else {
         float c = p.position.w;
-        float sigma = (wp.modes.w == WP_SPLAT_FIXED ? 1.0 : p.normal.w) * pow(wp.cascade.x, c); // Eq. 11
+        float sigma = (SPLAT_MODE == WP_SPLAT_FIXED ? 1.0 : p.normal.w) * pow(wp.cascade.x, c); // Eq. 11
         float grid = sqrt(wp.range.x / float(wp.size.x) * wp.range.y / float(wp.size.y));
         float q = grid * wp.cascade.y * sigma; // Eq. 16
         vec3 w = p.dir.xyz;

@@ -62,6 +62,11 @@ layout(set = 1, binding = WP_BINDING_FRONT_NORMAL, rgba32f) uniform readonly ima
 layout(set = 1, binding = WP_BINDING_BACK_POSITION, rgba32f) uniform readonly image2D back_position;
 layout(set = 1, binding = WP_BINDING_RADIANCE, rgba32f) uniform image2D radiance;
 
+// N, the cascades (wp.size.z), a pipeline constant (WP_SPEC_CASCADES):
+// as a uniform this loop's bound makes lavapipe recompile this shader at
+// every bind (water_photons/bindings.rs).
+layout(constant_id = WP_SPEC_CASCADES) const uint CASCADES = 1u;
+
 // Texels searched around the flat-water estimate: at most this many on
 // each side (a cap on the cost; the reach above decides below it).
 const int MAX_REACH_TEXELS = 48;
@@ -125,7 +130,7 @@ vec3 gather(vec3 x, vec3 nx) {
         float turn = type == WP_RAY_REFLECTED ? 2.0 : 0.5;
         float reach = along * turn * slope + amplitude * length(dir.xz) / abs(dir.y) + amplitude;
         vec2 ls = (wp.light_view * vec4(s, 1.0)).xy;
-        for (uint c = 0u; c < wp.size.z; ++c) {
+        for (uint c = 0u; c < CASCADES; ++c) {
             float scale = pow(wp.cascade.x, float(c));
             vec2 extent = wp.range.xy * scale;
             vec2 uv = (ls / extent + 0.5) * vec2(wp.size.xy);

@@ -5,6 +5,7 @@ use super::{
     check_validation, checked_technique_run, context, write_outputs, BenchArgs, DeviceArgs,
     RenderArgs, TechniqueArgs,
 };
+use anyhow::Context as _;
 use caustics::compare::report::{
     extend_per_pass, median, per_pass, stats_per_pass, BenchReport, MemorySample, RunInfo, Timing,
     SCHEMA,
@@ -14,7 +15,7 @@ use caustics::params::Params;
 use caustics::renderer::Renderer;
 use caustics::scene::Scene;
 use caustics::techniques;
-use caustics::vk::{bytes, Context, FrameOptions, PassTiming};
+use caustics::vk::{bytes, host_rss, Context, FrameOptions, PassTiming};
 use std::collections::BTreeMap;
 use std::io::Write as _;
 use std::sync::Arc;
@@ -154,7 +155,7 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
             let device = ctx.memory_report();
             memory.push(MemorySample {
                 frame: i + 1,
-                host_rss: host_rss()?,
+                host_rss: host_rss().context("--memory-samples: no VmRSS in /proc/self/status")?,
                 device_allocated: device.allocated,
                 device_allocations: device.allocations,
                 device_capacity: device.capacity,
@@ -256,17 +257,4 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
         println!("wrote {}", path.display());
     }
     Ok(())
-}
-
-/// The process's resident set size (VmRSS in /proc/self/status), bytes.
-fn host_rss() -> anyhow::Result<u64> {
-    let status = std::fs::read_to_string("/proc/self/status")
-        .map_err(|e| anyhow::anyhow!("--memory-samples: cannot read /proc/self/status: {e}"))?;
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix("VmRSS:"))
-        .and_then(|v| v.trim().strip_suffix("kB"))
-        .and_then(|kb| kb.trim().parse::<u64>().ok())
-        .map(|kb| kb * 1024)
-        .ok_or_else(|| anyhow::anyhow!("--memory-samples: no VmRSS in /proc/self/status"))
 }

@@ -242,6 +242,19 @@ pub(super) fn check_storage_buffer(
     Ok(())
 }
 
+/// The process's resident set size (VmRSS in /proc/self/status) in bytes;
+/// `None` where the file or the field is missing (not Linux). On lavapipe
+/// it holds the device's memory and the driver's compiled shaders too.
+pub fn host_rss() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmRSS:"))
+        .and_then(|v| v.trim().strip_suffix("kB"))
+        .and_then(|kb| kb.trim().parse::<u64>().ok())
+        .map(|kb| kb * 1024)
+}
+
 /// `n` bytes in binary units, for messages.
 pub fn bytes(n: u64) -> String {
     const UNITS: [&str; 5] = ["bytes", "KiB", "MiB", "GiB", "TiB"];

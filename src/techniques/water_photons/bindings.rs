@@ -51,6 +51,14 @@ pub const WP_INTENSITY_PAPER: u32 = 1;
 pub const WP_SPLAT_DIFFERENTIAL: u32 = 0;
 pub const WP_SPLAT_PAPER: u32 = 1;
 pub const WP_SPLAT_FIXED: u32 = 2;
+/// Specialisation constant ids: the cascade count N (view.comp's loop over
+/// the cascades) and the splat mode (kernel.glsl's branch). Both are
+/// `rebuild` parameters, so they are constants of the pipeline rather than
+/// uniform reads: lavapipe (Mesa 22.3) recompiles a compute shader at every
+/// bind while a uniform decides one of its branches or trip counts and keeps
+/// every copy (view.rs; BENCHMARKS.md, "Soak").
+pub const WP_SPEC_CASCADES: u32 = 0;
+pub const WP_SPEC_SPLAT_MODE: u32 = 1;
 /// Ray types of a photon (Algorithm 3 line 37).
 pub const WP_RAY_REFLECTED: u32 = 0;
 pub const WP_RAY_REFRACTED: u32 = 1;

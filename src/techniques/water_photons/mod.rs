@@ -166,7 +166,7 @@ use crate::passes::surface_frame::SurfaceFrame;
 use crate::radiometry::Component;
 use crate::scene::{Light, LightKind, Scene, Water};
 use crate::shader_bindings as b;
-use crate::vk::{Buffer, BufferUsage, Context, FrameRecorder, VkResult};
+use crate::vk::{Buffer, BufferUsage, Context, FrameRecorder, Specialization, VkResult};
 use anyhow::Context as _;
 use glam::{Mat4, Vec3};
 use std::mem::size_of;
@@ -327,11 +327,18 @@ impl WaterPhotons {
             &layout,
             capacity,
         )?;
+        // The cascade count and the splat mode as pipeline constants
+        // (bindings.rs, WP_SPEC_*), not uniform reads: lavapipe would
+        // recompile the water view at every bind.
+        let specialization = Specialization::new()
+            .u32(bindings::WP_SPEC_CASCADES, levels)
+            .u32(bindings::WP_SPEC_SPLAT_MODE, params.splat_mode);
         let splat = Splat::new(
             ctx,
             scene_gpu,
             &params_buffer,
             &trace.photons,
+            &specialization,
             width,
             height,
         )?;
@@ -349,6 +356,7 @@ impl WaterPhotons {
             scene_gpu,
             &params_buffer,
             &trace.photons,
+            &specialization,
         )?;
         let gpu_params = GpuWpParams {
             light_view: Mat4::IDENTITY.to_cols_array_2d(),

@@ -16,7 +16,7 @@ use super::WpParamsBuffer;
 use crate::frame::SceneGpu;
 use crate::passes::gbuffer::{GBuffer, DEPTH_FORMAT};
 use super::bindings;
-use crate::vk::{begin_rendering_with_depth, end_rendering, Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, Sampler, VkResult, groups_8x8};
+use crate::vk::{begin_rendering_with_depth, end_rendering, Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, Sampler, Specialization, VkResult, groups_8x8};
 use ash::vk;
 use std::sync::Arc;
 
@@ -37,6 +37,7 @@ impl Splat {
         scene_gpu: &SceneGpu,
         params: &WpParamsBuffer,
         photons: &Buffer,
+        specialization: &Specialization,
         width: u32,
         height: u32,
     ) -> VkResult<Self> {
@@ -73,6 +74,7 @@ impl Splat {
         desc.depth_write = false;
         desc.additive = true;
         desc.topology = vk::PrimitiveTopology::TRIANGLE_STRIP;
+        desc.specialization = specialization.clone();
         let pipeline = GraphicsPipeline::new(ctx, &desc, &[&scene_gpu.layout, &layout])?;
         Ok(Self {
             caustics,

@@ -6,13 +6,16 @@
 //! (direct + splatted caustics), a hit hidden from it (behind a wall,
 //! outside the view) is shaded there, its caustic gathered from the
 //! photons through the trace's slot image with the splat's kernel.
+//! The cascade count and the splat mode are specialisation constants
+//! (`WP_SPEC_*`): as uniform reads they made lavapipe recompile the shader
+//! at every bind, +1.85 MB host memory a frame (BENCHMARKS.md, "Soak").
 
 use super::WpParamsBuffer;
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::specular_gbuffer::SpecularGBuffer;
 use super::bindings;
-use crate::vk::{Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, VkResult, groups_8x8};
+use crate::vk::{Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, Specialization, VkResult, groups_8x8};
 use std::sync::Arc;
 
 pub struct WaterView {
@@ -27,6 +30,7 @@ impl WaterView {
         scene_gpu: &SceneGpu,
         params: &WpParamsBuffer,
         photons: &Buffer,
+        specialization: &Specialization,
     ) -> VkResult<Self> {
         let layout = DescriptorSetLayout::new(
             ctx,
@@ -45,9 +49,10 @@ impl WaterView {
         let set = DescriptorSet::new(ctx, &layout)?;
         set.write_buffer(bindings::WP_BINDING_PARAMS, &params.0)
             .write_buffer(bindings::WP_BINDING_PHOTONS, photons);
-        let pipeline = ComputePipeline::new(
+        let pipeline = ComputePipeline::specialized(
             ctx,
             "water_photons/view.comp",
+            specialization,
             &[&scene_gpu.layout, &layout],
             0,
         )?;
