@@ -70,6 +70,20 @@ float overlap(vec2 tri[3], vec2 quad[4], out vec2 mean) {
     int n = 3;
     for (int i = 0; i < 3; ++i) poly[i] = tri[i];
     float orient = cross2(quad[1] - quad[0], quad[2] - quad[0]) >= 0.0 ? 1.0 : -1.0;
+    // Exact shortcuts first: the triangle wholly outside one edge (most of
+    // the rectangle's pixels), or wholly inside all four (a triangle
+    // smaller than the pixel), need no clipping.
+    bool inside = true;
+    for (int e = 0; e < 4; ++e) {
+        vec2 a = quad[e], edge = quad[(e + 1) % 4] - a;
+        vec3 s = orient * vec3(cross2(edge, tri[0] - a), cross2(edge, tri[1] - a), cross2(edge, tri[2] - a));
+        if (all(lessThan(s, vec3(0.0)))) return 0.0;
+        inside = inside && all(greaterThanEqual(s, vec3(0.0)));
+    }
+    if (inside) {
+        mean = (tri[0] + tri[1] + tri[2]) / 3.0;
+        return polygon_area(poly, 3);
+    }
     for (int e = 0; e < 4; ++e) {
         vec2 a = quad[e], edge = quad[(e + 1) % 4] - a;
         vec2 next[8];
