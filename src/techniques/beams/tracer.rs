@@ -252,11 +252,10 @@ pub struct BeamTracer {
     apply_pipeline: ComputePipeline,
     composite_pipeline: ComputePipeline,
     filter_pipeline: ComputePipeline,
-    volume_pipeline: GraphicsPipeline,
+    /// Only where the scene has a medium (without one the volumes have
+    /// nothing to integrate and "beam volumes" is not drawn).
+    volume_pipeline: Option<GraphicsPipeline>,
     caustic_pipeline: GraphicsPipeline,
-    /// Whether the scene has a medium (the volumes have something to
-    /// integrate; without one "beam volumes" is not drawn).
-    medium: bool,
     sets: BeamSets,
     _layouts: BeamLayouts,
 }
@@ -477,7 +476,10 @@ impl BeamTracer {
         desc.additive = true;
         desc.topology = vk::PrimitiveTopology::POINT_LIST;
         desc.push_size = size_of::<VolumePush>() as u32;
-        let volume_pipeline = GraphicsPipeline::new(ctx, &desc, &with(&layouts.beams))?;
+        let volume_pipeline = match scene.medium {
+            Some(_) => Some(GraphicsPipeline::new(ctx, &desc, &with(&layouts.beams))?),
+            None => None,
+        };
         // The caustic triangles: the same points, one screen rectangle each.
         desc.geometry = Some("beams/caustic.geom");
         desc.fragment = "beams/caustic.frag";
@@ -544,7 +546,6 @@ impl BeamTracer {
             filter_pipeline,
             volume_pipeline,
             caustic_pipeline,
-            medium: scene.medium.is_some(),
             sets,
             _layouts: layouts,
         })
@@ -797,8 +798,8 @@ impl LightViewConsumer for BeamTracer {
         }
         // The volumes (nothing to integrate without a medium), then the
         // caustic triangles.
-        if self.medium {
-            self.draw_beams(rec, scene, "beam volumes", &self.volume, &self.volume_pipeline);
+        if let Some(volume) = &self.volume_pipeline {
+            self.draw_beams(rec, scene, "beam volumes", &self.volume, volume);
         }
         self.draw_beams(rec, scene, "beam caustics", &self.surface, &self.caustic_pipeline);
     }
