@@ -1,7 +1,8 @@
 // beams (Liktor & Dachsbacher 2011): the caustic beam, its area function
-// and what a camera ray or a receiver point gathers from it. Shared by the
-// refinement pass (refine.comp, which builds beams), the bounding volumes
-// (volume.geom) and their fragments (volume.frag). Requires scene.glsl,
+// what a camera ray gathers from it, and its footprint on the receivers.
+// Shared by the refinement pass (refine.comp, which builds beams), the
+// bounding volumes (volume.geom) and their fragments (volume.frag), and the
+// caustic triangles (caustic.geom, caustic.frag). Requires scene.glsl,
 // beams_bindings.glsl, optics.glsl, bvh.glsl, random.glsl, medium.glsl.
 #ifndef BEAMS_BEAM_GLSL
 #define BEAMS_BEAM_GLSL
@@ -13,7 +14,7 @@
 // cross-section parallel to the base at height y is the triangle
 // v_k + y e_k and its signed area is the quadratic
 //   A(y) = area.x + area.y y + area.z y^2 = dot(area.xyz, vec3(1, y, y^2)).
-// Mirrors `GpuBeam` in src/techniques/beams/volumes.rs.
+// Mirrors `GpuBeam` in src/techniques/beams/tracer.rs.
 struct Beam {
     vec4 v0;       // base vertex 0; w: y_max, the extrusion (height of the far end)
     vec4 v1;       // w: refinement level (uint bits)
@@ -25,21 +26,10 @@ struct Beam {
     vec4 area;     // A(y) coefficients (m^2, signed); w: measure of the incident triangle (sr or m^2)
     vec4 flux;     // rgb: flux carried by the beam (W)
     vec4 incident; // rgb: flux entering the base triangle from the light (W), before Fresnel and absorption
+    vec4 receiver; // xyz: heights y_k where edge k meets its first diffuse surface; w: that surface's object (uint bits), ~0u where the three do not meet one
 };
 
 float beam_area(Beam b, float y) { return dot(b.area.xyz, vec3(1.0, y, y * y)); }
-
-// Signed areas of the three sub-triangles (x, c_j, c_l), (k, j, l) cyclic,
-// of the cross-section at x's height: x is inside the beam where all three
-// have one sign; their ratios to A are x's barycentric coordinates.
-vec3 beam_sub_areas(Beam b, vec3 x, out float y) {
-    vec3 n = b.n.xyz;
-    y = dot(x, n) - b.n.w;
-    vec3 c0 = b.v0.xyz + y * b.e0.xyz - x;
-    vec3 c1 = b.v1.xyz + y * b.e1.xyz - x;
-    vec3 c2 = b.v2.xyz + y * b.e2.xyz - x;
-    return 0.5 * vec3(dot(n, cross(c1, c2)), dot(n, cross(c2, c0)), dot(n, cross(c0, c1)));
-}
 
 bool same_sign(vec3 a) {
     return (all(greaterThanEqual(a, vec3(0.0))) || all(lessThanEqual(a, vec3(0.0)))) && any(notEqual(a, vec3(0.0)));
@@ -199,55 +189,41 @@ vec3 beam_inscatter(Beam b, vec3 eye, vec3 w, float t_surface, uint points, uint
     return sum;
 }
 
-// --- Surface caustics (Sect. 5.3) ---------------------------------------
+// --- Surface caustics (Sect. 5.3): the caustic triangle ----------------
 
-// True if no diffuse surface lies between x (at height y) and the beam's
-// base along -d over s1 (the beam reaches x). Specular surfaces are passed,
-// as the edge rays of a beam that does not bounce on pass them, and so is
-// the emitting surface itself, which between the base vertices bulges past
-// the base plane; but a beam that ends on a further specular surface
-// (Sect. 6, b.e2.w > 0: its light goes on in the child beams) is blocked
-// by specular surfaces above half the height where its edges meet it (the
-// far surface may bulge toward the base between the edges).
-bool beam_reaches(Beam b, vec3 x, float y, vec3 d, float s1) {
-    vec3 o = x;
-    float left = s1;
-    float y_block = b.e2.w > 0.0 ? 0.5 * b.e2.w : 1e30;
-    float dy = dot(d, b.n.xyz); // height per unit length along d
-    float back = 0.0;
-    for (int i = 0; i < 16 && left > 0.0; ++i) {
-        Hit h;
-        if (!trace_closest(o, -d, 0.0, left, h)) return true;
-        if (material_kind(hit_material(h)) == MATERIAL_DIFFUSE) return false;
-        back += h.t;
-        if (y - back * dy > y_block) return false;
-        vec3 p = hit_position(h, o, -d);
-        float eps = 1e-4 * max(1.0, bvh_max_abs(p));
-        o = p - d * eps;
-        left -= h.t + eps;
-        back += eps;
-    }
-    return true;
+// Whether the beam's three edge rays meet one diffuse surface: then the
+// beam's footprint there (beam ∩ receiver) is the caustic triangle of
+// their hits c_k = v_k + y_k e_k (beam_caustic_triangle), which the
+// surface gather (caustic.frag) spreads over the pixels it covers.
+bool beam_has_receiver(Beam b) { return floatBitsToUint(b.receiver.w) != ~0u; }
+
+void beam_caustic_triangle(Beam b, out vec3 c[3]) {
+    c[0] = b.v0.xyz + b.receiver.x * b.e0.xyz;
+    c[1] = b.v1.xyz + b.receiver.y * b.e1.xyz;
+    c[2] = b.v2.xyz + b.receiver.z * b.e2.xyz;
 }
 
-// Irradiance (W/m^2) beam b delivers to the receiver point x with unit
-// normal n_r turned toward the camera: E = Phi |d . n_r| / (A(y) |d . n|)
-// (the issue's formula, d the local beam direction), where x lies in the
-// beam, the light arrives on the side the camera sees, and no surface
-// blocks the beam between its base and x. The medium's transmittance
-// along the beam is included.
-vec3 beam_receiver(Beam b, vec3 x, vec3 n_r, uint steps) {
-    float y;
-    vec3 sub = beam_sub_areas(b, x, y);
-    if (y <= 0.0 || y > b.v0.w || !same_sign(sub)) return vec3(0.0);
-    float total = sub.x + sub.y + sub.z;
-    vec3 d;
-    float s1;
-    vec3 e_perp = beam_flux_density(b, x, y, sub / total, steps, d, s1);
-    float cos_r = -dot(d, n_r);
-    if (cos_r <= 0.0) return vec3(0.0);
-    if (!beam_reaches(b, x + n_r * (1e-4 * max(1.0, bvh_max_abs(x))), y, d, s1)) return vec3(0.0);
-    return e_perp * cos_r;
+// True if no diffuse surface lies on the segment from x to the beam's base
+// point `base` (the beam reaches x: its light arrives unblocked). Specular
+// surfaces are passed, as the edge rays of a beam that does not bounce on
+// pass them, and so is the emitting surface itself, which between the base
+// vertices bulges past the base plane.
+bool beam_path_clear(vec3 x, vec3 base) {
+    vec3 d = base - x;
+    float left = length(d);
+    if (!(left > 0.0)) return true;
+    d /= left;
+    vec3 o = x;
+    for (int i = 0; i < 16 && left > 0.0; ++i) {
+        Hit h;
+        if (!trace_closest(o, d, 0.0, left, h)) return true;
+        if (material_kind(hit_material(h)) == MATERIAL_DIFFUSE) return false;
+        vec3 p = hit_position(h, o, d);
+        float eps = 1e-4 * max(1.0, bvh_max_abs(p));
+        o = p + d * eps;
+        left -= h.t + eps;
+    }
+    return true;
 }
 
 #endif

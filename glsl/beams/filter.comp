@@ -9,7 +9,9 @@
 // within 5%), so the filter never mixes a caustic into the background or
 // across a silhouette. Each input pixel's weights are normalised over its
 // own neighbours (a scatter written as a gather: out(p) = sum_q in(q)
-// w(p, q) / W(q), W(q) = sum_p' w(p', q)), so the pixels' sum is kept.
+// w(p, q) / W(q), W(q) = sum_p' w(p', q)), so the pixels' sum is kept:
+// the target holds flux (W, caustic.frag), so the filter moves light
+// between neighbouring receiver pixels and conserves it.
 #include "scene.glsl"
 #include "beams_bindings.glsl"
 #include "receiver.glsl"

@@ -103,6 +103,8 @@ bool back_face_normal(vec3 x, out vec3 n) {
 
 #include "image_space_refraction.glsl"
 
+uint hit_object(Hit h) { return floatBitsToUint(triangles[h.triangle].p1.w); }
+
 uint grid_fine() { return pc.grid.z << BEAMS_MAX_LEVELS; }
 
 uvec2 unpack_vertex(uint v) { return uvec2(v & 0xffffu, v >> 16); }
@@ -174,8 +176,11 @@ vec3 incident_flux(ivec2 q0, ivec2 q1, ivec2 q2, out float measure) {
 // surface (specular ones are passed, as volume_lines' rays do), else, where
 // it leaves the scene without meeting one, to where it leaves the medium's
 // bounds (beyond them it lights nothing; 0 without a medium). Sect. 4.3's
-// extrusion length from occlusion.
-float edge_length(vec3 o, vec3 d) {
+// extrusion length from occlusion. `object` and `normal`: the diffuse
+// surface met (~0u where none).
+float edge_length(vec3 o, vec3 d, out uint object, out vec3 normal) {
+    object = ~0u;
+    normal = vec3(0.0);
     vec3 x = o;
     float travelled = 0.0;
     for (int i = 0; i < 16; ++i) {
@@ -183,7 +188,11 @@ float edge_length(vec3 o, vec3 d) {
         if (!trace_closest(x, d, 0.0, 1e30, h)) break;
         vec3 hx = hit_position(h, x, d);
         travelled += h.t;
-        if (material_kind(hit_material(h)) == MATERIAL_DIFFUSE) return travelled;
+        if (material_kind(hit_material(h)) == MATERIAL_DIFFUSE) {
+            object = hit_object(h);
+            normal = hit_normal(h);
+            return travelled;
+        }
         float eps = 1e-4 * max(1.0, bvh_max_abs(hx));
         x = hx + d * eps;
         travelled += eps;
@@ -203,15 +212,26 @@ float edge_length(vec3 o, vec3 d) {
 // surface (the extrusion length from occlusion, Sect. 4.3), or, for a beam
 // that bounces on (Sect. 6), the highest of its edges' hits on the next
 // specular surface (stop[k] >= 0: the distance along d_k from p_k).
+// The receiver (Sect. 5.3): the heights where the edges meet their first
+// diffuse surface, kept as the beam's caustic triangle where all three
+// meet one object with normals within the split angle, below the
+// extrusion's end.
 // Set where make_beam found no beam space (the triangle is too coarse for
 // the beam's spread).
 bool beam_too_wide = false;
+// Set where the edges of a beam that does not bounce on meet different
+// diffuse surfaces, or only some meet one: its footprint crosses a
+// receiver's edge or crease (criterion (a) at the receiver's end).
+bool receiver_split = false;
 
 bool make_beam(vec3 p[3], vec3 d[3], float stop[3], vec3 flux, vec3 incident, float measure, uint kind,
                out Beam beam) {
     vec3 n = normalize(d[0] + d[1] + d[2]);
     float h = max(dot(p[0], n), max(dot(p[1], n), dot(p[2], n)));
     vec3 v[3], e[3];
+    uint hit_obj[3] = uint[3](~0u, ~0u, ~0u);
+    vec3 hit_n[3];
+    float y_hit[3] = float[3](-1.0, -1.0, -1.0);
     float y_max = 0.0;
     float y_stop = 1e30; // the lowest edge hit on the next specular surface
     for (int k = 0; k < 3; ++k) {
@@ -229,8 +249,9 @@ bool make_beam(vec3 p[3], vec3 d[3], float stop[3], vec3 flux, vec3 incident, fl
             continue;
         }
         float eps = 1e-4 * max(1.0, bvh_max_abs(p[k]));
-        float s = edge_length(p[k] + d[k] * eps, d[k]);
+        float s = edge_length(p[k] + d[k] * eps, d[k], hit_obj[k], hit_n[k]);
         if (s > 0.0) y_max = max(y_max, dot(p[k] + (s + eps) * d[k], n) - h);
+        y_hit[k] = hit_obj[k] != ~0u ? dot(p[k] + (s + eps) * d[k], n) - h : -1.0;
     }
     vec3 b1 = v[1] - v[0], b2 = v[2] - v[0];
     vec3 f1 = e[1] - e[0], f2 = e[2] - e[0];
@@ -261,6 +282,14 @@ bool make_beam(vec3 p[3], vec3 d[3], float stop[3], vec3 flux, vec3 incident, fl
         }
         y_max = min(y_max, y_cut);
     }
+    // One receiver for the three edges: the caustic triangle.
+    uint met = uint(hit_obj[0] != ~0u) + uint(hit_obj[1] != ~0u) + uint(hit_obj[2] != ~0u);
+    bool one = met == 3u && hit_obj[1] == hit_obj[0] && hit_obj[2] == hit_obj[0];
+    for (int k = 0; k < 3 && one; ++k) {
+        if (abs(dot(hit_n[k], hit_n[(k + 1) % 3])) < pc.split.y || y_hit[k] > y_max) one = false;
+    }
+    if (met > 0u && !one) receiver_split = true;
+    beam.receiver = vec4(y_hit[0], y_hit[1], y_hit[2], uintBitsToFloat(one ? hit_obj[0] : ~0u));
     beam.v0 = vec4(v[0], y_max * 1.001);
     beam.v1 = vec4(v[1], uintBitsToFloat(pc.grid.x));
     beam.v2 = vec4(v[2], uintBitsToFloat(kind));
@@ -393,8 +422,6 @@ void push_pending(vec3 p[3], vec3 d[3], vec3 flux, vec3 incident, uint kind, uin
     e.source = source;
     pending[pending_count++] = e;
 }
-
-uint hit_object(Hit h) { return floatBitsToUint(triangles[h.triangle].p1.w); }
 
 // The specular event at p[k] (light arriving along d[k], normals n[k]
 // facing it, material m): the reflected and the refracted beams pushed as
@@ -607,7 +634,9 @@ void main() {
             if (edges == EDGES_PARTIAL) split = true;
             if (edges != EDGES_BOUNCE) dist = float[3](-1.0, -1.0, -1.0);
             beam_too_wide = false;
+            receiver_split = false;
             has[i] = make_beam(e.p, e.d, dist, e.flux, e.incident, measure, e.kind, beam[i]);
+            if (receiver_split) split = true;
             // A bounced beam spreading too wide for one beam space (a coarse
             // triangle of a mirror's light across a lens) splits the triangle.
             if (beam_too_wide && e.bounce > 1u) split = true;

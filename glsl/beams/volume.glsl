@@ -2,11 +2,9 @@
 // the volume covers, volume.geom), the beam's in-scattering along the
 // pixel's camera ray (beam_inscatter: the exact interval(s) inside the
 // beam, Gauss-Legendre along them, up to the first surface the pixel sees,
-// diffuse or specular) into the volume target, and (Sect. 5.3, the
-// paper's choice: the receivers' camera G-buffer gathered per beam, a
-// point-in-beam test) the irradiance the beam delivers to the diffuse
-// surface this pixel sees into the surface target. Both targets blend
-// additively; alpha of the volume target counts fragments. The body of
+// diffuse or specular) into the volume target, blended additively; alpha
+// counts fragments. (The surface caustics are the caustic triangles'
+// pass, caustic.geom / caustic.frag.) The body of
 // volume.frag (inhomogeneous media) and volume_homogeneous.frag (constant
 // density or none: the density field compiled out, as volume_lines does).
 #extension GL_EXT_shader_atomic_float : require
@@ -31,8 +29,6 @@ layout(set = 1, binding = BEAMS_BINDING_RECEIVERS, std430) readonly buffer Recei
 layout(location = 0) flat in uint g_beam;
 // rgb: in-scattered radiance (W m^-2 sr^-1), component-weighted; a: 1 per fragment.
 layout(location = 0) out vec4 out_volume;
-// rgb: irradiance on the receiver (W/m^2), before albedo and the eye's transmittance.
-layout(location = 1) out vec4 out_surface;
 
 void main() {
     atomicAdd(fragments, 1u);
@@ -44,8 +40,5 @@ void main() {
     Receiver r = receivers[uint(gl_FragCoord.y) * uint(frame.viewport.x) + uint(gl_FragCoord.x)];
     vec3 volume = vec3(0.0);
     if (medium_present()) volume = beam_inscatter(b, eye, w, r.position.w, pc.quadrature, pc.medium_steps);
-    vec3 surface = vec3(0.0);
-    if (r.normal.w > 0.0) surface = beam_receiver(b, r.position.xyz, r.normal.xyz, pc.medium_steps);
     out_volume = vec4(volume * component_weight(COMPONENT_VOLUME_CAUSTICS), 1.0);
-    out_surface = vec4(surface, 0.0);
 }

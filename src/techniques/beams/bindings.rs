@@ -51,6 +51,8 @@ pub const BEAMS_STAT_FLUX_IN: u32 = 24;
 pub const BEAMS_STAT_FLUX_OUT: u32 = 25;
 /// Fragments the bounding volumes shaded (Fig. 6).
 pub const BEAMS_STAT_FRAGMENTS: u32 = 26;
+/// Fragments the caustic triangles' rectangles shaded (the surface gather).
+pub const BEAMS_STAT_CAUSTIC_FRAGMENTS: u32 = 27;
 pub const BEAMS_COUNTER_WORDS: u32 = 28;
 
 /// Layout of the indirect-arguments buffer (u32 words): one

@@ -29,27 +29,55 @@
 //!    triangle; spot: the integral of I over it; directional: E times the
 //!    projected area), times Fresnel and Beer-Lambert absorption and the
 //!    medium's transmittance from the light; the area function A(y).
-//! 3. "beam volumes" (volume.vert/geom/frag): one point per beam, drawn
-//!    indirect; the geometry shader extrudes the beam's bounding volume
-//!    (Ernst's prism, or the tight six-triangle hull with the prism as
-//!    fallback, `volume`), emitting only back faces so each covered pixel
-//!    gets one fragment; the fragment integrates the in-scattering over the
-//!    camera ray's exact interval inside the beam (Sect. 5, Gauss-Legendre,
-//!    `quadrature` points) into the volume target, and gathers the beam's
-//!    irradiance on the diffuse receiver the pixel sees (Sect. 5.3, a
-//!    point-in-beam test on the camera G-buffer, with a shadow ray from the
-//!    receiver to the base) into the surface target.
+//! 3. "beam volumes" (volume.vert/geom/frag, where the scene has a
+//!    medium): one point per beam, drawn indirect; the geometry shader
+//!    extrudes the beam's bounding volume (Ernst's prism, or the tight
+//!    six-triangle hull with the prism as fallback, `volume`), emitting
+//!    only back faces so each covered pixel gets one fragment; the fragment
+//!    integrates the in-scattering over the camera ray's exact interval
+//!    inside the beam (Sect. 5, Gauss-Legendre, `quadrature` points) into
+//!    the volume target.
+//! 4. "beam caustics" (volume.vert, caustic.geom/frag): the surface
+//!    caustics as caustic triangles, a flux-conserving gather. A beam
+//!    whose three edge rays meet one diffuse surface (refine.comp records
+//!    the heights of their hits; a beam whose edges meet different
+//!    surfaces, or only some of them meet one, is split like a
+//!    discontinuity) has a footprint there, the triangle of the hits. Its
+//!    screen bounding box grown by half a pixel is drawn as one quad (a
+//!    conservative rasterisation: every pixel the footprint touches gets
+//!    exactly one fragment, however small the footprint), and each
+//!    fragment deposits the beam's flux times the fraction of the
+//!    footprint's area inside the pixel's footprint on the footprint's
+//!    plane (an exact polygon clip, footprint.glsl / caustic.frag), where
+//!    the pixel sees that surface, the light arrives on its seen side and
+//!    no diffuse surface blocks the beam (a BVH ray to the base), times
+//!    the medium's transmittance along the beam. Pixel footprints tile
+//!    the plane, so the shares of a beam sum to its flux: the issue's
+//!    E = Phi |d . n_r| / (A(y) |d . n_Delta|) integrated over the pixel
+//!    instead of sampled at its centre, and the surface caustic's energy
+//!    does not depend on the image size (a focus a few pixels wide, or a
+//!    beam smaller than a pixel, keeps its flux). "beam apply" divides
+//!    each pixel's flux by its footprint's area on the receiver (from the
+//!    camera G-buffer's depth and normal): the mean irradiance over the
+//!    pixel. Within one beam the flux is spread uniformly over the
+//!    footprint (as the paper's one area function per beam spreads it
+//!    over a cross-section), so the variation of E inside a beam is what
+//!    refinement resolves. This replaced a point-sampled gather (each
+//!    beam's E at the pixel centres' receiver points, in the volumes'
+//!    fragments), whose energy on `ball_lens` swung with the image size
+//!    (-43% to +42%, BENCHMARKS.md).
 //!
 //! Per frame: "beam receivers" and "beam clear" before the lights, "beam
 //! filter" (the paper's optional low-pass filter of the surface caustics,
-//! `surface_filter`), "beam apply" (surface caustics into the opaque frame) before the camera
+//! `surface_filter`, on the deposited flux, which it keeps), "beam apply"
+//! (surface caustics into the opaque frame) before the camera
 //! refraction, "beam composite" (volume caustics) after it, "airlight"
 //! last. Counters (beams and triangles per level, the dropped fraction,
-//! fragments) go to `bench --json` through `counters`.
+//! volume and caustic fragments) go to `bench --json` through `counters`.
 //!
 //! Multiple bounces (Sect. 6, `bounces`): a beam whose three edge rays
-//! meet one further specular object ends there (its extrusion, and the
-//! surface gather, stop at that surface) and spawns that surface's
+//! meet one further specular object ends there (its extrusion stops at
+//! that surface, and it has no caustic triangle) and spawns that surface's
 //! reflected and refracted beams (Fresnel split, refraction traced through
 //! the BVH with Beer-Lambert absorption), each child recording its parent
 //! (`GpuBeam::parent`); a beam only partly meeting it splits its triangle,
@@ -60,7 +88,14 @@
 //! its three vertices); the beam's base plane is normal to the mean edge
 //! direction rather than the surface triangle (an equivalent beam space
 //! that stays valid after two refractions); area lights are point stand-ins
-//! (small rects only, `check_scene`).
+//! (small rects only, `check_scene`). Surface caustics: the footprint is
+//! the straight triangle of the edge hits (on a curved receiver, the
+//! chord; a pixel receives where its receiver lies within 1% of its
+//! distance plus a tenth of the triangle's size of that plane); a beam
+//! still crossing a receiver's edge at the last level deposits nothing,
+//! nor does the part of a footprint hidden from the camera; a degenerate
+//! footprint (a focus exactly on the receiver) goes whole to the pixel
+//! holding its centroid.
 
 pub mod bindings;
 mod tracer;
@@ -316,6 +351,7 @@ impl Technique for Beams {
             (c.dropped_fraction() as f64 * 1e6).round() as u64,
         ));
         out.push(("fragments", c.fragments as u64));
+        out.push(("caustic_fragments", c.caustic_fragments as u64));
         out.push(("beam_overflow", c.beam_overflow as u64));
         out.push(("triangle_overflow", c.triangle_overflow as u64));
         out

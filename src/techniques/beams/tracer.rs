@@ -1,6 +1,8 @@
 //! The beams themselves: per light, the adaptive projected grid ("beam
 //! refine", one compute level at a time, driven by indirect arguments) and
-//! the beams' bounding volumes ("beam volumes", one indirect draw); per
+//! the beams' bounding volumes ("beam volumes", one indirect draw, where
+//! the scene has a medium) and their caustic triangles ("beam caustics",
+//! one indirect draw: the flux-conserving surface gather); per
 //! frame, "beam receivers" and "beam clear" before the lights, "beam apply"
 //! (surface caustics into the opaque frame) and "beam composite" (volume
 //! caustics into the frame) after them, and the counters' copy to the host.
@@ -36,8 +38,11 @@ pub struct GpuBeam {
     pub flux: [f32; 4],
     /// rgb flux entering the base triangle (W).
     pub incident: [f32; 4],
+    /// Heights where the edges meet their first diffuse surface; w: that
+    /// surface's object (u32 bits), `u32::MAX` where the three do not meet one.
+    pub receiver: [f32; 4],
 }
-const _: () = assert!(size_of::<GpuBeam>() == 160);
+const _: () = assert!(size_of::<GpuBeam>() == 176);
 
 impl GpuBeam {
     pub fn level(&self) -> u32 {
@@ -59,6 +64,16 @@ impl GpuBeam {
     pub fn area_at(&self, y: f32) -> f32 {
         self.area[0] + self.area[1] * y + self.area[2] * y * y
     }
+    /// The caustic triangle (the beam's footprint on the one diffuse
+    /// surface its three edge rays meet), if it has one.
+    pub fn caustic_triangle(&self) -> Option<[glam::Vec3; 3]> {
+        if self.receiver[3].to_bits() == u32::MAX {
+            return None;
+        }
+        Some(std::array::from_fn(|k| {
+            glam::Vec4::from(self.v[k]).truncate() + self.receiver[k] * glam::Vec4::from(self.e[k]).truncate()
+        }))
+    }
 }
 
 /// The counters of one frame, summed over its lights (`bench --json`).
@@ -79,6 +94,8 @@ pub struct BeamCounts {
     pub flux_out: f32,
     /// Fragments of the bounding volumes.
     pub fragments: u32,
+    /// Fragments of the caustic triangles (the surface gather).
+    pub caustic_fragments: u32,
 }
 
 impl BeamCounts {
@@ -97,6 +114,7 @@ impl BeamCounts {
         c.flux_in = float(bb::BEAMS_STAT_FLUX_IN);
         c.flux_out = float(bb::BEAMS_STAT_FLUX_OUT);
         c.fragments = word(bb::BEAMS_STAT_FRAGMENTS);
+        c.caustic_fragments = word(bb::BEAMS_STAT_CAUSTIC_FRAGMENTS);
         c
     }
 
@@ -209,7 +227,8 @@ pub struct BeamTracer {
     pub beams: Buffer,
     /// The volume caustics alone (rgb, component-weighted; a: fragments).
     pub volume: Image,
-    /// Irradiance the beams deliver to the receiver each pixel sees (rgb).
+    /// Flux (W, rgb) the beams deposit on the receiver each pixel sees
+    /// (caustic.frag; "beam apply" divides it by the pixel's footprint).
     pub surface: Image,
     /// The filter's intermediate (after the x pass).
     surface_filtered: Image,
@@ -233,7 +252,10 @@ pub struct BeamTracer {
     apply_pipeline: ComputePipeline,
     composite_pipeline: ComputePipeline,
     filter_pipeline: ComputePipeline,
-    volume_pipeline: GraphicsPipeline,
+    /// Only where the scene has a medium (without one the volumes have
+    /// nothing to integrate and "beam volumes" is not drawn).
+    volume_pipeline: Option<GraphicsPipeline>,
+    caustic_pipeline: GraphicsPipeline,
     sets: BeamSets,
     _layouts: BeamLayouts,
 }
@@ -342,8 +364,8 @@ impl BeamTracer {
             )
         };
         let volume = target("beam volume caustics")?;
-        let surface_target = target("beam surface irradiance")?;
-        let surface_filtered = target("beam surface irradiance, filtered in x")?;
+        let surface_target = target("beam surface flux")?;
+        let surface_filtered = target("beam surface flux, filtered in x")?;
         use BindingKind::{Storage, StorageImage};
         let all = [
                 (bb::BEAMS_BINDING_TRIANGLES_A, Storage),
@@ -396,6 +418,7 @@ impl BeamTracer {
             ])?,
             apply: layout_of(&[
                 bb::BEAMS_BINDING_OPAQUE_ALBEDO,
+                bb::BEAMS_BINDING_OPAQUE_NORMAL,
                 bb::BEAMS_BINDING_OPAQUE_POSITION,
                 bb::BEAMS_BINDING_OPAQUE_RADIANCE,
                 bb::BEAMS_BINDING_SURFACE,
@@ -449,11 +472,18 @@ impl BeamTracer {
         };
         let mut desc = GraphicsPipelineDesc::new("beams/volume.vert", fragment);
         desc.geometry = Some("beams/volume.geom");
-        desc.color_formats = vec![vk::Format::R32G32B32A32_SFLOAT; 2];
+        desc.color_formats = vec![vk::Format::R32G32B32A32_SFLOAT];
         desc.additive = true;
         desc.topology = vk::PrimitiveTopology::POINT_LIST;
         desc.push_size = size_of::<VolumePush>() as u32;
-        let volume_pipeline = GraphicsPipeline::new(ctx, &desc, &with(&layouts.beams))?;
+        let volume_pipeline = match scene.medium {
+            Some(_) => Some(GraphicsPipeline::new(ctx, &desc, &with(&layouts.beams))?),
+            None => None,
+        };
+        // The caustic triangles: the same points, one screen rectangle each.
+        desc.geometry = Some("beams/caustic.geom");
+        desc.fragment = "beams/caustic.frag";
+        let caustic_pipeline = GraphicsPipeline::new(ctx, &desc, &with(&layouts.beams))?;
 
         // The lights the views are of: the scene's, then the stand-ins of
         // its sun and rect lights (without them the energy criterion of a
@@ -515,6 +545,7 @@ impl BeamTracer {
             composite_pipeline,
             filter_pipeline,
             volume_pipeline,
+            caustic_pipeline,
             sets,
             _layouts: layouts,
         })
@@ -629,6 +660,7 @@ impl BeamTracer {
         rec.pass("beam apply")
             .storage_image(set, bb::BEAMS_BINDING_SURFACE, &self.surface, Access::ComputeRead)
             .storage_image(set, bb::BEAMS_BINDING_OPAQUE_POSITION, &surface.gbuffer().position, Access::ComputeRead)
+            .storage_image(set, bb::BEAMS_BINDING_OPAQUE_NORMAL, &surface.gbuffer().normal, Access::ComputeRead)
             .storage_image(set, bb::BEAMS_BINDING_OPAQUE_ALBEDO, &surface.gbuffer().albedo, Access::ComputeRead)
             .storage_image(set, bb::BEAMS_BINDING_OPAQUE_RADIANCE, surface.opaque(), Access::ComputeWrite)
             .record(|cmd| {
@@ -764,44 +796,58 @@ impl LightViewConsumer for BeamTracer {
                 );
             });
         }
+        // The volumes (nothing to integrate without a medium), then the
+        // caustic triangles.
+        if let Some(volume) = &self.volume_pipeline {
+            self.draw_beams(rec, scene, "beam volumes", &self.volume, volume);
+        }
+        self.draw_beams(rec, scene, "beam caustics", &self.surface, &self.caustic_pipeline);
+    }
+}
+
+impl BeamTracer {
+    /// Records one indirect draw of the beams (one point each, the
+    /// geometry shader expands it) into `target`, blended additively.
+    fn draw_beams(
+        &self,
+        rec: &mut FrameRecorder,
+        scene: &SceneGpu,
+        name: &'static str,
+        target: &Image,
+        pipeline: &GraphicsPipeline,
+    ) {
+        let ctx = rec.ctx().clone();
         // Beams pulled by the geometry shader and read again by the
         // fragments; the draw's count as indirect arguments; the fragment
-        // counter by fragment atomics; the receivers' shadow rays traverse
-        // the scene.
+        // counters by fragment atomics; the receivers per pixel; the
+        // caustic fragments' rays traverse the scene.
         let set = &self.sets.beams;
-        rec.pass("beam volumes")
-            .write(&self.volume, Access::ColorAttachment)
-            .write(&self.surface, Access::ColorAttachment)
+        rec.pass(name)
+            .write(target, Access::ColorAttachment)
             .read(&self.beams, Access::GraphicsRead)
             .read(&self.indirect, Access::IndirectRead)
             .write(&self.counters, Access::FragmentWrite)
             .read(&self.receivers, Access::FragmentRead)
             .read(&scene.triangles, Access::FragmentRead)
             .record(|cmd| {
-            let extent = self.volume.extent();
-            begin_rendering(
-                &ctx,
-                cmd,
-                extent,
-                &[(self.volume.view, None), (self.surface.view, None)],
-                None,
-            );
-            self.volume_pipeline.bind(
-                cmd,
-                &[&scene.set, set],
-                bytemuck::bytes_of(&self.volume_push),
-                extent,
-            );
-            unsafe {
-                ctx.device.cmd_draw_indirect(
+                let extent = target.extent();
+                begin_rendering(&ctx, cmd, extent, &[(target.view, None)], None);
+                pipeline.bind(
                     cmd,
-                    self.indirect.raw,
-                    4 * bb::BEAMS_INDIRECT_DRAW as u64,
-                    1,
-                    0,
-                )
-            };
-            end_rendering(&ctx, cmd);
-        });
+                    &[&scene.set, set],
+                    bytemuck::bytes_of(&self.volume_push),
+                    extent,
+                );
+                unsafe {
+                    ctx.device.cmd_draw_indirect(
+                        cmd,
+                        self.indirect.raw,
+                        4 * bb::BEAMS_INDIRECT_DRAW as u64,
+                        1,
+                        0,
+                    )
+                };
+                end_rendering(&ctx, cmd);
+            });
     }
 }
