@@ -31,6 +31,16 @@ pub trait Technique {
         false
     }
 
+    /// The environment's `rotate` changed (`Renderer::set_environment_rotation`);
+    /// the scene's GPU copy (environment constants, lights) is updated
+    /// already. Returns true when the technique updated what it derived
+    /// from the environment in place (`direct`'s irradiance SH, recomputed
+    /// on the next frame); false (the default) makes the renderer rebuild
+    /// it. Called with no frame in flight.
+    fn environment_changed(&mut self) -> bool {
+        false
+    }
+
     /// Takes new values of `Live` parameters (`params::Apply`) in place:
     /// push constants and switches read at record time. Called by
     /// `Renderer::set_params` only when every changed parameter is live,
