@@ -178,16 +178,8 @@ registry! {
 /// light sampling). Every technique but `direct` calls it from its
 /// `check_scene`.
 pub fn check_materials(scene: &Scene, technique: &str) -> anyhow::Result<()> {
-    let mut used = vec![false; scene.materials.len()];
-    for o in &scene.objects {
-        for &m in &o.mesh.materials {
-            if let Some(u) = used.get_mut(m as usize) {
-                *u = true;
-            }
-        }
-    }
     let file = scene.source.display();
-    for (i, m) in scene.materials.iter().enumerate().filter(|&(i, _)| used[i]) {
+    for (i, m) in used_materials(scene) {
         if m.kind == crate::scene::MaterialKind::ThinDielectric {
             anyhow::bail!(
                 "{file}: material `{}`: {technique} does not render thin dielectric sheets (kind = \"thin_dielectric\", glTF transmission without a volume); use `direct` or `reference`",
@@ -201,6 +193,50 @@ pub fn check_materials(scene: &Scene, technique: &str) -> anyhow::Result<()> {
                 m.name
             );
         }
+    }
+    Ok(())
+}
+
+/// The materials some object uses, with their indices.
+fn used_materials(scene: &Scene) -> impl Iterator<Item = (usize, &crate::scene::Material)> {
+    let mut used = vec![false; scene.materials.len()];
+    for o in &scene.objects {
+        for &m in &o.mesh.materials {
+            if let Some(u) = used.get_mut(m as usize) {
+                *u = true;
+            }
+        }
+    }
+    scene
+        .materials
+        .iter()
+        .enumerate()
+        .filter(move |&(i, _)| used[i])
+}
+
+/// Whether an object uses a `mixed` material (a diffuse surface with a
+/// mirror part, `Material::specular`).
+pub fn has_mixed(scene: &Scene) -> bool {
+    used_materials(scene).any(|(_, m)| is_mixed(m))
+}
+
+fn is_mixed(m: &crate::scene::Material) -> bool {
+    m.kind == crate::scene::MaterialKind::Diffuse && m.specular.max_element() > 0.0
+}
+
+/// Refuses, naming the first one, a `mixed` material: its mirror part
+/// would be dropped silently by the techniques that trace caustics from
+/// mirrors and glass only (image_space, volume_lines, water_photons,
+/// beams: their G-buffers and light views see a diffuse surface). `pinhole`
+/// renders both parts, the reference exactly; `direct` draws no specular
+/// light at all.
+pub fn check_no_mixed(scene: &Scene, technique: &str) -> anyhow::Result<()> {
+    if let Some((_, m)) = used_materials(scene).find(|(_, m)| is_mixed(m)) {
+        anyhow::bail!(
+            "{}: material `{}`: {technique} does not render the mirror part of a mixed material (kind = \"mixed\"); use `pinhole` or `reference`",
+            scene.source.display(),
+            m.name
+        );
     }
     Ok(())
 }
