@@ -593,6 +593,9 @@ fn volume_box_rect_light_matches_reference() {
         "volume_box",
         Some((light, 3.0)),
     );
-    assert!(energy < MAX_REF_ENERGY, "volume_box: relative energy {energy:.4}");
+    assert!(
+        energy < MAX_REF_ENERGY,
+        "volume_box: relative energy {energy:.4}"
+    );
     assert!(flip_mean < 0.05, "volume_box: FLIP mean {flip_mean:.4}");
 }

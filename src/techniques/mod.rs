@@ -243,22 +243,44 @@ pub fn check_no_mixed(scene: &Scene, technique: &str) -> anyhow::Result<()> {
 
 /// `--technique auto`: the technique that renders every component `scene`
 /// has, among those that accept it (`check_scene`: e.g. image_space and
-/// volume_lines refuse sphere lights). A participating medium needs airlight
-/// and volume caustics: `volume_lines` (`beams` renders them too;
-/// volume_lines is the closer to the reference on volume_cone,
-/// BENCHMARKS.md). Water lit by a sun: `water_photons`. Otherwise
-/// `image_space`, the surface caustics of mirrors and glass; `direct` when
+/// volume_lines refuse sphere lights and mixed materials). A participating
+/// medium needs airlight and volume caustics: `volume_lines` (`beams`
+/// renders them too; volume_lines is the closer to the reference on
+/// volume_cone, BENCHMARKS.md). Water lit by a sun: `water_photons`.
+/// Reflectors (mirrors, mixed surfaces) and no refractors, lit by what
+/// image_space cannot map: `pinhole`, whose light cube maps hold every
+/// emitter. That is an environment (image_space maps its sun alone: the
+/// sky in the mirrors would cast nothing) or any scene image_space refuses
+/// (sphere lights, a rect too large for a point stand-in, a mixed
+/// material: `ring_sky`, `moving_lights`, `cup`). Otherwise `image_space`,
+/// the surface caustics of mirrors and glass under point, spot,
+/// directional and small rect lights, which it maps without pinhole's
+/// distant-light error (Wand & Straßer Sect. 5); then `pinhole` where
+/// image_space refuses a scene with specular surfaces (glass under sphere
+/// lights: it still shows the glass and its reflections); `direct` when
 /// none of them accepts the scene.
 pub fn auto(scene: &Scene) -> &'static str {
-    let candidates: &[&'static str] = if scene.medium.is_some() {
-        &["volume_lines", "beams", "direct"]
+    let accepts = |name: &str| find(name).is_ok_and(|t| (t.check_scene)(scene).is_ok());
+    let candidates: Vec<&'static str> = if scene.medium.is_some() {
+        vec!["volume_lines", "beams"]
     } else {
-        &["water_photons", "image_space", "direct"]
+        use crate::scene::MaterialKind;
+        let kind = |k: MaterialKind| used_materials(scene).any(|(_, m)| m.kind == k);
+        let reflectors = kind(MaterialKind::Mirror) || has_mixed(scene);
+        let refractors = kind(MaterialKind::Dielectric);
+        let pinhole_first =
+            reflectors && !refractors && (scene.environment.is_some() || !accepts("image_space"));
+        if pinhole_first {
+            vec!["water_photons", "pinhole"]
+        } else if reflectors || refractors {
+            vec!["water_photons", "image_space", "pinhole"]
+        } else {
+            vec!["water_photons", "image_space"]
+        }
     };
     candidates
-        .iter()
-        .copied()
-        .find(|name| find(name).is_ok_and(|t| (t.check_scene)(scene).is_ok()))
+        .into_iter()
+        .find(|name| accepts(name))
         .unwrap_or("direct")
 }
 
@@ -305,7 +327,7 @@ mod auto_tests {
     use super::*;
 
     /// `--technique auto` on the canonical scenes: a medium, sunlit water,
-    /// and glass over a floor.
+    /// glass over a floor, reflectors under what only pinhole maps.
     #[test]
     fn auto_picks_by_what_the_scene_has() {
         let load = |name: &str| {
@@ -319,5 +341,28 @@ mod auto_tests {
         assert_eq!(auto(&load("water_pool.toml")), "water_photons");
         assert_eq!(auto(&load("ball_lens.toml")), "image_space");
         assert_eq!(auto(&load("ring.toml")), "image_space");
+        // Reflectors under an environment, sphere lights, a mixed material.
+        assert_eq!(auto(&load("ring_sky.toml")), "pinhole");
+        assert_eq!(auto(&load("moving_lights.toml")), "pinhole");
+        assert_eq!(auto(&load("cup.toml")), "pinhole");
+        // A rect light in a medium: its stand-in serves volume_lines.
+        assert_eq!(auto(&load("volume_box.toml")), "volume_lines");
+        // Glass under a sphere light: image_space refuses it, pinhole
+        // still shows the glass; no specular surface at all: image_space.
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/ball_lens.toml");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let point =
+            "kind = \"point\"\nposition = [0.0, 8.0, 0.0]\nintensity = [60.0, 60.0, 60.0]\n";
+        assert!(text.contains(point));
+        let sphere =
+            "kind = \"sphere\"\ncenter = [0.0, 8.0, 0.0]\nradius = 0.2\nradiance = 100.0\n";
+        let glass = Scene::from_str(&text.replace(point, sphere), &path).unwrap();
+        assert_eq!(auto(&glass), "pinhole");
+        let mut plain = load("ring.toml");
+        for m in &mut plain.materials {
+            m.kind = crate::scene::MaterialKind::Diffuse;
+        }
+        assert_eq!(auto(&plain), "image_space");
     }
 }
