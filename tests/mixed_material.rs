@@ -171,3 +171,40 @@ fn mixed_plate_reflects_its_mirror_part() {
     assert!(rel.abs() < 0.03, "mirror part off by {rel:+.4}");
     assert_validation_clean(&ctx);
 }
+
+/// No technique drops a mixed surface's mirror part silently: those that
+/// trace caustics from mirrors and glass only refuse the scene (one line
+/// naming the file and the material); pinhole, which renders both parts,
+/// and direct, which renders no specular light, accept it. The same scene
+/// with the material plain diffuse is accepted by all (the refusal is the
+/// mirror part's).
+#[test]
+fn techniques_without_a_mirror_part_refuse_mixed_materials() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/cup.toml");
+    let cup = Scene::load(&path).unwrap();
+    assert!(techniques::has_mixed(&cup));
+    let mut plain = cup.clone();
+    for m in &mut plain.materials {
+        m.specular = Vec3::ZERO;
+    }
+    assert!(!techniques::has_mixed(&plain));
+    for name in ["image_space", "volume_lines", "water_photons", "beams"] {
+        let info = techniques::find(name).unwrap();
+        let e = (info.check_scene)(&cup).expect_err(name).to_string();
+        assert!(
+            e.starts_with(&path.display().to_string())
+                && e.contains("material `metal`")
+                && e.contains("mixed")
+                && e.contains(name),
+            "{e}"
+        );
+        assert_eq!(e.lines().count(), 1, "{e}");
+        if name != "water_photons" {
+            // (water_photons refuses the cup anyway: it has no water.)
+            (info.check_scene)(&plain).unwrap_or_else(|e| panic!("{name}: {e}"));
+        }
+    }
+    for name in ["pinhole", "direct"] {
+        (techniques::find(name).unwrap().check_scene)(&cup).unwrap();
+    }
+}

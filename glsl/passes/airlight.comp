@@ -28,6 +28,11 @@
 //   constant density, `medium_steps` midpoint steps otherwise);
 // - V from the shadow maps, which hold every caster, glass included: light
 //   that crossed a specular surface belongs to the volume caustics (B);
+//   the lights after the shadow-mapped ones (the point stand-ins of rect
+//   lights, a spot at the rect's centre with the cosine profile
+//   I = L A max(cos theta, 0), and of the environment's sun: src/environment.rs
+//   stand_in_lights) have no shadow map: V is one BVH shadow ray to the
+//   stand-in (every surface blocks it, glass included, as the maps do);
 // - HG phase (medium.glsl) with cos(theta) between the propagation
 //   directions: from the light to x, and from x to the eye.
 #include "scene.glsl"
@@ -48,6 +53,7 @@ layout(set = 1, binding = AIRLIGHT_BINDING_RADIANCE, rgba32f) uniform image2D ra
 
 layout(push_constant) uniform Push {
     uint light_count;  // lights with shadow maps (<= MAX_LIGHTS)
+    uint lit_count;    // all lights in the buffer: then the stand-ins, shadowed by BVH rays
     uint steps;        // strata along the camera ray inside the medium
     uint medium_steps; // midpoint steps of inhomogeneous light-side transmittance
     uint jitter;       // 1: per-pixel random stratum offset; 0: midpoints
@@ -109,7 +115,7 @@ void main() {
         depth += sigma_t * (density * dt);
         if (density <= 0.0) continue;
         vec3 in_scatter = vec3(0.0);
-        for (uint l = 0u; l < pc.light_count; ++l) {
+        for (uint l = 0u; l < pc.lit_count; ++l) {
             vec3 dir_in;
             float dist;
             vec3 li = incident(l, x, dir_in, dist);
@@ -117,7 +123,8 @@ void main() {
             vec3 to_light = -dir_in;
             // A point in the medium has no surface: the lookup is offset
             // toward the light, with no slope (n = to_light).
-            float v = shadow_visibility(l, x, to_light, to_light, 0);
+            float v = l < pc.light_count ? shadow_visibility(l, x, to_light, to_light, 0)
+                                         : (trace_any(x, to_light, 0.0, dist) ? 0.0 : 1.0);
             if (v == 0.0) continue;
             vec3 tau_light = medium_transmittance_steps(x, to_light, light_travel(dist, x), pc.medium_steps);
             in_scatter += li * v * tau_light * hg_phase(dot(dir_in, -dir), g);

@@ -1,5 +1,6 @@
 //! What keys and the mouse do to the open window's state: fly and orbit,
-//! move the light, screenshots, reload, technique and component switches.
+//! move the light, turn the environment, screenshots, reload, technique and
+//! component switches.
 
 use super::camera::OrbitCamera;
 use crate::output;
@@ -49,6 +50,30 @@ impl State {
         if let Some(light) = self.renderer.scene.lights.first_mut() {
             light.position += (right * dx - ahead * dy) * step;
             self.lights_changed = true;
+        }
+    }
+
+    /// `[` / `]`: turns the environment by `delta_deg` about +y.
+    pub(super) fn rotate_environment(&mut self, delta_deg: f32) {
+        let Some(env) = self.renderer.scene.environment.as_ref() else {
+            println!("environment rotation: the scene has no environment");
+            return;
+        };
+        let turned = (env.rotate_deg + delta_deg + 180.0).rem_euclid(360.0) - 180.0;
+        self.set_environment_rotation(turned);
+    }
+
+    /// The environment's `rotate` (degrees about +y), live
+    /// (`Renderer::set_environment_rotation`); the overlay's slider and the
+    /// bracket keys call it. On an error the old rotation is kept.
+    pub(super) fn set_environment_rotation(&mut self, rotate_deg: f32) {
+        let start = std::time::Instant::now();
+        match self.renderer.set_environment_rotation(rotate_deg) {
+            Ok(()) => println!(
+                "environment rotate = {rotate_deg:.1} degrees ({:.1} ms)",
+                start.elapsed().as_secs_f64() * 1e3
+            ),
+            Err(e) => eprintln!("environment rotation: {e:#}"),
         }
     }
 

@@ -43,6 +43,9 @@ use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::window::{Window, WindowId};
 
+/// Degrees the environment turns about +y per press of `[` or `]`.
+const ENVIRONMENT_STEP_DEG: f32 = 15.0;
+
 #[derive(Clone, Debug)]
 pub struct DemoOptions {
     pub scene: PathBuf,
@@ -381,6 +384,15 @@ impl ApplicationHandler for App {
                     KeyCode::KeyP => state.screenshot(),
                     KeyCode::KeyC => {
                         state.cycle_components();
+                        Ok(())
+                    }
+                    KeyCode::BracketLeft | KeyCode::BracketRight => {
+                        let step = ENVIRONMENT_STEP_DEG;
+                        state.rotate_environment(if code == KeyCode::BracketLeft {
+                            -step
+                        } else {
+                            step
+                        });
                         Ok(())
                     }
                     _ => match digit {

@@ -33,6 +33,8 @@ pub struct UiData<'a> {
     pub medium: Option<MediumValues>,
     /// Each light's intensity (W/sr) or, for a directional light, irradiance (W/m^2).
     pub light_intensities: Vec<[f32; 3]>,
+    /// The environment's `rotate` (degrees about +y), if there is one.
+    pub environment_rotate: Option<f32>,
 }
 
 /// The medium coefficients the overlay edits.
@@ -56,6 +58,8 @@ pub enum Action {
         light: usize,
         rgb: [f32; 3],
     },
+    /// The environment's new `rotate` (degrees about +y).
+    EnvironmentRotation(f32),
 }
 
 #[cfg(not(feature = "overlay"))]
@@ -324,6 +328,7 @@ mod enabled {
                 components(ui, data, actions);
                 medium(ui, data, actions);
                 light_intensities(ui, data, actions);
+                environment_rotation(ui, data, actions);
                 ui.separator();
                 egui::Grid::new("timings").striped(true).show(ui, |ui| {
                     let mut total = 0.0;
@@ -414,6 +419,20 @@ mod enabled {
                     rgb: rgb_value,
                 });
             }
+        }
+    }
+
+    /// The environment's rotation about +y, applied while dragging.
+    fn environment_rotation(ui: &mut egui::Ui, data: &UiData, actions: &mut Vec<Action>) {
+        let Some(old) = data.environment_rotate else {
+            return;
+        };
+        ui.separator();
+        let mut deg = old;
+        ui.add(egui::Slider::new(&mut deg, -180.0..=180.0).text("environment rotate ([ ])"))
+            .on_hover_text("degrees about +y: background, irradiance, sun and reflections follow");
+        if deg != old {
+            actions.push(Action::EnvironmentRotation(deg));
         }
     }
 

@@ -189,6 +189,12 @@ impl State {
                     .iter()
                     .map(|l| l.intensity.to_array())
                     .collect(),
+                environment_rotate: self
+                    .renderer
+                    .scene
+                    .environment
+                    .as_ref()
+                    .map(|e| e.rotate_deg),
             },
         )?;
         for action in actions {
@@ -209,6 +215,7 @@ impl State {
                         self.lights_changed = true;
                     }
                 }
+                Action::EnvironmentRotation(deg) => self.set_environment_rotation(deg),
                 Action::Params(params) => {
                     // No wait: a rebuilt technique's predecessor is released
                     // after the frames in flight that use it.

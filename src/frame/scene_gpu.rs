@@ -307,6 +307,16 @@ impl SceneGpu {
         self.geometry_time = time;
     }
 
+    /// The environment's `rotate` changed (`Scene::set_environment_rotation`):
+    /// re-uploads its constants and the lights, whose stand-in for the
+    /// environment's sun turned with it. The caller has waited for every
+    /// frame that read the old ones.
+    pub fn update_environment(&mut self, scene: &Scene) -> VkResult<()> {
+        self.environment
+            .update(scene.environment.as_ref(), self.sphere.1)?;
+        self.update_lights(scene)
+    }
+
     /// Re-uploads moved lights (same count). The caller has waited for every
     /// frame that read the old ones.
     pub fn update_lights(&self, scene: &Scene) -> VkResult<()> {

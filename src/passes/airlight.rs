@@ -11,7 +11,17 @@
 //! I / r^2), HG phase with the medium's g, V from the shadow maps (every
 //! caster, glass included), transmittance exact for constant density and by
 //! `medium_steps` midpoint steps otherwise. This is exactly what the
-//! reference's `airlight` component (L V paths) converges to. The camera ray
+//! reference's `airlight` component (L V paths) converges to. The lights
+//! are the GPU light buffer's (`environment::caustic_lights`): the scene's
+//! own, with the technique's shadow maps, then the point stand-ins of small
+//! rect lights (a spot at the centre with the cosine profile
+//! I = L A max(cos θ, 0), so their airlight agrees with the surface light
+//! and volume caustics the techniques draw from the same stand-ins) and of
+//! an environment's sun (a directional light of its irradiance), each
+//! shadowed by one BVH ray per sample (they have no shadow map). The
+//! stand-in differs from the rect's own airlight by O((s/d)²) at distance d
+//! (`environment::STAND_IN_MAX_SIZE_RATIO`). An environment's sky (beyond
+//! its sun) and sphere lights scatter no airlight here. The camera ray
 //! ends at the first surface of any kind (one BVH ray per pixel): the
 //! reference has no L V path seen through glass, and a technique's
 //! G-buffer may hold only the opaque surfaces.
@@ -54,6 +64,7 @@ crate::declare_params! {
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 struct AirlightPush {
     light_count: u32,
+    lit_count: u32,
     steps: u32,
     medium_steps: u32,
     jitter: u32,
@@ -100,6 +111,7 @@ impl Airlight {
         Ok(Self {
             push: AirlightPush {
                 light_count: scene.lights.len().min(b::MAX_LIGHTS as usize) as u32,
+                lit_count: crate::environment::caustic_lights(scene).len() as u32,
                 steps: params.airlight_steps,
                 medium_steps,
                 jitter: params.airlight_jitter,

@@ -16,8 +16,8 @@
 //!
 //! Environment and area lights (docs/ARCHITECTURE.md, "Environment and
 //! area lights in direct"): 0. "environment irradiance"
-//! (glsl/direct/environment_sh.comp, recorded on the first frame only: the
-//! environment is fixed while the scene is on the GPU) projects the
+//! (glsl/direct/environment_sh.comp, recorded on the first frame and on the
+//! first after the environment rotated, `environment_changed`) projects the
 //! environment's table onto order-2 spherical harmonics (Ramamoorthi &
 //! Hanrahan 2001); the lighting adds their irradiance, unoccluded, the
 //! sky's sun as a directional light with one BVH shadow ray, and each area
@@ -83,7 +83,7 @@ pub struct DirectLight {
     /// 9 rgb coefficients (vec4 each) of the environment's irradiance.
     sh: Buffer,
     /// Whether `sh` holds this scene's environment (computed on the first
-    /// frame: the environment is fixed while the scene is on the GPU).
+    /// frame and again after `environment_changed`).
     sh_done: bool,
     set: DescriptorSet,
     /// "environment irradiance"'s set (the SH alone).
@@ -184,6 +184,12 @@ impl DirectLight {
             _layouts: [layout, sh_layout],
             sampler,
         })
+    }
+
+    /// The environment rotated: its irradiance SH is projected again on the
+    /// next frame ("environment irradiance").
+    pub fn environment_changed(&mut self) {
+        self.sh_done = false;
     }
 
     /// Takes the live parameters of `params` (`pcf_radius`, `sky_rays`).

@@ -123,4 +123,9 @@ impl SurfaceFrame {
     pub fn set_lights(&mut self, lights: &[Light]) -> bool {
         self.direct.set_lights(lights)
     }
+
+    /// The environment rotated (`DirectLight::environment_changed`).
+    pub fn environment_changed(&mut self) {
+        self.direct.environment_changed();
+    }
 }

@@ -250,6 +250,40 @@ impl Renderer {
         }
     }
 
+    /// Turns the environment to `rotate_deg` degrees about +y (the demo's
+    /// live rotation), with the result of loading the scene with that
+    /// `rotate`: the scene (a sky's sun direction), the environment's
+    /// constants on the GPU (what the camera sees, the reference's and
+    /// pinhole's lookups, the sun found in an image), the lights (the sun's
+    /// directional stand-in) and the technique: updated in place where it
+    /// can (`Technique::environment_changed`: `direct`'s SH are projected
+    /// again on the GPU next frame), else rebuilt for the new scene. Waits
+    /// for the frames in flight, which read the constants. An error when
+    /// the scene has no environment; when the rebuild fails, the old
+    /// rotation is restored.
+    pub fn set_environment_rotation(&mut self, rotate_deg: f32) -> anyhow::Result<()> {
+        anyhow::ensure!(
+            rotate_deg.is_finite(),
+            "environment rotation must be finite, got {rotate_deg}"
+        );
+        let Some(old) = self.scene.environment.as_ref().map(|e| e.rotate_deg) else {
+            anyhow::bail!("the scene has no environment to rotate");
+        };
+        self.finish()?;
+        self.scene.set_environment_rotation(rotate_deg);
+        self.scene_gpu.update_environment(&self.scene)?;
+        if !self.technique.environment_changed() {
+            let params = self.params.clone();
+            if let Err(e) = self.set_technique(self.technique.name(), &params) {
+                // The current technique stays, with the old rotation.
+                self.scene.set_environment_rotation(old);
+                self.scene_gpu.update_environment(&self.scene)?;
+                return Err(e);
+            }
+        }
+        Ok(())
+    }
+
     pub fn params(&self) -> &Params {
         &self.params
     }

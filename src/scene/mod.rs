@@ -81,6 +81,22 @@ impl Scene {
         self.objects.iter().map(|o| o.mesh.indices.len()).sum()
     }
 
+    /// Sets the environment's `rotate` (degrees about +y) as loading the
+    /// file with that value would: a sky's sun direction, stored rotated,
+    /// turns with it. False (nothing changed) without an environment.
+    pub fn set_environment_rotation(&mut self, rotate_deg: f32) -> bool {
+        let Some(env) = self.environment.as_mut() else {
+            return false;
+        };
+        if let EnvironmentKind::Sky(sky) = &mut env.kind {
+            let turn = Quat::from_rotation_y(rotate_deg.to_radians())
+                * Quat::from_rotation_y(-env.rotate_deg.to_radians());
+            sky.sun_direction = (turn * sky.sun_direction).normalize();
+        }
+        env.rotate_deg = rotate_deg;
+        true
+    }
+
     /// Whether any object moves with time (an `animate` block that moves,
     /// or water with waves that have height and speed).
     pub fn is_animated(&self) -> bool {

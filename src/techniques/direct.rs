@@ -59,4 +59,11 @@ impl Technique for Direct {
     fn set_lights(&mut self, lights: &[crate::scene::Light]) -> bool {
         self.light.set_lights(lights)
     }
+
+    /// Its shadow maps hold the scene's own lights; the sun and the sky
+    /// come from the environment's constants and SH.
+    fn environment_changed(&mut self) -> bool {
+        self.light.environment_changed();
+        true
+    }
 }

@@ -31,6 +31,16 @@ pub trait Technique {
         false
     }
 
+    /// The environment's `rotate` changed (`Renderer::set_environment_rotation`);
+    /// the scene's GPU copy (environment constants, lights) is updated
+    /// already. Returns true when the technique updated what it derived
+    /// from the environment in place (`direct`'s irradiance SH, recomputed
+    /// on the next frame); false (the default) makes the renderer rebuild
+    /// it. Called with no frame in flight.
+    fn environment_changed(&mut self) -> bool {
+        false
+    }
+
     /// Takes new values of `Live` parameters (`params::Apply`) in place:
     /// push constants and switches read at record time. Called by
     /// `Renderer::set_params` only when every changed parameter is live,
@@ -168,16 +178,8 @@ registry! {
 /// light sampling). Every technique but `direct` calls it from its
 /// `check_scene`.
 pub fn check_materials(scene: &Scene, technique: &str) -> anyhow::Result<()> {
-    let mut used = vec![false; scene.materials.len()];
-    for o in &scene.objects {
-        for &m in &o.mesh.materials {
-            if let Some(u) = used.get_mut(m as usize) {
-                *u = true;
-            }
-        }
-    }
     let file = scene.source.display();
-    for (i, m) in scene.materials.iter().enumerate().filter(|&(i, _)| used[i]) {
+    for (i, m) in used_materials(scene) {
         if m.kind == crate::scene::MaterialKind::ThinDielectric {
             anyhow::bail!(
                 "{file}: material `{}`: {technique} does not render thin dielectric sheets (kind = \"thin_dielectric\", glTF transmission without a volume); use `direct` or `reference`",
@@ -195,24 +197,90 @@ pub fn check_materials(scene: &Scene, technique: &str) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The materials some object uses, with their indices.
+fn used_materials(scene: &Scene) -> impl Iterator<Item = (usize, &crate::scene::Material)> {
+    let mut used = vec![false; scene.materials.len()];
+    for o in &scene.objects {
+        for &m in &o.mesh.materials {
+            if let Some(u) = used.get_mut(m as usize) {
+                *u = true;
+            }
+        }
+    }
+    scene
+        .materials
+        .iter()
+        .enumerate()
+        .filter(move |&(i, _)| used[i])
+}
+
+/// Whether an object uses a `mixed` material (a diffuse surface with a
+/// mirror part, `Material::specular`).
+pub fn has_mixed(scene: &Scene) -> bool {
+    used_materials(scene).any(|(_, m)| is_mixed(m))
+}
+
+fn is_mixed(m: &crate::scene::Material) -> bool {
+    m.kind == crate::scene::MaterialKind::Diffuse && m.specular.max_element() > 0.0
+}
+
+/// Refuses, naming the first one, a `mixed` material: its mirror part
+/// would be dropped silently by the techniques that trace caustics from
+/// mirrors and glass only (image_space, volume_lines, water_photons,
+/// beams: their G-buffers and light views see a diffuse surface). `pinhole`
+/// renders both parts, the reference exactly; `direct` draws no specular
+/// light at all.
+pub fn check_no_mixed(scene: &Scene, technique: &str) -> anyhow::Result<()> {
+    if let Some((_, m)) = used_materials(scene).find(|(_, m)| is_mixed(m)) {
+        anyhow::bail!(
+            "{}: material `{}`: {technique} does not render the mirror part of a mixed material (kind = \"mixed\"); use `pinhole` or `reference`",
+            scene.source.display(),
+            m.name
+        );
+    }
+    Ok(())
+}
+
 /// `--technique auto`: the technique that renders every component `scene`
 /// has, among those that accept it (`check_scene`: e.g. image_space and
-/// volume_lines refuse sphere lights). A participating medium needs airlight
-/// and volume caustics: `volume_lines` (`beams` renders them too;
-/// volume_lines is the closer to the reference on volume_cone,
-/// BENCHMARKS.md). Water lit by a sun: `water_photons`. Otherwise
-/// `image_space`, the surface caustics of mirrors and glass; `direct` when
+/// volume_lines refuse sphere lights and mixed materials). A participating
+/// medium needs airlight and volume caustics: `volume_lines` (`beams`
+/// renders them too; volume_lines is the closer to the reference on
+/// volume_cone, BENCHMARKS.md). Water lit by a sun: `water_photons`.
+/// Reflectors (mirrors, mixed surfaces) and no refractors, lit by what
+/// image_space cannot map: `pinhole`, whose light cube maps hold every
+/// emitter. That is an environment (image_space maps its sun alone: the
+/// sky in the mirrors would cast nothing) or any scene image_space refuses
+/// (sphere lights, a rect too large for a point stand-in, a mixed
+/// material: `ring_sky`, `moving_lights`, `cup`). Otherwise `image_space`,
+/// the surface caustics of mirrors and glass under point, spot,
+/// directional and small rect lights, which it maps without pinhole's
+/// distant-light error (Wand & Straßer Sect. 5); then `pinhole` where
+/// image_space refuses a scene with specular surfaces (glass under sphere
+/// lights: it still shows the glass and its reflections); `direct` when
 /// none of them accepts the scene.
 pub fn auto(scene: &Scene) -> &'static str {
-    let candidates: &[&'static str] = if scene.medium.is_some() {
-        &["volume_lines", "beams", "direct"]
+    let accepts = |name: &str| find(name).is_ok_and(|t| (t.check_scene)(scene).is_ok());
+    let candidates: Vec<&'static str> = if scene.medium.is_some() {
+        vec!["volume_lines", "beams"]
     } else {
-        &["water_photons", "image_space", "direct"]
+        use crate::scene::MaterialKind;
+        let kind = |k: MaterialKind| used_materials(scene).any(|(_, m)| m.kind == k);
+        let reflectors = kind(MaterialKind::Mirror) || has_mixed(scene);
+        let refractors = kind(MaterialKind::Dielectric);
+        let pinhole_first =
+            reflectors && !refractors && (scene.environment.is_some() || !accepts("image_space"));
+        if pinhole_first {
+            vec!["water_photons", "pinhole"]
+        } else if reflectors || refractors {
+            vec!["water_photons", "image_space", "pinhole"]
+        } else {
+            vec!["water_photons", "image_space"]
+        }
     };
     candidates
-        .iter()
-        .copied()
-        .find(|name| find(name).is_ok_and(|t| (t.check_scene)(scene).is_ok()))
+        .into_iter()
+        .find(|name| accepts(name))
         .unwrap_or("direct")
 }
 
@@ -259,7 +327,7 @@ mod auto_tests {
     use super::*;
 
     /// `--technique auto` on the canonical scenes: a medium, sunlit water,
-    /// and glass over a floor.
+    /// glass over a floor, reflectors under what only pinhole maps.
     #[test]
     fn auto_picks_by_what_the_scene_has() {
         let load = |name: &str| {
@@ -273,5 +341,28 @@ mod auto_tests {
         assert_eq!(auto(&load("water_pool.toml")), "water_photons");
         assert_eq!(auto(&load("ball_lens.toml")), "image_space");
         assert_eq!(auto(&load("ring.toml")), "image_space");
+        // Reflectors under an environment, sphere lights, a mixed material.
+        assert_eq!(auto(&load("ring_sky.toml")), "pinhole");
+        assert_eq!(auto(&load("moving_lights.toml")), "pinhole");
+        assert_eq!(auto(&load("cup.toml")), "pinhole");
+        // A rect light in a medium: its stand-in serves volume_lines.
+        assert_eq!(auto(&load("volume_box.toml")), "volume_lines");
+        // Glass under a sphere light: image_space refuses it, pinhole
+        // still shows the glass; no specular surface at all: image_space.
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/ball_lens.toml");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let point =
+            "kind = \"point\"\nposition = [0.0, 8.0, 0.0]\nintensity = [60.0, 60.0, 60.0]\n";
+        assert!(text.contains(point));
+        let sphere =
+            "kind = \"sphere\"\ncenter = [0.0, 8.0, 0.0]\nradius = 0.2\nradiance = 100.0\n";
+        let glass = Scene::from_str(&text.replace(point, sphere), &path).unwrap();
+        assert_eq!(auto(&glass), "pinhole");
+        let mut plain = load("ring.toml");
+        for m in &mut plain.materials {
+            m.kind = crate::scene::MaterialKind::Diffuse;
+        }
+        assert_eq!(auto(&plain), "image_space");
     }
 }

@@ -510,4 +510,11 @@ impl Technique for Pinhole {
     fn set_lights(&mut self, lights: &[crate::scene::Light]) -> bool {
         self.surface.set_lights(lights)
     }
+
+    /// The light cube maps are drawn every frame from the environment's
+    /// constants on the GPU; the surface frame recomputes its SH.
+    fn environment_changed(&mut self) -> bool {
+        self.surface.environment_changed();
+        true
+    }
 }

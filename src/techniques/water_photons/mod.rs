@@ -463,6 +463,7 @@ impl TechniqueBuild for WaterPhotons {
     /// as the scene fields that lack them.
     fn check_scene(scene: &Scene) -> anyhow::Result<()> {
         super::check_materials(scene, Self::NAME)?;
+        super::check_no_mixed(scene, Self::NAME)?;
         let file = scene.source.display();
         if !scene.objects.iter().any(|o| o.water.is_some()) {
             anyhow::bail!(
