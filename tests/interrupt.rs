@@ -105,6 +105,8 @@ fn moments(n: usize, max: Duration) -> Vec<Duration> {
 fn render_args(out: &Path) -> Vec<String> {
     [
         "render",
+        "--scene",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/ball_lens.toml"),
         "--technique",
         "direct",
         "--width",
