@@ -347,7 +347,10 @@ mod tests {
         assert_eq!(batch.len(), 2);
         assert!(names(&dir).iter().all(|n| n.ends_with(".partial")));
         drop(batch);
-        assert!(names(&dir).is_empty(), "an uncommitted batch leaves nothing");
+        assert!(
+            names(&dir).is_empty(),
+            "an uncommitted batch leaves nothing"
+        );
         let mut batch = Batch::default();
         batch.write(exr_file(&a, 1, 1, &[0.0; 4])).unwrap();
         batch.write(png_file(&b, 1, 1, &[0, 0, 0, 255])).unwrap();

@@ -1,4 +1,4 @@
-//! Killed while writing (issue 18): `render` and `bench --json` interrupted
+//! Killed while writing (issue 18): `render`, `compare` and `bench --json` interrupted
 //! by SIGTERM or SIGINT at any moment leave either the complete output (the
 //! signal came after it was written) or nothing at the output names, and
 //! never a temporary; `reference` interrupted finishes the pass in flight
@@ -172,6 +172,45 @@ fn render_killed_at_random_moments_is_all_or_nothing() {
         signal(&child, "TERM");
         assert_all_or_nothing(&out, child, 15, &["x.exr", "x.png"]);
     }
+}
+
+/// `compare` writes each file to its temporary as soon as it is made
+/// (`output::Batch`); SIGTERM after the first of them leaves no file and no
+/// temporary in its folder.
+#[test]
+fn compare_killed_while_writing_leaves_nothing() {
+    let out = temp_dir("compare").join("out");
+    let mut child = caustics()
+        .args([
+            "compare",
+            "--scene",
+            concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/ball_lens.toml"),
+            "--techniques",
+            "direct",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--photons",
+            "262144",
+            "--frames",
+            "1",
+            "--no-cache",
+            "--out",
+        ])
+        .arg(&out)
+        .env("CAUSTICS_TEST_WRITE_PAUSE_MS", "2000")
+        .spawn()
+        .expect("spawn");
+    assert!(
+        wait_for_file(&out, ".partial", &mut child),
+        "no temporary seen"
+    );
+    signal(&child, "TERM");
+    let o = child.wait_with_output().expect("wait");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(128 + 15), "{stderr}");
+    assert_eq!(names(&out), Vec::<String>::new(), "{stderr}");
 }
 
 /// `bench --json` interrupted while the JSON is written leaves no JSON and
