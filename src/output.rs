@@ -1,7 +1,7 @@
 //! Writing images: EXR holds linear radiance (32-bit float, the truth), PNG
 //! holds the tonemapped 8-bit sRGB display image. Outputs are written to
 //! temporary names in their folder and renamed together at the end
-//! ([`write_files`]), so a failure, or a process interrupted by a signal
+//! ([`write_files`], or [`Batch`] for files written as they are made), so a failure, or a process interrupted by a signal
 //! (whose handler calls [`abandon_temporaries`]), never leaves a partial
 //! file, nor one image of a pair without the other.
 
@@ -145,53 +145,94 @@ pub struct OutputFile<'a> {
 /// together: all of them or none appear (a failure removes what was already
 /// renamed and every temporary).
 pub fn write_files(files: Vec<OutputFile>) -> anyhow::Result<()> {
-    let mut written: Vec<(PathBuf, &Path)> = Vec::new();
-    let result = (|| {
-        for f in files {
-            let dir = folder_of(f.path);
-            std::fs::create_dir_all(&dir)
-                .with_context(|| format!("cannot create folder {}", dir.display()))?;
-            let name = f
-                .path
-                .file_name()
-                .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
-            let tmp = dir.join(format!(".{name}.{}.partial", std::process::id()));
-            // Created with the lock held: after a signal's handler took it,
-            // no temporary can appear.
-            let file = {
-                let mut list = temporaries();
-                let file = File::create(&tmp)
-                    .with_context(|| format!("cannot write {}", f.path.display()))?;
-                list.push(tmp.clone());
-                file
-            };
-            written.push((tmp, f.path));
-            let mut w = BufWriter::new(file);
-            (f.write)(&mut w)
-                .and_then(|()| Ok(w.flush()?))
-                .with_context(|| format!("cannot write {}", f.path.display()))?;
-            test_pause();
-        }
+    let mut batch = Batch::default();
+    for f in files {
+        batch.write(f)?;
+    }
+    batch.commit()
+}
+
+/// Files written one at a time, each to its temporary as soon as it is
+/// known, and renamed into place together by [`Batch::commit`], in the
+/// order they were written: what [`write_files`] does for files held in
+/// memory, for a producer that must not hold them all (`caustics
+/// compare`). Until the commit only temporaries exist; a batch dropped
+/// uncommitted (an error) removes them, and a signal's handler removes them
+/// through [`abandon_temporaries`].
+#[derive(Default)]
+pub struct Batch {
+    /// (temporary, final path), in the order written.
+    written: Vec<(PathBuf, PathBuf)>,
+}
+
+impl Batch {
+    /// Writes `f` to its temporary now.
+    pub fn write(&mut self, f: OutputFile) -> anyhow::Result<()> {
+        let dir = folder_of(f.path);
+        std::fs::create_dir_all(&dir)
+            .with_context(|| format!("cannot create folder {}", dir.display()))?;
+        let name = f
+            .path
+            .file_name()
+            .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
+        let tmp = dir.join(format!(".{name}.{}.partial", std::process::id()));
+        // Created with the lock held: after a signal's handler took it,
+        // no temporary can appear.
+        let file = {
+            let mut list = temporaries();
+            let file =
+                File::create(&tmp).with_context(|| format!("cannot write {}", f.path.display()))?;
+            list.push(tmp.clone());
+            file
+        };
+        self.written.push((tmp, f.path.to_path_buf()));
+        let mut w = BufWriter::new(file);
+        (f.write)(&mut w)
+            .and_then(|()| Ok(w.flush()?))
+            .with_context(|| format!("cannot write {}", f.path.display()))?;
+        test_pause();
+        Ok(())
+    }
+
+    /// How many files were written.
+    pub fn len(&self) -> usize {
+        self.written.len()
+    }
+
+    /// Whether no file was written.
+    pub fn is_empty(&self) -> bool {
+        self.written.is_empty()
+    }
+
+    /// Renames every temporary into place, in the order written; on a
+    /// failure removes those already renamed (and, on drop, the rest).
+    pub fn commit(mut self) -> anyhow::Result<()> {
         let mut list = temporaries();
-        for (i, (tmp, path)) in written.iter().enumerate() {
+        for (i, (tmp, path)) in self.written.iter().enumerate() {
             if let Err(e) = std::fs::rename(tmp, path) {
-                for (_, done) in &written[..i] {
+                for (_, done) in &self.written[..i] {
                     let _ = std::fs::remove_file(done);
                 }
-                return Err(e).with_context(|| format!("cannot write {}", path.display()));
+                let message = format!("cannot write {}", path.display());
+                self.written.drain(..i);
+                return Err(e).context(message);
             }
             list.retain(|p| p != tmp);
         }
+        self.written.clear();
         Ok(())
-    })();
-    if result.is_err() {
+    }
+}
+
+impl Drop for Batch {
+    /// An uncommitted batch removes its temporaries.
+    fn drop(&mut self) {
         let mut list = temporaries();
-        for (tmp, _) in &written {
+        for (tmp, _) in &self.written {
             let _ = std::fs::remove_file(tmp);
             list.retain(|p| p != tmp);
         }
     }
-    result
 }
 
 /// A test hook (tests/interrupt.rs): `CAUSTICS_TEST_WRITE_PAUSE_MS` pauses
@@ -284,6 +325,37 @@ mod tests {
         std::fs::write(dir.join("file"), "").unwrap();
         let e = prepare(&dir.join("file/z.png")).expect_err("a file is in the way");
         assert!(e.to_string().contains("is not a folder"), "{e:#}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_batch_shows_its_files_only_when_committed() {
+        let dir = std::env::temp_dir().join(format!("caustics-batch-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let names = |dir: &Path| -> Vec<String> {
+            let mut v: Vec<String> = std::fs::read_dir(dir)
+                .unwrap()
+                .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                .collect();
+            v.sort();
+            v
+        };
+        let (a, b) = (dir.join("a.exr"), dir.join("b.png"));
+        let mut batch = Batch::default();
+        batch.write(exr_file(&a, 1, 1, &[0.0; 4])).unwrap();
+        batch.write(png_file(&b, 1, 1, &[0, 0, 0, 255])).unwrap();
+        assert_eq!(batch.len(), 2);
+        assert!(names(&dir).iter().all(|n| n.ends_with(".partial")));
+        drop(batch);
+        assert!(
+            names(&dir).is_empty(),
+            "an uncommitted batch leaves nothing"
+        );
+        let mut batch = Batch::default();
+        batch.write(exr_file(&a, 1, 1, &[0.0; 4])).unwrap();
+        batch.write(png_file(&b, 1, 1, &[0, 0, 0, 255])).unwrap();
+        batch.commit().unwrap();
+        assert_eq!(names(&dir), vec!["a.exr", "b.png"]);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

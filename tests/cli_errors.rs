@@ -143,6 +143,8 @@ fn photons_rounded_to_whole_passes_say_so() {
     let o = run(
         &[
             "reference",
+            "--scene",
+            &manifest("assets/scenes/ball_lens.toml"),
             "--photons",
             "1",
             "--width",

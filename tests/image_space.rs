@@ -706,6 +706,23 @@ fn gemstone_caustics_match_reference() {
     );
 }
 
+/// The default scene, a showcase (tinted glass, coloured receivers, a spot
+/// light), in the default photon mode, which `auto` renders it with.
+/// Measured on lavapipe: energy -0.0248, FLIP mean 0.0167 (the reference's
+/// two halves: +0.0008 and 0.0139); bounds as above.
+#[test]
+fn still_life_caustics_match_reference() {
+    caustics_match_reference(
+        "still_life",
+        PHOTONS_REFERENCE,
+        &[Bound {
+            photon_mode: 0,
+            energy: 0.045,
+            flip: 0.025,
+        }],
+    );
+}
+
 /// Flux (W, red) that the point or spot light 0 of `s` sends through the
 /// photon view of `f` into texels whose centre ray meets a specular surface
 /// first (CPU BVH): I * falloff * Omega_texel, as photons.comp emits it.

@@ -1,4 +1,4 @@
-//! Killed while writing (issue 18): `render` and `bench --json` interrupted
+//! Killed while writing (issue 18): `render`, `compare` and `bench --json` interrupted
 //! by SIGTERM or SIGINT at any moment leave either the complete output (the
 //! signal came after it was written) or nothing at the output names, and
 //! never a temporary; `reference` interrupted finishes the pass in flight
@@ -69,6 +69,24 @@ fn wait_for_file(dir: &Path, needle: &str, child: &mut Child) -> bool {
     false
 }
 
+/// Spawns `caustics ARGS` with a 2 s pause after each temporary it writes
+/// (the test hook) and returns once the first temporary is in `out`.
+fn spawn_until_writing<S: AsRef<std::ffi::OsStr>>(
+    args: impl IntoIterator<Item = S>,
+    out: &Path,
+) -> Child {
+    let mut child = caustics()
+        .args(args)
+        .env("CAUSTICS_TEST_WRITE_PAUSE_MS", "2000")
+        .spawn()
+        .expect("spawn");
+    assert!(
+        wait_for_file(out, ".partial", &mut child),
+        "no temporary seen"
+    );
+    child
+}
+
 /// Either the complete pair (exit 0) or nothing at all (exit 128 + signal,
 /// one line of error), and no temporary either way.
 fn assert_all_or_nothing(out: &Path, child: Child, signal_number: i32, wanted: &[&str]) {
@@ -105,6 +123,8 @@ fn moments(n: usize, max: Duration) -> Vec<Duration> {
 fn render_args(out: &Path) -> Vec<String> {
     [
         "render",
+        "--scene",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/ball_lens.toml"),
         "--technique",
         "direct",
         "--width",
@@ -126,15 +146,7 @@ fn render_args(out: &Path) -> Vec<String> {
 fn render_killed_while_writing_leaves_nothing() {
     for (sig, number) in [("TERM", 15), ("INT", 2)] {
         let out = temp_dir("writing").join("out");
-        let mut child = caustics()
-            .args(render_args(&out))
-            .env("CAUSTICS_TEST_WRITE_PAUSE_MS", "2000")
-            .spawn()
-            .expect("spawn");
-        assert!(
-            wait_for_file(&out, ".partial", &mut child),
-            "no temporary seen"
-        );
+        let child = spawn_until_writing(render_args(&out), &out);
         signal(&child, sig);
         let o = child.wait_with_output().expect("wait");
         let stderr = String::from_utf8_lossy(&o.stderr);
@@ -172,14 +184,46 @@ fn render_killed_at_random_moments_is_all_or_nothing() {
     }
 }
 
+/// `compare` writes each file to its temporary as soon as it is made
+/// (`output::Batch`); SIGTERM after the first of them leaves no file and no
+/// temporary in its folder.
+#[test]
+fn compare_killed_while_writing_leaves_nothing() {
+    let out = temp_dir("compare").join("out");
+    let child = spawn_until_writing(
+        [
+            "compare",
+            "--scene",
+            concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/ball_lens.toml"),
+            "--techniques",
+            "direct",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--photons",
+            "262144",
+            "--frames",
+            "1",
+            "--no-cache",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &out,
+    );
+    signal(&child, "TERM");
+    // It pauses 2 s after each of its dozens of files: the signal lands.
+    assert_all_or_nothing(&out, child, 15, &[]);
+}
+
 /// `bench --json` interrupted while the JSON is written leaves no JSON and
 /// no temporary.
 #[test]
 fn bench_json_killed_while_writing_leaves_nothing() {
     let out = temp_dir("bench").join("out");
     let json = out.join("b.json");
-    let mut child = caustics()
-        .args([
+    let child = spawn_until_writing(
+        [
             "bench",
             "--technique",
             "direct",
@@ -192,14 +236,9 @@ fn bench_json_killed_while_writing_leaves_nothing() {
             "--warmup",
             "0",
             "--json",
-        ])
-        .arg(&json)
-        .env("CAUSTICS_TEST_WRITE_PAUSE_MS", "2000")
-        .spawn()
-        .expect("spawn");
-    assert!(
-        wait_for_file(&out, ".partial", &mut child),
-        "no temporary seen"
+            json.to_str().unwrap(),
+        ],
+        &out,
     );
     signal(&child, "TERM");
     assert_all_or_nothing(&out, child, 15, &["b.json"]);

@@ -85,6 +85,8 @@ fn manifest(rel: &str) -> PathBuf {
 #[test]
 fn every_canonical_scene_loads() {
     let names = [
+        "still_life",
+        "light_shaft",
         "ball_lens",
         "ring",
         "gemstone",
@@ -131,10 +133,33 @@ fn every_canonical_scene_loads() {
     }
 }
 
+/// The default scene is a showcase: tinted glass (absorption) on coloured
+/// surfaces under a spot light, at an exposure of its own.
 #[test]
-fn default_scene_is_the_ball_lens() {
-    assert_eq!(DEFAULT_SCENE, "assets/scenes/ball_lens.toml");
+fn default_scene_is_the_still_life_showcase() {
+    assert_eq!(DEFAULT_SCENE, "assets/scenes/still_life.toml");
     let scene = Scene::load(&manifest(DEFAULT_SCENE)).expect("default scene");
+    let tinted = scene
+        .materials
+        .iter()
+        .filter(|m| m.kind == MaterialKind::Dielectric && m.absorption.max_element() > 0.0)
+        .count();
+    assert_eq!(tinted, 2, "two tinted glasses");
+    let coloured = scene
+        .materials
+        .iter()
+        .filter(|m| {
+            m.kind == MaterialKind::Diffuse && m.color.max_element() > 1.4 * m.color.min_element()
+        })
+        .count();
+    assert_eq!(coloured, 2, "a coloured floor and wall");
+    assert_eq!(scene.lights[0].kind, LightKind::Spot);
+    assert_ne!(scene.output.exposure, 1.0);
+}
+
+#[test]
+fn ball_lens_contents() {
+    let scene = Scene::load(&manifest("assets/scenes/ball_lens.toml")).expect("ball_lens");
     let glass = scene.material_index("glass").expect("glass") as usize;
     assert_eq!(scene.materials[glass].kind, MaterialKind::Dielectric);
     assert_eq!(scene.materials[glass].ior, 1.5);

@@ -3,10 +3,14 @@
 //! half-runs, whose difference is its own noise), taken from the cache, or
 //! read from `--reference`; each technique renders its full frame and each
 //! of its components, timed over `--frames`; the metrics are the tests'
-//! (`caustics::compare::metrics`). Every file is kept in memory until the
-//! end and then written by `output::write_files` (temporaries renamed
-//! together, removed on SIGINT/SIGTERM), report.json last, so a failed or
-//! interrupted run leaves none of its files.
+//! (`caustics::compare::metrics`). Each file is written as soon as it is
+//! made, to a temporary renamed into place with all the others at the end
+//! (`output::Batch`; removed on SIGINT/SIGTERM or an error), report.json
+//! last, so a failed or interrupted run leaves none of its files. What
+//! stays in memory is what the rest of the run needs: the reference and
+//! its components (every technique is measured against them), the contact
+//! sheet's thumbnails (`sheet::thumbnail`) and the numbers; a technique's
+//! images are dropped once written and measured.
 
 use super::reference::trace_reference;
 use super::{check_size, check_validation, context, load_scene, CompareArgs};
@@ -19,7 +23,7 @@ use caustics::compare::report::{
 use caustics::compare::sheet::{self, Tile};
 use caustics::compare::{cache_key, ReferenceKey};
 use caustics::output;
-use caustics::output::OutputFile;
+use caustics::output::{Batch, OutputFile};
 use caustics::params::Params;
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use caustics::renderer::Renderer;
@@ -90,7 +94,7 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
     let mut staging = Outputs::new(&args.out);
     let ctx = context(&args.device)?;
 
-    let reference = match from_file {
+    let mut reference = match from_file {
         Some(all) => ReferenceImages {
             all,
             components: Vec::new(),
@@ -118,27 +122,24 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
         )?;
     }
     let mut info = reference.info.clone();
-    let mut noise_map = None;
-    if let Some(half) = &reference.first_half {
-        let second = metrics::second_half(&reference.all, half);
-        let (m, map) = metrics::compare(&second, half, width, height, exposure);
-        info.noise = Some(m);
+    let mut tiles = vec![vec![Tile {
+        rgb: thumbnail_of(&reference.all, width, height, exposure),
+        lines: vec!["reference".into(), format!("{} photons", info.photons)],
+    }]];
+    // The first half-run is needed for the noise only.
+    if let Some(half) = reference.first_half.take() {
+        let second = metrics::second_half(&reference.all, &half);
+        let (m, map) = metrics::compare(&second, &half, width, height, exposure);
         staging.write_map("reference_noise_flip", &map)?;
-        noise_map = Some(map);
+        tiles[0].push(Tile {
+            rgb: sheet::thumbnail(map.magma_rgb8(), width, height),
+            lines: vec!["its noise".into(), format!("FLIP {:.4}", m.flip)],
+        });
+        info.noise = Some(m);
     }
 
     let mut results = Vec::new();
     let mut skipped = Vec::new();
-    let mut tiles = vec![vec![Tile {
-        rgb: metrics::rgb8(&metrics::tonemap(&reference.all, exposure)),
-        lines: vec!["reference".into(), format!("{} photons", info.photons)],
-    }]];
-    if let (Some(map), Some(n)) = (&noise_map, &info.noise) {
-        tiles[0].push(Tile {
-            rgb: map.magma_rgb8(),
-            lines: vec!["its noise".into(), format!("FLIP {:.4}", n.flip)],
-        });
-    }
     let bar = indicatif::ProgressBar::new(names.len() as u64).with_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} techniques {msg}")
             .context("progress style")?,
@@ -155,7 +156,7 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
             &mut staging,
             &mut timing_source,
         )? {
-            Ok((result, image, map)) => {
+            Ok((result, [image, map])) => {
                 let label = vec![
                     name.to_string(),
                     format!("FLIP {:.4}", result.full.flip),
@@ -164,11 +165,11 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
                 ];
                 tiles.push(vec![
                     Tile {
-                        rgb: metrics::rgb8(&metrics::tonemap(&image, exposure)),
+                        rgb: image,
                         lines: label,
                     },
                     Tile {
-                        rgb: map.magma_rgb8(),
+                        rgb: map,
                         lines: vec![format!("{name} error")],
                     },
                 ]);
@@ -182,8 +183,9 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
         bar.inc(1);
     }
     bar.finish_and_clear();
-    let contact = sheet::compose(&tiles, width, height);
-    staging.write_rgb("contact_sheet", contact.width, contact.height, &contact.rgb)?;
+    let (tile_w, tile_h) = sheet::tile_size(width, height);
+    let contact = sheet::compose(&tiles, tile_w, tile_h);
+    staging.write_rgb("contact_sheet", contact.width, contact.height, contact.rgb)?;
 
     let report = CompareReport {
         run: RunInfo {
@@ -385,8 +387,19 @@ fn write_cache(
     Ok(())
 }
 
-/// One technique's renders and metrics; `Ok(Err(reason))` when it does
-/// not apply to the scene (its constructor refused it).
+/// The contact sheet's thumbnail of a radiance image.
+fn thumbnail_of(rgba: &[f32], width: u32, height: u32, exposure: f32) -> Vec<u8> {
+    sheet::thumbnail(
+        metrics::rgb8(&metrics::tonemap(rgba, exposure)),
+        width,
+        height,
+    )
+}
+
+/// One technique's metrics and the sheet's thumbnails of its full frame
+/// and of its FLIP map, its images written to `staging` as they are made;
+/// `Ok(Err(reason))` when it does not apply to the scene (its constructor
+/// refused it).
 #[allow(clippy::type_complexity)]
 fn run_technique(
     ctx: &Arc<Context>,
@@ -396,7 +409,7 @@ fn run_technique(
     reference: &ReferenceImages,
     staging: &mut Outputs,
     timing_source: &mut Option<String>,
-) -> anyhow::Result<Result<(TechniqueResult, Vec<f32>, FlipMap), String>> {
+) -> anyhow::Result<Result<(TechniqueResult, [Vec<u8>; 2]), String>> {
     let (width, height, time) = (args.scene.width, args.scene.height, args.scene.time);
     let exposure = scene.output.exposure;
     let info = techniques::find(name)?;
@@ -427,6 +440,11 @@ fn run_technique(
     let (full, map) = metrics::compare(&image, &reference.all, width, height, exposure);
     staging.write_pair(name, width, height, &image, exposure)?;
     staging.write_map(&format!("{name}_flip"), &map)?;
+    let thumbnails = [
+        thumbnail_of(&image, width, height, exposure),
+        sheet::thumbnail(map.magma_rgb8(), width, height),
+    ];
+    drop((image, map));
     let mut components = Vec::new();
     for &c in info.components {
         r.scene_gpu.components = c.mask();
@@ -457,34 +475,28 @@ fn run_technique(
         full,
         components,
     };
-    Ok(Ok((result, image, map)))
+    Ok(Ok((result, thumbnails)))
 }
 
-/// One file's content, held until `Outputs::commit`.
-enum Content {
-    Exr(u32, u32, Vec<f32>),
-    Png(u32, u32, Vec<u8>),
-    Rgb(u32, u32, Vec<u8>),
-    Text(String),
-}
-
-/// Every file of the comparison, in memory until `commit` writes them all
-/// at once (`output::write_files`: all of them or none).
+/// Every file of the comparison, each written to its temporary when it is
+/// made and renamed into place with the others by `commit` (all of them or
+/// none appear).
 struct Outputs {
     out: PathBuf,
-    files: Vec<(PathBuf, Content)>,
+    batch: Batch,
 }
 
 impl Outputs {
     fn new(out: &Path) -> Outputs {
         Outputs {
             out: out.to_path_buf(),
-            files: Vec::new(),
+            batch: Batch::default(),
         }
     }
 
-    fn add(&mut self, name: String, content: Content) {
-        self.files.push((self.out.join(name), content));
+    fn add(&mut self, name: String, write: output::WriteBytes) -> anyhow::Result<()> {
+        let path = self.out.join(name);
+        self.batch.write(OutputFile { path: &path, write })
     }
 
     /// `<stem>.exr` (linear radiance) and `<stem>.png` (display transform).
@@ -499,55 +511,42 @@ impl Outputs {
         if rgba.iter().any(|v| !v.is_finite()) {
             anyhow::bail!("{stem}: the radiance contains NaN or Inf; nothing written");
         }
-        self.add(format!("{stem}.exr"), Content::Exr(w, h, rgba.to_vec()));
-        self.add(
-            format!("{stem}.png"),
-            Content::Png(w, h, metrics::tonemap(rgba, exposure)),
-        );
-        Ok(())
+        let exr = self.out.join(format!("{stem}.exr"));
+        self.batch.write(output::exr_file(&exr, w, h, rgba))?;
+        let png = self.out.join(format!("{stem}.png"));
+        let display = metrics::tonemap(rgba, exposure);
+        self.batch.write(output::png_file(&png, w, h, &display))
     }
 
     /// A FLIP map through the magma colour map, `<stem>.png`.
     fn write_map(&mut self, stem: &str, map: &FlipMap) -> anyhow::Result<()> {
-        self.write_rgb(stem, map.width, map.height, &map.magma_rgb8())
+        self.write_rgb(stem, map.width, map.height, map.magma_rgb8())
     }
 
-    fn write_rgb(&mut self, stem: &str, w: u32, h: u32, rgb: &[u8]) -> anyhow::Result<()> {
-        self.add(format!("{stem}.png"), Content::Rgb(w, h, rgb.to_vec()));
-        Ok(())
+    fn write_rgb(&mut self, stem: &str, w: u32, h: u32, rgb: Vec<u8>) -> anyhow::Result<()> {
+        self.add(
+            format!("{stem}.png"),
+            Box::new(move |out| {
+                let image = image::RgbImage::from_raw(w, h, rgb)
+                    .ok_or_else(|| anyhow::anyhow!("image buffer has the wrong size"))?;
+                Ok(image.write_to(out, image::ImageFormat::Png)?)
+            }),
+        )
     }
 
     fn write_text(&mut self, name: &str, text: &str) -> anyhow::Result<()> {
-        self.add(name.to_owned(), Content::Text(text.to_owned()));
-        Ok(())
+        let text = text.to_owned();
+        self.add(
+            name.to_owned(),
+            Box::new(move |out| Ok(out.write_all(text.as_bytes())?)),
+        )
     }
 
-    /// Writes every file, report.json last; returns how many.
-    fn commit(mut self) -> anyhow::Result<usize> {
-        self.files
-            .sort_by_key(|(p, _)| p.file_name().is_some_and(|n| n == "report.json"));
-        let files: Vec<OutputFile> = self
-            .files
-            .iter()
-            .map(|(path, content)| match content {
-                Content::Exr(w, h, rgba) => output::exr_file(path, *w, *h, rgba),
-                Content::Png(w, h, rgba8) => output::png_file(path, *w, *h, rgba8),
-                Content::Rgb(w, h, rgb) => OutputFile {
-                    path,
-                    write: Box::new(move |out| {
-                        let image = image::RgbImage::from_raw(*w, *h, rgb.clone())
-                            .ok_or_else(|| anyhow::anyhow!("image buffer has the wrong size"))?;
-                        Ok(image.write_to(out, image::ImageFormat::Png)?)
-                    }),
-                },
-                Content::Text(text) => OutputFile {
-                    path,
-                    write: Box::new(move |out| Ok(out.write_all(text.as_bytes())?)),
-                },
-            })
-            .collect();
-        let n = files.len();
-        output::write_files(files)?;
+    /// Renames every file into place, report.json (written last) last;
+    /// returns how many.
+    fn commit(self) -> anyhow::Result<usize> {
+        let n = self.batch.len();
+        self.batch.commit()?;
         Ok(n)
     }
 }

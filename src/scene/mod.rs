@@ -29,8 +29,11 @@ use glam::{Mat3, Mat4, Quat, Vec3};
 use std::borrow::Cow;
 use std::path::Path;
 
-/// The scene the CLI and demo open when none is given.
-pub const DEFAULT_SCENE: &str = "assets/scenes/ball_lens.toml";
+/// The scene the CLI and demo open when none is given: a showcase of
+/// surface caustics (tinted glass on coloured surfaces under a spot light).
+/// The physics scenes (ball_lens, ring, ...) are named by the tests that
+/// use them.
+pub const DEFAULT_SCENE: &str = "assets/scenes/still_life.toml";
 
 impl Scene {
     /// Reads and validates a scene file. Relative paths inside it (OBJ meshes,
