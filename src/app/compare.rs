@@ -118,6 +118,7 @@ pub(super) struct Compare {
 }
 
 /// What the overlay reads of the compare panel.
+#[cfg_attr(not(feature = "overlay"), allow(dead_code))]
 pub struct CompareStatus<'a> {
     pub view: View,
     /// None without a snapshot.
