@@ -3,6 +3,7 @@
 //! on. It must exit 0 with no validation error and no leak. Without Xvfb the
 //! test fails (scripts/setup.sh installs it); it never passes silently.
 
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -30,7 +31,10 @@ fn find_in_path(name: &str) -> Option<std::path::PathBuf> {
         .find(|p| p.is_file())
 }
 
-/// Starts Xvfb on the first display number whose socket and lock are free.
+/// Starts Xvfb on a display number it picks itself (`-displayfd`: the
+/// server takes the first free number under its own lock and writes it to
+/// our pipe once it accepts clients), so that tests running at once, in
+/// this process or others, never share or race for a display.
 fn start_xvfb() -> Xvfb {
     let xvfb = find_in_path("Xvfb").unwrap_or_else(|| {
         panic!(
@@ -38,46 +42,33 @@ fn start_xvfb() -> Xvfb {
              Run scripts/setup.sh (or `apt-get install xvfb xauth`)."
         )
     });
-    let first = 100 + std::process::id() % 400;
-    for n in first..first + 50 {
-        let socket = format!("/tmp/.X11-unix/X{n}");
-        let lock = format!("/tmp/.X{n}-lock");
-        if Path::new(&socket).exists() || Path::new(&lock).exists() {
-            continue;
+    let mut child = Command::new(&xvfb)
+        .args([
+            "-displayfd",
+            "1",
+            "-screen",
+            "0",
+            "800x600x24",
+            "-nolisten",
+            "tcp",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("spawn Xvfb");
+    let mut line = String::new();
+    let read = BufReader::new(child.stdout.take().expect("Xvfb stdout")).read_line(&mut line);
+    match line.trim().parse::<u32>() {
+        Ok(n) if read.is_ok() => Xvfb {
+            child,
+            display: format!(":{n}"),
+        },
+        _ => {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("Xvfb did not report a display number ({read:?}, {line:?})");
         }
-        let mut child = Command::new(&xvfb)
-            .args([
-                &format!(":{n}"),
-                "-screen",
-                "0",
-                "800x600x24",
-                "-nolisten",
-                "tcp",
-            ])
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("spawn Xvfb");
-        let start = Instant::now();
-        while start.elapsed() < Duration::from_secs(10) {
-            if Path::new(&socket).exists() {
-                return Xvfb {
-                    child,
-                    display: format!(":{n}"),
-                };
-            }
-            if child.try_wait().ok().flatten().is_some() {
-                break; // lost a race for this display number: try the next
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        }
-        let _ = child.kill();
-        let _ = child.wait();
     }
-    panic!(
-        "could not start Xvfb on any display :{first}..:{}",
-        first + 50
-    );
 }
 
 /// What a finished demo run left: exit status, stdout, stderr, and the

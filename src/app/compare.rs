@@ -126,6 +126,8 @@ pub struct CompareStatus<'a> {
     pub photons: u64,
     pub flip_mean: Option<f32>,
     pub size: (u32, u32),
+    /// The component the reference resolves (`Component::name`).
+    pub component: &'static str,
     /// The image of `view` (RGBA8, `size`), None for the live view.
     pub image: Option<(&'a [u8], u64)>,
 }
@@ -242,6 +244,7 @@ impl Compare {
             photons: s.map_or(0, |s| s.reference.reference.photons),
             flip_mean: s.and_then(|s| s.flip_mean),
             size: s.map_or((0, 0), |s| s.key.size),
+            component: s.map_or("all", |s| s.component.name()),
             image,
         }
     }

@@ -475,9 +475,10 @@ mod enabled {
             }
             Some(passes) => {
                 ui.label(format!(
-                    "reference {}x{}: {passes} passes, {:.2} M photons",
+                    "reference {}x{} ({}): {passes} passes, {:.2} M photons",
                     c.size.0,
                     c.size.1,
+                    c.component,
                     c.photons as f64 / 1e6
                 ));
                 ui.label(match c.flip_mean {
