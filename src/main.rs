@@ -86,6 +86,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             frames,
             exit,
             resize_test,
+            compare_test,
             frames_in_flight,
             device,
         }) => {
@@ -112,6 +113,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             if frames == Some(0) {
                 anyhow::bail!("--frames must be at least 1");
             }
+            if compare_test == Some(0) {
+                anyhow::bail!("--compare-test must be at least 1");
+            }
             caustics::app::run(caustics::app::DemoOptions {
                 scene,
                 technique,
@@ -126,6 +130,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 validate: device.validate,
                 validate_sync: device.validate_sync,
                 device: device.device,
+                compare_test,
             })
         }
         Command::Info => cli::info::info(),

@@ -69,10 +69,13 @@ impl State {
     pub(super) fn set_environment_rotation(&mut self, rotate_deg: f32) {
         let start = std::time::Instant::now();
         match self.renderer.set_environment_rotation(rotate_deg) {
-            Ok(()) => println!(
-                "environment rotate = {rotate_deg:.1} degrees ({:.1} ms)",
-                start.elapsed().as_secs_f64() * 1e3
-            ),
+            Ok(()) => {
+                self.scene_edits += 1;
+                println!(
+                    "environment rotate = {rotate_deg:.1} degrees ({:.1} ms)",
+                    start.elapsed().as_secs_f64() * 1e3
+                )
+            }
             Err(e) => eprintln!("environment rotation: {e:#}"),
         }
     }
@@ -106,6 +109,7 @@ impl State {
                 match self.renderer.set_scene(scene, self.time) {
                     Ok(()) => {
                         self.camera = camera;
+                        self.scene_edits += 1;
                         println!("reloaded {}", path.display());
                     }
                     Err(e) => eprintln!("reload: {e:#} (keeping the old scene)"),

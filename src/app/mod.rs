@@ -16,6 +16,7 @@
 //!    while the GPU runs this one.
 
 mod camera;
+mod compare;
 mod controls;
 mod overlay;
 mod slots;
@@ -64,6 +65,9 @@ pub struct DemoOptions {
     /// Synchronization validation too (implies `validate`).
     pub validate_sync: bool,
     pub device: Option<String>,
+    /// `--compare-test N`: a scripted compare snapshot of N reference
+    /// passes that switches the three views (tests).
+    pub compare_test: Option<u32>,
 }
 
 pub fn parse_present_mode(s: &str) -> anyhow::Result<vk::PresentModeKHR> {
@@ -232,6 +236,9 @@ impl App {
             waited_from: Duration::ZERO,
             swapchain_wait: Duration::ZERO,
             screenshots: 0,
+            compare: compare::Compare::new(),
+            scene_edits: 0,
+            compare_script: o.compare_test,
         };
         state.recreate(o.present_mode)?;
         println!(

@@ -10,6 +10,7 @@
 //! once per submitted frame, so a buffer is rewritten only after the fence
 //! of the frame that last read it has been waited for.
 
+pub use super::compare::{CompareStatus, View};
 use crate::params::Params;
 use crate::radiometry::Component;
 use crate::vk::{Context, PassTiming};
@@ -35,6 +36,8 @@ pub struct UiData<'a> {
     pub light_intensities: Vec<[f32; 3]>,
     /// The environment's `rotate` (degrees about +y), if there is one.
     pub environment_rotate: Option<f32>,
+    /// The compare panel's snapshot and chosen view.
+    pub compare: CompareStatus<'a>,
 }
 
 /// The medium coefficients the overlay edits.
@@ -60,6 +63,11 @@ pub enum Action {
     },
     /// The environment's new `rotate` (degrees about +y).
     EnvironmentRotation(f32),
+    /// Take a reference snapshot of the current view.
+    CompareStart,
+    CompareDiscard,
+    /// Show the live frame, the reference or the FLIP map.
+    CompareView(View),
 }
 
 #[cfg(not(feature = "overlay"))]
@@ -117,6 +125,8 @@ mod enabled {
         /// Slider edits not yet applied (applied when the mouse is released,
         /// since a technique rebuild compiles pipelines).
         pending: Option<Params>,
+        /// The compare view's image and the snapshot generation it holds.
+        compare_texture: Option<(egui::TextureHandle, u64)>,
     }
 
     impl Overlay {
@@ -177,6 +187,7 @@ mod enabled {
                 pixels_per_point: 1.0,
                 to_free: Vec::new(),
                 pending: None,
+                compare_texture: None,
             })
         }
 
@@ -226,7 +237,9 @@ mod enabled {
             let mut actions = Vec::new();
             let raw = self.winit.take_egui_input(window);
             let pending = &mut self.pending;
+            let texture = &mut self.compare_texture;
             let mut output = self.egui.run_ui(raw, |ui| {
+                compare_view(ui.ctx(), &data.compare, texture);
                 panel(ui.ctx(), data, &mut actions, pending);
             });
             if let Some(p) = self.pending.take() {
@@ -329,6 +342,7 @@ mod enabled {
                 medium(ui, data, actions);
                 light_intensities(ui, data, actions);
                 environment_rotation(ui, data, actions);
+                compare_panel(ui, &data.compare, actions);
                 ui.separator();
                 egui::Grid::new("timings").striped(true).show(ui, |ui| {
                     let mut total = 0.0;
@@ -434,6 +448,98 @@ mod enabled {
         if deg != old {
             actions.push(Action::EnvironmentRotation(deg));
         }
+    }
+
+    /// The compare panel: snapshot, its progress and FLIP mean, the view.
+    fn compare_panel(ui: &mut egui::Ui, c: &CompareStatus, actions: &mut Vec<Action>) {
+        ui.separator();
+        ui.horizontal(|ui| {
+            ui.strong("compare");
+            if ui
+                .button("snapshot")
+                .on_hover_text(
+                    "trace a reference of this view (scene, time, camera) at the window's size; \
+                     pauses the animation",
+                )
+                .clicked()
+            {
+                actions.push(Action::CompareStart);
+            }
+            if c.passes.is_some() && ui.button("discard").clicked() {
+                actions.push(Action::CompareDiscard);
+            }
+        });
+        match c.passes {
+            None => {
+                ui.label("no snapshot");
+            }
+            Some(passes) => {
+                ui.label(format!(
+                    "reference {}x{} ({}): {passes} passes, {:.2} M photons",
+                    c.size.0,
+                    c.size.1,
+                    c.component,
+                    c.photons as f64 / 1e6
+                ));
+                ui.label(match c.flip_mean {
+                    Some(f) => format!("FLIP mean (live vs reference): {f:.4}"),
+                    None => "FLIP mean: after the first pass".to_owned(),
+                });
+            }
+        }
+        ui.horizontal(|ui| {
+            let mut view = c.view;
+            for v in View::ALL {
+                ui.radio_value(&mut view, v, v.name());
+            }
+            if view != c.view {
+                actions.push(Action::CompareView(view));
+            }
+        });
+        ui.small(
+            "One reference pass runs per live frame: on lavapipe (CPU Vulkan) the live \
+             frame rate drops while it runs. Moving the camera, time, technique, \
+             parameters, components, window size or scene discards the snapshot.",
+        );
+    }
+
+    /// The reference or FLIP map over the whole window, under the panel
+    /// (the live view draws nothing here). The texture is re-uploaded when
+    /// the snapshot's images change.
+    fn compare_view(
+        ctx: &egui::Context,
+        c: &CompareStatus,
+        texture: &mut Option<(egui::TextureHandle, u64)>,
+    ) {
+        let Some((rgba, generation)) = c.image else {
+            return;
+        };
+        let key = generation * 3 + c.view as u64;
+        let image = || {
+            let size = [c.size.0 as usize, c.size.1 as usize];
+            egui::ColorImage::from_rgba_unmultiplied(size, rgba)
+        };
+        match texture {
+            Some((_, shown)) if *shown == key => {}
+            Some((handle, shown)) => {
+                handle.set(image(), egui::TextureOptions::NEAREST);
+                *shown = key;
+            }
+            None => {
+                let handle = ctx.load_texture("compare", image(), egui::TextureOptions::NEAREST);
+                *texture = Some((handle, key));
+            }
+        }
+        let Some((handle, _)) = texture.as_ref() else {
+            return;
+        };
+        let painter = ctx.layer_painter(egui::LayerId::background());
+        painter.image(
+            handle.id(),
+            ctx.content_rect(),
+            egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
+            egui::Color32::WHITE,
+        );
     }
 
     /// Frame intervals as a polyline, scaled to the largest recent one.

@@ -2,6 +2,7 @@
 //! blit, overlay, present, and the once-a-second report.
 
 use super::camera::OrbitCamera;
+use super::compare::{Compare, View, ViewKey};
 use super::overlay::{Action, MediumValues, Overlay, UiData};
 use super::slots::ImageSemaphores;
 use crate::renderer::Renderer;
@@ -63,6 +64,14 @@ pub(super) struct State {
     /// the frame's rendering).
     pub(super) swapchain_wait: Duration,
     pub(super) screenshots: u32,
+    /// The compare panel: reference snapshot and the view shown.
+    pub(super) compare: Compare,
+    /// Counts scene edits (lights, medium, environment, reload): a change
+    /// discards the compare snapshot.
+    pub(super) scene_edits: u64,
+    /// `--compare-test N`: a scripted snapshot of N reference passes that
+    /// switches the three views (tests); None for interactive runs.
+    pub(super) compare_script: Option<u32>,
 }
 
 impl State {
@@ -153,12 +162,19 @@ impl State {
             self.lights_changed = false;
             // Waits for the frames in flight, which read the lights.
             self.renderer.lights_changed(self.time)?;
+            self.scene_edits += 1;
         }
         if self.medium_changed {
             self.medium_changed = false;
             self.renderer.medium_changed()?;
+            self.scene_edits += 1;
         }
         self.renderer.scene.camera = self.camera.camera();
+        // The last submitted frame showed this view if nothing changed
+        // since the snapshot: trace a pass and compare.
+        let key = ViewKey::of(&self.renderer, self.time, self.scene_edits);
+        self.compare.step(&self.renderer, &key)?;
+        let mut scripted = self.script_compare();
 
         let ctx = self.ctx().clone();
         if self.overlay.is_none() {
@@ -195,9 +211,11 @@ impl State {
                     .environment
                     .as_ref()
                     .map(|e| e.rotate_deg),
+                compare: self.compare.status(),
             },
         )?;
-        for action in actions {
+        scripted.extend(actions);
+        for action in scripted {
             match action {
                 Action::Technique(name) => self.switch_technique_named(name)?,
                 Action::Components(mask) => self.renderer.scene_gpu.components = mask,
@@ -216,6 +234,22 @@ impl State {
                     }
                 }
                 Action::EnvironmentRotation(deg) => self.set_environment_rotation(deg),
+                Action::CompareStart => {
+                    // The snapshot holds one instant: stop the clock.
+                    self.paused = true;
+                    // The reference uploads its scene with `Buffer::upload`,
+                    // which needs no frame in flight: wait for them once.
+                    for done in self.renderer.finish()? {
+                        self.timings.push(done.passes);
+                    }
+                    // A reference the device cannot make (too large an
+                    // image) is reported; the demo goes on.
+                    if let Err(e) = self.compare.start(&ctx, &self.renderer, key.clone()) {
+                        eprintln!("compare: no snapshot: {e:#}");
+                    }
+                }
+                Action::CompareDiscard => self.compare.discard("by the user"),
+                Action::CompareView(view) => self.compare.set_view(view),
                 Action::Params(params) => {
                     // No wait: a rebuilt technique's predecessor is released
                     // after the frames in flight that use it.
@@ -305,6 +339,24 @@ impl State {
             self.report();
         }
         Ok(true)
+    }
+
+    /// `--compare-test N`: starts a snapshot on the third frame, switches
+    /// to the next view (live, reference, FLIP) after each reference pass
+    /// and stops tracing after N passes.
+    fn script_compare(&mut self) -> Vec<Action> {
+        let Some(n) = self.compare_script else {
+            return Vec::new();
+        };
+        match self.compare.snapshot.as_ref().map(|s| s.passes()) {
+            None if self.presented == 2 => vec![Action::CompareStart],
+            Some(p) if p >= n as u64 => {
+                self.compare_script = None;
+                vec![Action::CompareView(View::Live), Action::CompareDiscard]
+            }
+            Some(p) if p > 0 => vec![Action::CompareView(View::ALL[p as usize % 3])],
+            _ => Vec::new(),
+        }
     }
 
     /// Once a second: per-pass means on stdout (the same scope names as

@@ -263,6 +263,11 @@ pub struct DemoArgs {
     /// Resize the window every few frames while running (tests).
     #[arg(long)]
     pub resize_test: bool,
+    /// Take a compare snapshot on the third frame, trace N reference passes
+    /// beside the live frames while switching live, reference and FLIP
+    /// views, then discard it (tests).
+    #[arg(long, value_name = "N")]
+    pub compare_test: Option<u32>,
     /// Frames the GPU may still be running while the host records the next (1 to 4).
     #[arg(long, allow_negative_numbers = true, default_value_t = 2)]
     pub frames_in_flight: usize,
