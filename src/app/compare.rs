@@ -211,7 +211,7 @@ impl Compare {
         let exposure = renderer.scene.output.exposure;
         let (m, map) = metrics::compare(&live, &reference, w, h, exposure);
         s.reference_rgba = metrics::tonemap(&reference, exposure);
-        s.flip_rgba = rgba(&map.magma_rgb8());
+        s.flip_rgba = metrics::rgba8(&map.magma_rgb8());
         s.flip_mean = Some(m.flip);
         s.generation += 1;
         println!(
@@ -248,11 +248,4 @@ impl Compare {
             image,
         }
     }
-}
-
-/// RGBA8 (opaque) from RGB8.
-fn rgba(rgb: &[u8]) -> Vec<u8> {
-    rgb.chunks(3)
-        .flat_map(|p| [p[0], p[1], p[2], 255])
-        .collect()
 }

@@ -32,6 +32,13 @@ pub fn rgb8(rgba: &[u8]) -> Vec<u8> {
     rgba.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect()
 }
 
+/// Opaque RGBA8 from RGB8.
+pub fn rgba8(rgb: &[u8]) -> Vec<u8> {
+    rgb.chunks(3)
+        .flat_map(|p| [p[0], p[1], p[2], 255])
+        .collect()
+}
+
 /// A FLIP error map: one value in [0, 1] per pixel.
 pub struct FlipMap {
     pub width: u32,

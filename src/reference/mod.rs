@@ -89,7 +89,7 @@ pub fn specular_sphere(scene: &crate::scene::Scene, time: f32) -> Option<(glam::
     let mut hi = glam::Vec3::splat(f32::NEG_INFINITY);
     for t in scene.triangles(time) {
         let m = &scene.materials[t.material as usize];
-        if m.kind != MaterialKind::Diffuse || m.specular != glam::Vec3::ZERO {
+        if m.kind != MaterialKind::Diffuse || m.is_mixed() {
             for p in t.positions {
                 lo = lo.min(p);
                 hi = hi.max(p);

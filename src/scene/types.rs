@@ -101,6 +101,13 @@ pub struct Material {
     pub specular: Vec3,
 }
 
+impl Material {
+    /// A `mixed` material: diffuse with a mirror part (`specular` > 0).
+    pub fn is_mixed(&self) -> bool {
+        self.kind == MaterialKind::Diffuse && self.specular.max_element() > 0.0
+    }
+}
+
 /// An environment light: radiance arriving from every direction at
 /// infinity (docs/SCENES.md, "Environment light").
 #[derive(Clone, Debug, PartialEq)]

@@ -217,11 +217,7 @@ fn used_materials(scene: &Scene) -> impl Iterator<Item = (usize, &crate::scene::
 /// Whether an object uses a `mixed` material (a diffuse surface with a
 /// mirror part, `Material::specular`).
 pub fn has_mixed(scene: &Scene) -> bool {
-    used_materials(scene).any(|(_, m)| is_mixed(m))
-}
-
-fn is_mixed(m: &crate::scene::Material) -> bool {
-    m.kind == crate::scene::MaterialKind::Diffuse && m.specular.max_element() > 0.0
+    used_materials(scene).any(|(_, m)| m.is_mixed())
 }
 
 /// Refuses, naming the first one, a `mixed` material: its mirror part
@@ -231,7 +227,7 @@ fn is_mixed(m: &crate::scene::Material) -> bool {
 /// renders both parts, the reference exactly; `direct` draws no specular
 /// light at all.
 pub fn check_no_mixed(scene: &Scene, technique: &str) -> anyhow::Result<()> {
-    if let Some((_, m)) = used_materials(scene).find(|(_, m)| is_mixed(m)) {
+    if let Some((_, m)) = used_materials(scene).find(|(_, m)| m.is_mixed()) {
         anyhow::bail!(
             "{}: material `{}`: {technique} does not render the mirror part of a mixed material (kind = \"mixed\"); use `pinhole` or `reference`",
             scene.source.display(),
