@@ -23,8 +23,9 @@
 //!    arguments a one-thread pass (args.comp) writes from the counters.
 //!    Final triangles become beams (Sects. 4.3, 6): the base at the first
 //!    specular interaction, edges by reflection and by two-sided
-//!    refraction (Wyman's, through the back faces of the light's
-//!    G-buffer, or exactly through the BVH: `refraction`), Fresnel splitting the flux; flux from the light's
+//!    refraction (exactly through the BVH by default, or Wyman's
+//!    image-space exit through the back faces of the light's G-buffer:
+//!    `refraction`), Fresnel splitting the flux; flux from the light's
 //!    radiometry (point: I times the exact solid angle of the base
 //!    triangle; spot: the integral of I over it; directional: E times the
 //!    projected area), times Fresnel and Beer-Lambert absorption and the
@@ -146,8 +147,8 @@ crate::declare_params! {
             "bounding volumes (Sect. 4.3): 0 Ernst's prism, 1 the tight six-triangle hull (prism where it is not convex)";
         quadrature: u32 [1, 4] = 3, rebuild,
             "Gauss-Legendre points per interval of a camera ray inside a beam (Sect. 5)";
-        refraction: u32 [0, 1] = 0, rebuild,
-            "two-sided refraction (Sect. 6): 0 Wyman's image-space exit through the light view's back faces (the paper's approximate ray tracing), 1 exactly through the BVH (internal total reflections followed)";
+        refraction: u32 [0, 1] = 1, rebuild,
+            "two-sided refraction (Sect. 6): 1 exactly through the BVH (internal total reflections followed; the exact intersection the paper's distance impostor approximates), 0 Wyman's image-space exit through the light view's back faces (approximate: its false total internal reflection near a sphere's rim throws light out sideways)";
         bounces: u32 [1, 3] = 2, rebuild,
             "specular events per beam path (Sect. 6): a beam whose edge rays all meet a further specular object ends there and spawns its reflected / refracted beams, up to this many events (1: one event, edges pass further specular surfaces)";
         tir_remedy: u32 [0, 2] = 1, rebuild,
