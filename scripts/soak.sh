@@ -5,9 +5,13 @@
 # flight, with validation and synchronization validation on (any error
 # fails the run). `caustics bench --memory-samples SAMPLES` (10) samples the
 # host's RSS and gpu-allocator's live device memory evenly over the timed
-# frames (after WARMUP, 10, untimed); each must stay flat: max over min of the samples at most 1 + TOL
-# (0.01). Prints a table (BENCHMARKS.md, "Soak") with the RSS samples'
-# least-squares slope (a leak's trend; churn scatters around it); JSON in out/soak/.
+# frames (after WARMUP, 10, untimed); each must stay flat: max over min of
+# the samples at most 1 + TOL (0.01). Each RSS sample is memory in use: taken
+# with no frame in flight, after glibc's malloc_trim returned the arenas'
+# free pages (a leak is live memory, which neither frees; BENCHMARKS.md
+# "Soak"). Prints a table (BENCHMARKS.md, "Soak") with the RSS samples'
+# least-squares slope (a leak's trend; churn scatters around it) and, for
+# comparison only, the untrimmed RSS's max/min; JSON in out/soak/.
 #   scripts/soak.sh                    everything at the default counts
 #   DIRECT_FRAMES=2000 CAUSTICS_FRAMES=50 scripts/soak.sh direct image_space
 # BIN picks the binary (default target/release/caustics, built if missing).
@@ -49,8 +53,8 @@ params_of() {
     for x in $p; do printf -- '--param %s ' "$x"; done
 }
 
-echo "| technique | scene | frames | frame ms | host RSS first → last (max/min) | RSS trend | device memory first → last (max/min) | flat |"
-echo "|---|---|---|---|---|---|---|---|"
+echo "| technique | scene | frames | frame ms | host RSS first → last (max/min) | RSS trend | untrimmed RSS (max/min) | device memory first → last (max/min) | flat |"
+echo "|---|---|---|---|---|---|---|---|---|"
 failed=0
 for t in "${techniques[@]}"; do
     frames=$CAUSTICS_FRAMES
@@ -62,7 +66,7 @@ for t in "${techniques[@]}"; do
     if ! "$BIN" bench --technique "$t" --scene "$scene" --width "$SIZE" --height "$SIZE" \
         $(params_of "$t") --frames "$frames" --warmup "${WARMUP:-10}" --memory-samples "$SAMPLES" --validate-sync \
         --json "$json" >"$log" 2>&1; then
-        echo "| $t | $scene | $frames | failed: $(tail -n 1 "$log") | | | | no |"
+        echo "| $t | $scene | $frames | failed: $(tail -n 1 "$log") | | | | | no |"
         failed=1
         continue
     fi
@@ -76,6 +80,7 @@ def spread(key):
     v = [s[key] for s in m]
     return v[0], v[-1], max(v) / max(min(v), 1)
 rss = spread("host_rss")
+raw = spread("host_rss_untrimmed")
 dev = spread("device_allocated")
 flat = rss[2] <= 1 + tol and dev[2] <= 1 + tol
 # Least-squares slope of the RSS samples over their frames: a leak is a
@@ -87,6 +92,7 @@ den = sum((x - fm) ** 2 for x in f)
 slope = sum((x - fm) * (y - vm) for x, y in zip(f, v)) / den if den else 0.0
 print(f"| {technique} | {scene.split('/')[-1]} | {r['frames']} | {r['frame_ms']:.2f} | "
       f"{mib(rss[0])} → {mib(rss[1])} ({rss[2]:.4f}) | {slope / 1024:+.2f} KiB/frame | "
+      f"{mib(raw[0])} → {mib(raw[1])} ({raw[2]:.4f}) | "
       f"{mib(dev[0])} → {mib(dev[1])} ({dev[2]:.4f}) | {'yes' if flat else 'NO'} |")
 sys.exit(0 if flat else 1)
 EOF

@@ -1496,9 +1496,13 @@ fn a_thin_wall_lit_on_one_side_stays_dark_on_the_other() {
 
 /// 60 frames of `bench` at 32² on water_pool: the host RSS after frame 60
 /// is at most 16 MiB above the one after frame 10 (samples every 10
-/// frames). Measured: no trend, samples scattered by up to 9 MiB (validation
-/// layer and malloc; e.g. 166.1, 171.6, 167.4, 168.7 MiB), last minus first
-/// between -3.6 and +6.4 MiB in 4 runs (2026-12-02). With the cascade count
+/// frames; each taken between frames after glibc's malloc_trim, so memory
+/// in use). Measured: no trend; 165.19, 165.18, 165.16, 165.17, 166.78,
+/// 165.18 MiB (2026-12-02, debug build); up to 8 MiB swings inside
+/// lavapipe in the 500-frame soak (BENCHMARKS.md "Soak"), hence the
+/// margin. Before the trim the samples scattered by up to 9 MiB (malloc's
+/// retained pages), last minus first between -3.6 and +6.4 MiB in 4
+/// runs. With the cascade count
 /// and the splat mode read from the uniform block, lavapipe (Mesa 22.3)
 /// recompiled view.comp at every bind and kept each copy: +1.85 MB a frame,
 /// about 90 MiB over these 50 frames (BENCHMARKS.md "Soak",

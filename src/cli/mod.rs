@@ -194,7 +194,11 @@ pub struct BenchArgs {
     pub json: Option<PathBuf>,
     /// Sample host RSS and gpu-allocator's device memory this many times,
     /// evenly over the timed frames (printed, and in the JSON): a soak
-    /// test's leak check (scripts/soak.sh).
+    /// test's leak check (scripts/soak.sh). Each sample waits for the
+    /// frames in flight and, with glibc, returns the malloc heap's free
+    /// pages (malloc_trim) first, so the RSS is memory in use between
+    /// frames; the JSON keeps the untrimmed RSS too. The waits cost the
+    /// timings a little overlap (one drain per sample).
     #[arg(long, allow_negative_numbers = true, default_value_t = 0)]
     pub memory_samples: u32,
     #[command(flatten)]

@@ -15,7 +15,7 @@ use caustics::params::Params;
 use caustics::renderer::Renderer;
 use caustics::scene::Scene;
 use caustics::techniques;
-use caustics::vk::{bytes, host_rss, Context, FrameOptions, PassTiming};
+use caustics::vk::{bytes, host_rss, trim_host_heap, Context, FrameOptions, PassTiming};
 use std::collections::BTreeMap;
 use std::io::Write as _;
 use std::sync::Arc;
@@ -152,10 +152,23 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
         if n > 0
             && (u64::from(i) + 1) * n / u64::from(frames) > u64::from(i) * n / u64::from(frames)
         {
+            // Sampled with no frame in flight: the driver's per-frame
+            // working memory (lavapipe's command execution, llvmpipe's
+            // rasteriser bins) is freed again when the frame completes and
+            // is not what a leak check counts.
+            take(renderer.finish()?);
             let device = ctx.memory_report();
+            let rss = || host_rss().context("--memory-samples: no VmRSS in /proc/self/status");
+            // The untrimmed RSS moves by MiBs with the arenas' retained free
+            // pages (BENCHMARKS.md "Soak"); after the trim it is memory in
+            // use, which is what a leak makes grow.
+            let host_rss_untrimmed = rss()?;
+            let host_heap_trimmed = trim_host_heap();
             memory.push(MemorySample {
                 frame: i + 1,
-                host_rss: host_rss().context("--memory-samples: no VmRSS in /proc/self/status")?,
+                host_rss: rss()?,
+                host_rss_untrimmed,
+                host_heap_trimmed,
                 device_allocated: device.allocated,
                 device_allocations: device.allocations,
                 device_capacity: device.capacity,
@@ -210,9 +223,10 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
     );
     for m in &memory {
         println!(
-            "  memory after frame {:>7}: host RSS {:>10}, device {:>10} in {} allocations ({} in blocks)",
+            "  memory after frame {:>7}: host RSS {:>10} ({:>10} untrimmed), device {:>10} in {} allocations ({} in blocks)",
             m.frame,
             bytes(m.host_rss),
+            bytes(m.host_rss_untrimmed),
             bytes(m.device_allocated),
             m.device_allocations,
             bytes(m.device_capacity)

@@ -198,12 +198,20 @@ pub struct BenchReport {
     pub memory: Vec<MemorySample>,
 }
 
-/// Host and device memory after `frame` timed frames were submitted.
+/// Host and device memory after `frame` timed frames completed (none in
+/// flight).
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct MemorySample {
     pub frame: u32,
-    /// The process's resident set (VmRSS), bytes.
+    /// The process's resident set (VmRSS), bytes, after the malloc heap's
+    /// free pages were returned (`trim_host_heap`; glibc only): memory in
+    /// use, which a leak makes grow.
     pub host_rss: u64,
+    /// VmRSS just before that trim: with the pages the allocator keeps.
+    pub host_rss_untrimmed: u64,
+    /// Whether the trim ran (false where the C library is not glibc:
+    /// `host_rss` then equals `host_rss_untrimmed`, allocator cache and all).
+    pub host_heap_trimmed: bool,
     /// gpu-allocator's live allocations: bytes, count, and the bytes of
     /// its memory blocks.
     pub device_allocated: u64,

@@ -255,6 +255,29 @@ pub fn host_rss() -> Option<u64> {
         .map(|kb| kb * 1024)
 }
 
+/// Returns the malloc heap's free pages to the system: glibc's
+/// `malloc_trim(0)`, which walks every arena (the main thread's and those of
+/// lavapipe's and the validation layer's threads) and releases the free
+/// pages that glibc otherwise keeps for reuse. It frees no live allocation,
+/// so the RSS after it is memory in use: a leak (live memory that grows)
+/// still shows, while the arenas' retained pages, which go up and down with
+/// which thread freed what, no longer scatter the samples. Returns whether
+/// a trim ran: only with glibc; elsewhere (musl, macOS, Windows) nothing
+/// happens and the RSS keeps the allocator's cache.
+pub fn trim_host_heap() -> bool {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    {
+        // SAFETY: malloc_trim takes the arenas' locks itself and is safe to
+        // call while other threads allocate; it only returns free pages.
+        unsafe { libc::malloc_trim(0) };
+        true
+    }
+    #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+    {
+        false
+    }
+}
+
 /// `n` bytes in binary units, for messages.
 pub fn bytes(n: u64) -> String {
     const UNITS: [&str; 5] = ["bytes", "KiB", "MiB", "GiB", "TiB"];

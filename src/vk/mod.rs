@@ -37,7 +37,7 @@ pub use frame::{
     MAX_FRAMES_IN_FLIGHT,
 };
 pub use image::{Image, ImageDesc};
-pub use limits::{bytes, host_rss, MemoryHeaps, MemoryReport};
+pub use limits::{bytes, host_rss, trim_host_heap, MemoryHeaps, MemoryReport};
 pub use pass::{step, Pass, Resource, Sync};
 pub use pipeline::{
     begin_rendering, begin_rendering_with_depth, end_rendering, groups_8x8, ComputePipeline,
