@@ -781,21 +781,19 @@ fn volume_cone_volume_caustics_match_reference() {
     let ctx = validated_context();
     let scene = load("volume_cone");
     let truth = reference_truth(&ctx, &scene, Component::VolumeCaustics, 64, 1_000_000);
-    let bounds = [
-        (&[][..], 0.205, 0.018),
-        (&["refraction=0"][..], 0.115, 0.027),
+    let cases = [
+        ("volume_cone_volume", &[][..], 0.205, 0.018),
+        (
+            "volume_cone_volume_image_space",
+            &["refraction=0"][..],
+            0.115,
+            0.027,
+        ),
     ];
-    for (overrides, energy, flip) in bounds {
+    for (label, overrides, energy, flip) in cases {
         compare(
             &ctx,
-            &format!(
-                "volume_cone_volume{}",
-                if overrides.is_empty() {
-                    ""
-                } else {
-                    "_image_space"
-                }
-            ),
+            label,
             &scene,
             Component::VolumeCaustics,
             &truth,
