@@ -3,6 +3,10 @@
 
 mod cli;
 
+// Counts the Rust heap in use, for `bench --memory-samples` (vk/host_memory.rs).
+#[global_allocator]
+static HEAP: caustics::vk::CountingAllocator = caustics::vk::CountingAllocator;
+
 use caustics::params::Params;
 use caustics::techniques;
 use clap::Parser;

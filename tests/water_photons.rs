@@ -1494,19 +1494,19 @@ fn a_thin_wall_lit_on_one_side_stays_dark_on_the_other() {
     assert_validation_clean(&ctx);
 }
 
-/// 60 frames of `bench` at 32² on water_pool: the host RSS after frame 60
-/// is at most 16 MiB above the one after frame 10 (samples every 10
-/// frames; each taken between frames after glibc's malloc_trim, so memory
-/// in use). Measured: no trend; 165.19, 165.18, 165.16, 165.17, 166.78,
-/// 165.18 MiB (2026-12-02, debug build); up to 8 MiB swings inside
-/// lavapipe in the 500-frame soak (BENCHMARKS.md "Soak"), hence the
-/// margin. Before the trim the samples scattered by up to 9 MiB (malloc's
-/// retained pages), last minus first between -3.6 and +6.4 MiB in 4
-/// runs. With the cascade count
-/// and the splat mode read from the uniform block, lavapipe (Mesa 22.3)
-/// recompiled view.comp at every bind and kept each copy: +1.85 MB a frame,
-/// about 90 MiB over these 50 frames (BENCHMARKS.md "Soak",
-/// examples/lavapipe_rebind.rs).
+/// 60 frames of `bench` at 32² on water_pool, memory sampled every 10
+/// frames between frames (after glibc's malloc_trim, so memory in use).
+/// - What the renderer owns (Rust heap, Vulkan host allocations, device
+///   memory; vk/host_memory.rs) is the same at every sample, to the byte.
+/// - The host RSS after frame 60 is at most 16 MiB above the one after frame
+///   10. Measured: no trend; 165.19, 165.18, 165.16, 165.17, 166.78, 165.18
+///   MiB (2026-12-02, debug build). It gets a margin because lavapipe keeps
+///   a finished scene's rasteriser bins until it reuses the scene, 4.5 MiB
+///   for the splat's, at some samples (BENCHMARKS.md "Soak"). With the
+///   cascade count and the splat mode read from the uniform block, lavapipe
+///   (Mesa 22.3) recompiled view.comp at every bind and kept each copy:
+///   +1.85 MB a frame, about 90 MiB over these 50 frames
+///   (examples/lavapipe_rebind.rs), memory only the RSS sees.
 #[test]
 fn host_memory_stays_flat_over_frames() {
     let json = std::env::temp_dir().join(format!("water_photons_rss_{}.json", std::process::id()));
@@ -1535,16 +1535,38 @@ fn host_memory_stays_flat_over_frames() {
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let _ = std::fs::remove_file(&json);
-    let rss: Vec<i64> = report["memory"]
-        .as_array()
-        .expect("memory samples")
-        .iter()
-        .map(|s| s["host_rss"].as_i64().unwrap())
-        .collect();
+    let series = |key: &str| -> Vec<i64> {
+        report["memory"]
+            .as_array()
+            .expect("memory samples")
+            .iter()
+            .map(|s| s[key].as_i64().unwrap_or_else(|| panic!("{key} in {s}")))
+            .collect()
+    };
+    let rss = series("host_rss");
     println!("host RSS after frames 10, 20, ..., 60: {rss:?} bytes");
     let growth = rss[rss.len() - 1] - rss[0];
     assert!(
         growth <= 16 << 20,
         "host RSS grew {growth} bytes over 50 frames: {rss:?}"
     );
+    // What the renderer owns, counted where it is allocated
+    // (vk/host_memory.rs), is the same at every sample, to the byte: the
+    // bench reserves its own records up front, and a frame frees what it
+    // allocates.
+    for key in [
+        "rust_heap",
+        "rust_heap_allocations",
+        "vulkan_host",
+        "vulkan_host_allocations",
+        "device_allocated",
+    ] {
+        let v = series(key);
+        println!("{key}: {v:?}");
+        assert!(v[0] > 0, "{key} not counted: {v:?}");
+        assert!(
+            v.iter().all(|&x| x == v[0]),
+            "{key} changed between samples: {v:?}"
+        );
+    }
 }

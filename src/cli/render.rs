@@ -15,7 +15,10 @@ use caustics::params::Params;
 use caustics::renderer::Renderer;
 use caustics::scene::Scene;
 use caustics::techniques;
-use caustics::vk::{bytes, host_rss, trim_host_heap, Context, FrameOptions, PassTiming};
+use caustics::vk::{
+    bytes, host_rss, rust_heap, trim_host_heap, vulkan_host_memory, Context, FrameOptions,
+    PassTiming,
+};
 use std::collections::BTreeMap;
 use std::io::Write as _;
 use std::sync::Arc;
@@ -135,13 +138,24 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
     let submit_before = renderer.frames.host_submit;
     let start = Instant::now();
     // Timings are taken as numbers every so often, so a long run's host
-    // memory does not grow with per-frame records.
-    let (mut by_pass, mut submit_to_done) = (Vec::new(), Vec::new());
+    // memory does not grow with per-frame records. Each record is reserved
+    // for the whole run when it first appears (before the first memory
+    // sample), so the Rust heap in use does not grow with the bench's own
+    // bookkeeping either: as many times a frame as the pass has run so far
+    // (beams records its refinement passes several times a frame).
+    let all_frames = frames as usize;
+    let (mut by_pass, mut submit_to_done) = (Vec::new(), Vec::with_capacity(all_frames));
+    let mut frames_taken = 0;
     let mut take = |done: Vec<caustics::vk::FrameTiming>| {
         submit_to_done.extend(done.iter().map(|f| f.submit_to_done_ms));
+        frames_taken += done.len();
         extend_per_pass(&mut by_pass, per_pass(&done));
+        for (_, ms) in by_pass.iter_mut() {
+            let whole_run = ms.len().div_ceil(frames_taken.max(1)) * all_frames;
+            ms.reserve_exact(whole_run.saturating_sub(ms.len()));
+        }
     };
-    let mut memory = Vec::new();
+    let mut memory = Vec::with_capacity(memory_samples as usize);
     for i in 0..frames {
         renderer.submit_frame(scene.time + (warmup + i) as f32 / 60.0)?;
         if i % 64 == 63 {
@@ -164,6 +178,7 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
             // use, which is what a leak makes grow.
             let host_rss_untrimmed = rss()?;
             let host_heap_trimmed = trim_host_heap();
+            let (vulkan_host, rust_heap) = (vulkan_host_memory(), rust_heap());
             memory.push(MemorySample {
                 frame: i + 1,
                 host_rss: rss()?,
@@ -172,6 +187,10 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
                 device_allocated: device.allocated,
                 device_allocations: device.allocations,
                 device_capacity: device.capacity,
+                vulkan_host: vulkan_host.bytes,
+                vulkan_host_allocations: vulkan_host.allocations,
+                rust_heap: rust_heap.map(|h| h.bytes),
+                rust_heap_allocations: rust_heap.map(|h| h.allocations),
             });
         }
     }

@@ -217,6 +217,15 @@ pub struct MemorySample {
     pub device_allocated: u64,
     pub device_allocations: usize,
     pub device_capacity: u64,
+    /// Host memory the renderer owns (`vk/host_memory.rs`), counted where it
+    /// is allocated, which the RSS mixes with the driver's own caches: live
+    /// bytes and allocations made through its Vulkan allocation callbacks
+    /// (the instance, the device, their objects and command buffers)...
+    pub vulkan_host: u64,
+    pub vulkan_host_allocations: u64,
+    /// ...and the Rust heap in use (the `caustics` binary counts it).
+    pub rust_heap: Option<u64>,
+    pub rust_heap_allocations: Option<u64>,
 }
 
 /// Each pass's times over `frames`, in the order of the first frame (a

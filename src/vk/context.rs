@@ -13,6 +13,11 @@ use std::mem::ManuallyDrop;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 
+/// Instance and device are created with these (`vk/host_memory.rs`), so
+/// their host allocations are counted.
+const HOST_CALLBACKS: Option<&vk::AllocationCallbacks<'static>> =
+    Some(&super::host_memory::HOST_ALLOCATION_CALLBACKS);
+
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
 #[derive(Clone, Debug, Default)]
@@ -179,7 +184,7 @@ pub(super) fn create_instance(
     if sync_validation {
         info = info.push_next(&mut features);
     }
-    let instance = unsafe { entry.create_instance(&info, None) }?;
+    let instance = unsafe { entry.create_instance(&info, HOST_CALLBACKS) }?;
     Ok((instance, sync_validation))
 }
 
@@ -238,7 +243,7 @@ impl Context {
             if let Some(d) = &debug_instance {
                 d.destroy_debug_utils_messenger(messenger, None);
             }
-            instance.destroy_instance(None);
+            instance.destroy_instance(HOST_CALLBACKS);
         };
         let devices = unsafe { instance.enumerate_physical_devices() }?;
         let infos: Vec<DeviceInfo> = devices
@@ -334,7 +339,9 @@ impl Context {
             .push_next(&mut v12)
             .push_next(&mut v13)
             .push_next(&mut atomic);
-        let device = match unsafe { instance.create_device(physical_device, &device_info, None) } {
+        let device = match unsafe {
+            instance.create_device(physical_device, &device_info, HOST_CALLBACKS)
+        } {
             Ok(d) => d,
             Err(e) => {
                 cleanup(&instance);
@@ -373,7 +380,7 @@ impl Context {
                                 .unwrap_or(VkError::OutOfHostMemory)
                         }
                     };
-                    device.destroy_device(None);
+                    device.destroy_device(HOST_CALLBACKS);
                     cleanup(&instance);
                     return Err(error);
                 }
@@ -563,11 +570,11 @@ impl Context {
             self.pipelines.destroy();
             // The allocator frees its memory blocks; it must go before the device.
             ManuallyDrop::drop(&mut self.allocator);
-            self.device.destroy_device(None);
+            self.device.destroy_device(HOST_CALLBACKS);
             if let Some(d) = &self.debug_instance {
                 d.destroy_debug_utils_messenger(self.messenger, None);
             }
-            self.instance.destroy_instance(None);
+            self.instance.destroy_instance(HOST_CALLBACKS);
         }
     }
 }

@@ -161,7 +161,7 @@ pub fn enumerate_devices() -> VkResult<Vec<DeviceInfo>> {
         .enumerate()
         .map(|(i, &pd)| query_device(&instance, pd, i))
         .collect();
-    unsafe { instance.destroy_instance(None) };
+    unsafe { instance.destroy_instance(Some(&super::host_memory::HOST_ALLOCATION_CALLBACKS)) };
     Ok(infos)
 }
 

@@ -17,6 +17,7 @@ mod descriptors;
 mod device;
 mod fault;
 mod frame;
+mod host_memory;
 mod image;
 mod limits;
 mod pass;
@@ -36,6 +37,7 @@ pub use frame::{
     FrameOptions, FrameRecorder, FrameSync, FrameTiming, Frames, PassTiming, TimingSource,
     MAX_FRAMES_IN_FLIGHT,
 };
+pub use host_memory::{rust_heap, vulkan_host_memory, CountingAllocator, HostCount};
 pub use image::{Image, ImageDesc};
 pub use limits::{bytes, host_rss, trim_host_heap, MemoryHeaps, MemoryReport};
 pub use pass::{step, Pass, Resource, Sync};
