@@ -15,8 +15,8 @@
 #   themselves (a leak the renderer's use causes inside the driver shows only
 #   here). Its floor must stay flat: the least sample of the last third at
 #   most 1 + TOL times the least of the first third. Not max/min: lavapipe
-#   holds the last rasterised scene's bins until it reuses the scene (4.5
-#   MiB for water_photons' splats), so single samples rise and fall by MiBs
+#   keeps a finished scene's rasteriser bins until it reuses the scene (4.5
+#   MiB on water_pool's 18,770 triangles), so single samples rise and fall by MiBs
 #   while the memory in use does not grow (BENCHMARKS.md "Soak").
 # Prints a table (BENCHMARKS.md, "Soak") with the RSS's max/min, floor rise
 # and least-squares slope, and the untrimmed RSS's max/min for comparison;

@@ -1502,7 +1502,7 @@ fn a_thin_wall_lit_on_one_side_stays_dark_on_the_other() {
 ///   10. Measured: no trend; 165.19, 165.18, 165.16, 165.17, 166.78, 165.18
 ///   MiB (2026-12-02, debug build). It gets a margin because lavapipe keeps
 ///   a finished scene's rasteriser bins until it reuses the scene, 4.5 MiB
-///   for the splat's, at some samples (BENCHMARKS.md "Soak"). With the
+///   on water_pool at some samples (BENCHMARKS.md "Soak"). With the
 ///   cascade count and the splat mode read from the uniform block, lavapipe
 ///   (Mesa 22.3) recompiled view.comp at every bind and kept each copy:
 ///   +1.85 MB a frame, about 90 MiB over these 50 frames
