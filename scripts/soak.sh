@@ -18,6 +18,8 @@
 #   keeps a finished scene's rasteriser bins until it reuses the scene (4.5
 #   MiB on water_pool's 18,770 triangles), so single samples rise and fall by MiBs
 #   while the memory in use does not grow (BENCHMARKS.md "Soak").
+# Without CountingAllocator (a library build) the Rust heap is "not counted"
+# and left out of the verdict.
 # Prints a table (BENCHMARKS.md, "Soak") with the RSS's max/min, floor rise
 # and least-squares slope, and the untrimmed RSS's max/min for comparison;
 # JSON in out/soak/.
@@ -32,6 +34,7 @@ SIZE=${SIZE:-32}
 SAMPLES=${SAMPLES:-30}
 TOL=${TOL:-0.01}
 BIN=${BIN:-target/release/caustics}
+[ "$SAMPLES" -ge 3 ] || { echo "soak.sh: SAMPLES=$SAMPLES: the floor compares thirds, so at least 3" >&2; exit 2; }
 [ -x "$BIN" ] || cargo build --release --quiet
 out=out/soak
 mkdir -p "$out"

@@ -138,11 +138,12 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
     let submit_before = renderer.frames.host_submit;
     let start = Instant::now();
     // Timings are taken as numbers every so often, so a long run's host
-    // memory does not grow with per-frame records. Each record is reserved
-    // for the whole run when it first appears (before the first memory
-    // sample), so the Rust heap in use does not grow with the bench's own
-    // bookkeeping either: as many times a frame as the pass has run so far
-    // (beams records its refinement passes several times a frame).
+    // memory does not grow with per-frame records. At each take every
+    // pass's record is reserved for the whole run, as many values a frame
+    // as the pass has run so far (beams records its refinement passes
+    // several times a frame); the first take comes before the first memory
+    // sample, so the Rust heap does not grow with the bench's bookkeeping
+    // unless a pass first runs, or runs more often, later in the run.
     let all_frames = frames as usize;
     let (mut by_pass, mut submit_to_done) = (Vec::new(), Vec::with_capacity(all_frames));
     let mut frames_taken = 0;

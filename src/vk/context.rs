@@ -209,15 +209,16 @@ impl Context {
             (true, false) => Validation::On,
             (true, true) => Validation::Sync,
         };
+        // Asked before the instance exists, so no early return leaves one.
+        let has_debug_utils = unsafe { entry.enumerate_instance_extension_properties(None) }?
+            .iter()
+            .any(|e| e.extension_name_as_c_str() == Ok(ash::ext::debug_utils::NAME));
         let (instance, sync_validation) = create_instance(&entry, validation, instance_extensions)?;
         let counters = Box::new(Counters {
             errors: AtomicU32::new(0),
             warnings: AtomicU32::new(0),
             first_errors: Mutex::new(Vec::new()),
         });
-        let has_debug_utils = unsafe { entry.enumerate_instance_extension_properties(None) }?
-            .iter()
-            .any(|e| e.extension_name_as_c_str() == Ok(ash::ext::debug_utils::NAME));
         let (debug_instance, messenger) = if has_debug_utils {
             let debug = ash::ext::debug_utils::Instance::new(&entry, &instance);
             let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
@@ -233,8 +234,13 @@ impl Context {
                 )
                 .pfn_user_callback(Some(debug_callback))
                 .user_data(&*counters as *const Counters as *mut c_void);
-            let messenger = unsafe { debug.create_debug_utils_messenger(&info, None) }?;
-            (Some(debug), messenger)
+            match unsafe { debug.create_debug_utils_messenger(&info, None) } {
+                Ok(messenger) => (Some(debug), messenger),
+                Err(e) => {
+                    unsafe { instance.destroy_instance(HOST_CALLBACKS) };
+                    return Err(e.into());
+                }
+            }
         } else {
             (None, vk::DebugUtilsMessengerEXT::null())
         };
@@ -245,7 +251,13 @@ impl Context {
             }
             instance.destroy_instance(HOST_CALLBACKS);
         };
-        let devices = unsafe { instance.enumerate_physical_devices() }?;
+        let devices = match unsafe { instance.enumerate_physical_devices() } {
+            Ok(d) => d,
+            Err(e) => {
+                cleanup(&instance);
+                return Err(e.into());
+            }
+        };
         let infos: Vec<DeviceInfo> = devices
             .iter()
             .enumerate()

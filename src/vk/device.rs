@@ -155,14 +155,16 @@ pub(super) fn query_device(
 pub fn enumerate_devices() -> VkResult<Vec<DeviceInfo>> {
     let entry = load_entry()?;
     let (instance, _) = create_instance(&entry, Validation::Off, &[])?;
-    let devices = unsafe { instance.enumerate_physical_devices() }?;
-    let infos = devices
-        .iter()
-        .enumerate()
-        .map(|(i, &pd)| query_device(&instance, pd, i))
-        .collect();
+    let devices = unsafe { instance.enumerate_physical_devices() };
+    let infos = devices.map(|devices| {
+        devices
+            .iter()
+            .enumerate()
+            .map(|(i, &pd)| query_device(&instance, pd, i))
+            .collect()
+    });
     unsafe { instance.destroy_instance(Some(&super::host_memory::HOST_ALLOCATION_CALLBACKS)) };
-    Ok(infos)
+    Ok(infos?)
 }
 
 pub(super) fn pick_device(infos: &[DeviceInfo], wanted: Option<&str>) -> VkResult<usize> {

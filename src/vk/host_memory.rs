@@ -6,12 +6,16 @@
 //!   loader, the layers and the driver make through the application's
 //!   `VkAllocationCallbacks` (Vulkan spec, "Host Memory"). The context
 //!   passes `HOST_ALLOCATION_CALLBACKS` to vkCreateInstance and
-//!   vkCreateDevice; objects created with a null allocator then allocate
-//!   through the device's (Mesa: `vk_object_alloc` falls back to
-//!   `device->alloc`), so this counts what the objects and command buffers
-//!   the renderer creates hold. What a driver allocates with plain malloc for
-//!   its own work (llvmpipe's rasteriser bins, compiled shader variants) is
-//!   not counted here: it shows only in the RSS.
+//!   vkCreateDevice. Objects created with a null allocator then allocate
+//!   through the device's on Mesa (`vk_object_alloc` falls back to
+//!   `device->alloc`; the spec does not require it, so other drivers may
+//!   count only the instance and device), so there this counts what the
+//!   objects and command buffers the renderer creates hold, plus what the
+//!   loader and layers allocate through the callbacks. What a driver
+//!   allocates with plain malloc for its own work (llvmpipe's rasteriser
+//!   bins, compiled shader variants) is not counted here: it shows only in
+//!   the RSS. A sample may catch a small block the driver's queue thread
+//!   frees just after the fence (168 bytes on lavapipe).
 //! - The Rust heap: `CountingAllocator`, the `caustics` binary's global
 //!   allocator. Library users that install another allocator get `None`
 //!   from `rust_heap`.
@@ -78,13 +82,21 @@ pub fn rust_heap() -> Option<HostCount> {
 /// The system allocator, counting live bytes and allocations.
 pub struct CountingAllocator;
 
+/// Marks the Rust heap as counted (a read first: no shared write on every
+/// allocation).
+fn note_counting() {
+    if !RUST_HEAP_COUNTED.load(Ordering::Relaxed) {
+        RUST_HEAP_COUNTED.store(true, Ordering::Relaxed);
+    }
+}
+
 // SAFETY: every call is forwarded to `System` with the caller's layout; the
 // counters only observe sizes.
 unsafe impl GlobalAlloc for CountingAllocator {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         let p = System.alloc(layout);
         if !p.is_null() {
-            RUST_HEAP_COUNTED.store(true, Ordering::Relaxed);
+            note_counting();
             RUST_HEAP.add(layout.size());
         }
         p
@@ -93,7 +105,7 @@ unsafe impl GlobalAlloc for CountingAllocator {
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
         let p = System.alloc_zeroed(layout);
         if !p.is_null() {
-            RUST_HEAP_COUNTED.store(true, Ordering::Relaxed);
+            note_counting();
             RUST_HEAP.add(layout.size());
         }
         p
