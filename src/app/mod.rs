@@ -23,6 +23,9 @@ mod slots;
 mod state;
 
 pub use camera::OrbitCamera;
+// For tests/overlay_layout.rs: the panel's layout without a window.
+#[cfg(feature = "overlay")]
+pub use overlay::{panel_rect, CompareStatus, MediumValues, UiData, View};
 use slots::ImageSemaphores;
 use state::{Input, State};
 

@@ -101,7 +101,7 @@ impl Overlay {
 }
 
 #[cfg(feature = "overlay")]
-pub use enabled::Overlay;
+pub use enabled::{panel_rect, Overlay};
 
 #[cfg(feature = "overlay")]
 mod enabled {
@@ -291,6 +291,9 @@ mod enabled {
         }
     }
 
+    /// The panel window's egui id (`panel_rect` looks its area up).
+    const PANEL_ID: &str = "caustics panel";
+
     fn panel(
         ctx: &egui::Context,
         data: &UiData,
@@ -298,67 +301,106 @@ mod enabled {
         pending: &mut Option<Params>,
     ) {
         egui::Window::new("caustics")
+            .id(egui::Id::new(PANEL_ID))
             .default_pos([8.0, 8.0])
             .default_width(260.0)
+            // The height follows the content, up to the screen's (the
+            // scroll area below); the width stays the user's. Without the
+            // default height egui would cap the content at 420 points.
+            .resizable([true, false])
+            .default_height(ctx.content_rect().height())
             .show(ctx, |ui| {
-                let mut chosen = data.technique;
-                egui::ComboBox::from_label("technique")
-                    .selected_text(chosen)
-                    .show_ui(ui, |ui| {
-                        for t in TECHNIQUES {
-                            ui.selectable_value(&mut chosen, t.name, t.name)
-                                .on_hover_text(t.description);
+                // With every section shown the panel is taller than a
+                // 480-pixel window: what does not fit between here and the
+                // screen's bottom (less the window's margin) scrolls; a
+                // tall enough screen shows it all.
+                let room = ui.ctx().content_rect().bottom() - ui.cursor().top() - 12.0;
+                egui::ScrollArea::vertical()
+                    .max_height(room.max(64.0))
+                    .show(ui, |ui| {
+                        let mut chosen = data.technique;
+                        egui::ComboBox::from_label("technique")
+                            .selected_text(chosen)
+                            .show_ui(ui, |ui| {
+                                for t in TECHNIQUES {
+                                    ui.selectable_value(&mut chosen, t.name, t.name)
+                                        .on_hover_text(t.description);
+                                }
+                            });
+                        if chosen != data.technique {
+                            actions.push(Action::Technique(chosen));
                         }
+                        if let Some(info) = TECHNIQUES.iter().find(|t| t.name == data.technique) {
+                            let current = pending.clone().unwrap_or_else(|| data.params.clone());
+                            let mut edited = false;
+                            let mut values = Vec::new();
+                            for spec in info.params() {
+                                // The values belong to this technique's specs; a
+                                // missing one shows its default.
+                                let mut v = current.value(spec.name).unwrap_or(spec.default);
+                                let mut slider =
+                                    egui::Slider::new(&mut v, spec.min..=spec.max).text(spec.name);
+                                if spec.apply == Apply::Live {
+                                    slider = slider.suffix(" (live)");
+                                }
+                                if spec.integer {
+                                    slider = slider.integer();
+                                }
+                                edited |= ui.add(slider).on_hover_text(spec.description).changed();
+                                values.push(format!("{}={}", spec.name, v));
+                            }
+                            if edited {
+                                if let Ok(p) = Params::resolve(info.name, info.params(), &values) {
+                                    *pending = Some(p);
+                                }
+                            }
+                        }
+                        components(ui, data, actions);
+                        medium(ui, data, actions);
+                        light_intensities(ui, data, actions);
+                        environment_rotation(ui, data, actions);
+                        compare_panel(ui, &data.compare, actions);
+                        ui.separator();
+                        egui::Grid::new("timings").striped(true).show(ui, |ui| {
+                            let mut total = 0.0;
+                            for t in data.timings {
+                                ui.label(&t.name);
+                                ui.label(format!("{:8.3} ms", t.ms));
+                                ui.end_row();
+                                total += t.ms;
+                            }
+                            ui.strong("total");
+                            ui.strong(format!("{total:8.3} ms"));
+                            ui.end_row();
+                        });
+                        ui.separator();
+                        frame_graph(ui, data.history_ms);
                     });
-                if chosen != data.technique {
-                    actions.push(Action::Technique(chosen));
-                }
-                if let Some(info) = TECHNIQUES.iter().find(|t| t.name == data.technique) {
-                    let current = pending.clone().unwrap_or_else(|| data.params.clone());
-                    let mut edited = false;
-                    let mut values = Vec::new();
-                    for spec in info.params() {
-                        // The values belong to this technique's specs; a
-                        // missing one shows its default.
-                        let mut v = current.value(spec.name).unwrap_or(spec.default);
-                        let mut slider =
-                            egui::Slider::new(&mut v, spec.min..=spec.max).text(spec.name);
-                        if spec.apply == Apply::Live {
-                            slider = slider.suffix(" (live)");
-                        }
-                        if spec.integer {
-                            slider = slider.integer();
-                        }
-                        edited |= ui.add(slider).on_hover_text(spec.description).changed();
-                        values.push(format!("{}={}", spec.name, v));
-                    }
-                    if edited {
-                        if let Ok(p) = Params::resolve(info.name, info.params(), &values) {
-                            *pending = Some(p);
-                        }
-                    }
-                }
-                components(ui, data, actions);
-                medium(ui, data, actions);
-                light_intensities(ui, data, actions);
-                environment_rotation(ui, data, actions);
-                compare_panel(ui, &data.compare, actions);
-                ui.separator();
-                egui::Grid::new("timings").striped(true).show(ui, |ui| {
-                    let mut total = 0.0;
-                    for t in data.timings {
-                        ui.label(&t.name);
-                        ui.label(format!("{:8.3} ms", t.ms));
-                        ui.end_row();
-                        total += t.ms;
-                    }
-                    ui.strong("total");
-                    ui.strong(format!("{total:8.3} ms"));
-                    ui.end_row();
-                });
-                ui.separator();
-                frame_graph(ui, data.history_ms);
             });
+    }
+
+    /// The panel laid out alone on a `width` x `height` (points) screen
+    /// with `data`, after enough passes for egui to size the window: its
+    /// rectangle as [left, top, right, bottom]. For tests/overlay_layout.rs.
+    pub fn panel_rect(data: &UiData, width: f32, height: f32) -> [f32; 4] {
+        let screen = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(width, height));
+        let egui = egui::Context::default();
+        let (mut actions, mut pending) = (Vec::new(), None);
+        // egui sizes a window from the previous pass's content.
+        for _ in 0..4 {
+            let raw = egui::RawInput {
+                screen_rect: Some(screen),
+                ..Default::default()
+            };
+            let mut output =
+                egui.run_ui(raw, |ui| panel(ui.ctx(), data, &mut actions, &mut pending));
+            // Nothing is drawn; egui panics on dropping unapplied deltas.
+            output.textures_delta.clear();
+        }
+        let r = egui
+            .memory(|m| m.area_rect(egui::Id::new(PANEL_ID)))
+            .expect("the panel was laid out");
+        [r.left(), r.top(), r.right(), r.bottom()]
     }
 
     /// One checkbox per component the technique renders.
