@@ -317,66 +317,73 @@ mod enabled {
                 let room = ui.ctx().content_rect().bottom() - ui.cursor().top() - 12.0;
                 egui::ScrollArea::vertical()
                     .max_height(room.max(64.0))
-                    .show(ui, |ui| {
-                        let mut chosen = data.technique;
-                        egui::ComboBox::from_label("technique")
-                            .selected_text(chosen)
-                            .show_ui(ui, |ui| {
-                                for t in TECHNIQUES {
-                                    ui.selectable_value(&mut chosen, t.name, t.name)
-                                        .on_hover_text(t.description);
-                                }
-                            });
-                        if chosen != data.technique {
-                            actions.push(Action::Technique(chosen));
-                        }
-                        if let Some(info) = TECHNIQUES.iter().find(|t| t.name == data.technique) {
-                            let current = pending.clone().unwrap_or_else(|| data.params.clone());
-                            let mut edited = false;
-                            let mut values = Vec::new();
-                            for spec in info.params() {
-                                // The values belong to this technique's specs; a
-                                // missing one shows its default.
-                                let mut v = current.value(spec.name).unwrap_or(spec.default);
-                                let mut slider =
-                                    egui::Slider::new(&mut v, spec.min..=spec.max).text(spec.name);
-                                if spec.apply == Apply::Live {
-                                    slider = slider.suffix(" (live)");
-                                }
-                                if spec.integer {
-                                    slider = slider.integer();
-                                }
-                                edited |= ui.add(slider).on_hover_text(spec.description).changed();
-                                values.push(format!("{}={}", spec.name, v));
-                            }
-                            if edited {
-                                if let Ok(p) = Params::resolve(info.name, info.params(), &values) {
-                                    *pending = Some(p);
-                                }
-                            }
-                        }
-                        components(ui, data, actions);
-                        medium(ui, data, actions);
-                        light_intensities(ui, data, actions);
-                        environment_rotation(ui, data, actions);
-                        compare_panel(ui, &data.compare, actions);
-                        ui.separator();
-                        egui::Grid::new("timings").striped(true).show(ui, |ui| {
-                            let mut total = 0.0;
-                            for t in data.timings {
-                                ui.label(&t.name);
-                                ui.label(format!("{:8.3} ms", t.ms));
-                                ui.end_row();
-                                total += t.ms;
-                            }
-                            ui.strong("total");
-                            ui.strong(format!("{total:8.3} ms"));
-                            ui.end_row();
-                        });
-                        ui.separator();
-                        frame_graph(ui, data.history_ms);
-                    });
+                    .show(ui, |ui| panel_contents(ui, data, actions, pending));
             });
+    }
+
+    /// The panel's sections, top to bottom.
+    fn panel_contents(
+        ui: &mut egui::Ui,
+        data: &UiData,
+        actions: &mut Vec<Action>,
+        pending: &mut Option<Params>,
+    ) {
+        let mut chosen = data.technique;
+        egui::ComboBox::from_label("technique")
+            .selected_text(chosen)
+            .show_ui(ui, |ui| {
+                for t in TECHNIQUES {
+                    ui.selectable_value(&mut chosen, t.name, t.name)
+                        .on_hover_text(t.description);
+                }
+            });
+        if chosen != data.technique {
+            actions.push(Action::Technique(chosen));
+        }
+        if let Some(info) = TECHNIQUES.iter().find(|t| t.name == data.technique) {
+            let current = pending.clone().unwrap_or_else(|| data.params.clone());
+            let mut edited = false;
+            let mut values = Vec::new();
+            for spec in info.params() {
+                // The values belong to this technique's specs; a
+                // missing one shows its default.
+                let mut v = current.value(spec.name).unwrap_or(spec.default);
+                let mut slider = egui::Slider::new(&mut v, spec.min..=spec.max).text(spec.name);
+                if spec.apply == Apply::Live {
+                    slider = slider.suffix(" (live)");
+                }
+                if spec.integer {
+                    slider = slider.integer();
+                }
+                edited |= ui.add(slider).on_hover_text(spec.description).changed();
+                values.push(format!("{}={}", spec.name, v));
+            }
+            if edited {
+                if let Ok(p) = Params::resolve(info.name, info.params(), &values) {
+                    *pending = Some(p);
+                }
+            }
+        }
+        components(ui, data, actions);
+        medium(ui, data, actions);
+        light_intensities(ui, data, actions);
+        environment_rotation(ui, data, actions);
+        compare_panel(ui, &data.compare, actions);
+        ui.separator();
+        egui::Grid::new("timings").striped(true).show(ui, |ui| {
+            let mut total = 0.0;
+            for t in data.timings {
+                ui.label(&t.name);
+                ui.label(format!("{:8.3} ms", t.ms));
+                ui.end_row();
+                total += t.ms;
+            }
+            ui.strong("total");
+            ui.strong(format!("{total:8.3} ms"));
+            ui.end_row();
+        });
+        ui.separator();
+        frame_graph(ui, data.history_ms);
     }
 
     /// The panel laid out alone on a `width` x `height` (points) screen

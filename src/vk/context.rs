@@ -13,10 +13,9 @@ use std::mem::ManuallyDrop;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 
-/// Instance and device are created with these (`vk/host_memory.rs`), so
-/// their host allocations are counted.
-const HOST_CALLBACKS: Option<&vk::AllocationCallbacks<'static>> =
-    Some(&super::host_memory::HOST_ALLOCATION_CALLBACKS);
+// Instance and device are created with these, so their host allocations
+// are counted (`vk/host_memory.rs`).
+use super::host_memory::HOST_CALLBACKS;
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 

@@ -163,7 +163,7 @@ pub fn enumerate_devices() -> VkResult<Vec<DeviceInfo>> {
             .map(|(i, &pd)| query_device(&instance, pd, i))
             .collect()
     });
-    unsafe { instance.destroy_instance(Some(&super::host_memory::HOST_ALLOCATION_CALLBACKS)) };
+    unsafe { instance.destroy_instance(super::host_memory::HOST_CALLBACKS) };
     Ok(infos?)
 }
 

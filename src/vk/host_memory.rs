@@ -26,7 +26,7 @@ use std::ffi::c_void;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// Live bytes and allocations of one counter.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct HostCount {
     pub bytes: u64,
     pub allocations: u64,
@@ -227,7 +227,11 @@ unsafe extern "system" fn vulkan_reallocate(
 }
 
 /// The callbacks the context creates and destroys its instance and device
-/// with, counting into `vulkan_host_memory`.
+/// with, counting into `vulkan_host_memory` (as ash takes them).
+pub(super) const HOST_CALLBACKS: Option<&vk::AllocationCallbacks<'static>> =
+    Some(&HOST_ALLOCATION_CALLBACKS);
+
+/// The callbacks themselves.
 pub static HOST_ALLOCATION_CALLBACKS: vk::AllocationCallbacks<'static> = vk::AllocationCallbacks {
     p_user_data: &VULKAN_HOST as *const Counter as *mut c_void,
     pfn_allocation: Some(vulkan_allocate),
