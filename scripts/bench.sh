@@ -12,7 +12,7 @@
 # sweep); volume_lines: stage B (Hu 2010's volume caustic passes) over
 # volume caustic buffers 256^2/512^2/1024^2 x screens 256^2/512^2/1024^2 on
 # volume_cone (Hu's Table 2 sweep), then the line and covered-pixel counts
-# (tests/volume_lines.rs, ignored test `coverage_statistics`);
+# (tests/suite/volume_lines.rs, ignored test `coverage_statistics`);
 # water_photons: the per-pass split of Kougianos & Moustakas' Fig. 14 on
 # water_pool over ccm_0 and cascade counts; loading: Scene::load per MB of
 # TOML (64,000 materials and 16,000 boxes) and for a 2,000,000-triangle OBJ
@@ -20,7 +20,7 @@
 # pinhole: Wand & Strasser's Fig. 4 (time against sample count, filtering
 # on and off) and the cost of the visibility rays on ring; SIZE (128) the
 # screen; then the accuracy table (Fig. 5's strategies, the cluster count)
-# from tests/pinhole.rs.
+# from tests/suite/pinhole.rs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 sections=("$@")
@@ -109,7 +109,7 @@ print(f"| {n}² | {b['width']}x{b['height']} | " + " | ".join(cells)
 PY
     done
   done
-  cargo test --release --quiet --test volume_lines -- --ignored --nocapture coverage_statistics | grep '^|'
+  cargo test --release --quiet --test suite volume_lines::coverage_statistics -- --ignored --nocapture | grep '^|'
   # Hu's Table 1: the whole frame's stage split (A airlight, C surface
   # radiance = image_space, B volume caustics, composition) at 256^2.
   echo "| scene | A airlight | C surface (image_space) | B volume caustics | composition | frame |"
@@ -224,5 +224,5 @@ if wants pinhole; then
   $bin bench --pass-timing --scene assets/scenes/ring.toml --technique pinhole --param samples=1000 \
     --param visibility=0 --width $size --height $size --frames ${FRAMES:-10} --warmup 1 \
     --json out/bench/pinhole_ring_1000_vis0.json | grep -E "pinhole receivers|frame interval"
-  cargo test --release --test pinhole ring_accuracy_table -- --ignored --nocapture | grep "^|"
+  cargo test --release --test suite pinhole::ring_accuracy_table -- --ignored --nocapture | grep "^|"
 fi

@@ -235,7 +235,7 @@ impl Drop for Batch {
     }
 }
 
-/// A test hook (tests/interrupt.rs): `CAUSTICS_TEST_WRITE_PAUSE_MS` pauses
+/// A test hook (tests/suite/interrupt.rs): `CAUSTICS_TEST_WRITE_PAUSE_MS` pauses
 /// after each temporary is written, so that a test can aim a signal at the
 /// moment between writing and renaming.
 fn test_pause() {

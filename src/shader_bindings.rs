@@ -94,7 +94,7 @@ pub const DIRECT_BINDING_ENVIRONMENT_SH: u32 = 6;
 /// Workgroup size of glsl/direct/environment_sh.comp (one workgroup).
 pub const DIRECT_SH_GROUP_SIZE: u32 = 64;
 
-// BVH probe (glsl/tests/bvh_probe.comp, tests/bvh_gpu.rs), descriptor set 1
+// BVH probe (glsl/tests/bvh_probe.comp, tests/suite/bvh_gpu.rs), descriptor set 1
 // (set 0 is the scene). Numbers kept from the probe's first version.
 pub const PROBE_BINDING_RAYS: u32 = 10;
 pub const PROBE_BINDING_RESULTS: u32 = 11;

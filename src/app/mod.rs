@@ -23,7 +23,7 @@ mod slots;
 mod state;
 
 pub use camera::OrbitCamera;
-// For tests/overlay_layout.rs: the panel's layout without a window.
+// For tests/suite/overlay_layout.rs: the panel's layout without a window.
 #[cfg(feature = "overlay")]
 pub use overlay::{panel_rect, CompareStatus, MediumValues, UiData, View};
 use slots::ImageSemaphores;

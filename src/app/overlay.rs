@@ -388,7 +388,7 @@ mod enabled {
 
     /// The panel laid out alone on a `width` x `height` (points) screen
     /// with `data`, after enough passes for egui to size the window: its
-    /// rectangle as [left, top, right, bottom]. For tests/overlay_layout.rs.
+    /// rectangle as [left, top, right, bottom]. For tests/suite/overlay_layout.rs.
     pub fn panel_rect(data: &UiData, width: f32, height: f32) -> [f32; 4] {
         let screen = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(width, height));
         let egui = egui::Context::default();

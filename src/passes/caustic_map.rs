@@ -59,7 +59,7 @@
 //! the approximated exit, a real one there, and every remedy sends the
 //! trapped light on towards the floor (85% of the landing flux within 1 m
 //! of the gem, 8.9 W where the traced photons land 2.2 W): no energy is
-//! created (tests/image_space.rs checks that every mode lands at most the
+//! created (tests/suite/image_space.rs checks that every mode lands at most the
 //! flux that entered), but two interfaces cannot tell where a diamond
 //! lets its light out (mostly upwards). The default stays mode 0 (exact)
 //! for these reasons; mode 2 shows neither artefact on the ball lens but

@@ -4,7 +4,7 @@
 //! `GpuWaterVertex` (position, normal) in the grid order of `Water::mesh`.
 //! It is the input of the light-view raster of the water (the cascaded
 //! caustic maps of Kougianos & Moustakas 2021, §3.1: water_photons' "ccm
-//! raster" reads `vertices`); tests/water_surface.rs checks it against the
+//! raster" reads `vertices`); tests/suite/water_surface.rs checks it against the
 //! CPU evaluation.
 
 use crate::gpu::{GpuWaterVertex, GpuWave};

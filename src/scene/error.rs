@@ -92,7 +92,7 @@ impl Source<'_> {
 
 /// `text` with control characters escaped (`\n`, `\t`, `\u{1b}`): a
 /// message quoting a key or string from the file (which TOML lets hold
-/// escaped newlines) stays one line (found by tests/fuzz.rs).
+/// escaped newlines) stays one line (found by tests/suite/fuzz.rs).
 pub fn escape_control(text: &str) -> String {
     if !text.chars().any(char::is_control) {
         return text.to_owned();

@@ -92,7 +92,7 @@ fn is_dielectric(m: &tobj::Material) -> bool {
 /// Relative (negative) indices of faces, lines and points must stay within
 /// the `v`, `vt` and `vn` statements before them: tobj 4 turns one that
 /// reaches before the first into a huge index and overflows (a panic, found
-/// by tests/fuzz.rs). One pass over the bytes; only statements holding a
+/// by tests/suite/fuzz.rs). One pass over the bytes; only statements holding a
 /// `-` are parsed. The error is (1-based line, message).
 fn check_relative_indices(bytes: &[u8]) -> Result<(), (usize, String)> {
     let mut counts = [0i64; 3]; // v, vt, vn
@@ -131,7 +131,7 @@ fn check_relative_indices(bytes: &[u8]) -> Result<(), (usize, String)> {
 
 /// `Ka`, `Kd`, `Ks` and `Ke` with one number mean that number for r, g
 /// and b (the MTL format's rule); tobj 4 reads exactly three and panics on
-/// fewer (found by tests/fuzz.rs), so one is repeated here and none or two
+/// fewer (found by tests/suite/fuzz.rs), so one is repeated here and none or two
 /// are an error naming the line.
 fn complete_colours(text: &str) -> Result<String, String> {
     let mut out = String::with_capacity(text.len() + 16);

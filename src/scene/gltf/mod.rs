@@ -196,7 +196,7 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
         })
         .collect();
     // gltf-json 1.4.1's validation indexes the POSITION accessor before it
-    // checks that it exists (a panic, found by tests/fuzz.rs): check first.
+    // checks that it exists (a panic, found by tests/suite/fuzz.rs): check first.
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, prim) in mesh.primitives.iter().enumerate() {
             let position = prim.attributes.get(&json::validation::Checked::Valid(

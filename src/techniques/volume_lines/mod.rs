@@ -61,7 +61,7 @@
 //! texels x screen side (BENCHMARKS.md). The front-face reflections cross
 //! the whole medium and make most of the fragments.
 //!
-//! Checked (tests/volume_lines.rs): the image's energy against a CPU
+//! Checked (tests/suite/volume_lines.rs): the image's energy against a CPU
 //! integral of the same light rays within 0.3%, HG's g = +-0.7 ratio
 //! within 1e-4, and against the reference's L S+ V on volume_cone and
 //! smoke (+1.4% to +3.2% energy; +16% at g = -0.7, see below).

@@ -41,7 +41,7 @@
 //! zero, and every output is a convex combination of inputs (no NaN from
 //! the division: the sum of weights is at least 1). A gather filter
 //! normalises rows, not columns, of its weight matrix, so it conserves total
-//! energy only approximately: tests/denoise.rs measures the change on a
+//! energy only approximately: tests/suite/denoise.rs measures the change on a
 //! sparse photon image (an adaptive kernel that gathers wide into dark
 //! pixels and narrow at bright ones adds energy around isolated photons).
 
@@ -359,7 +359,7 @@ impl AdaptiveVsFixed {
 /// Runs both denoisers on copies of `input` (left untouched) over the
 /// G-buffer `position`, each for `frames` timed frames after a warm-up, and
 /// reads both results back. FLIP between the two is the caller's (nv-flip is
-/// a test dependency; tests/denoise.rs has the helper).
+/// a test dependency; tests/suite/denoise.rs has the helper).
 #[allow(clippy::too_many_arguments)]
 pub fn adaptive_vs_fixed(
     ctx: &Arc<Context>,

@@ -23,7 +23,7 @@
 //!    into the screen-space caustic buffer of irradiance E (W/m²). The
 //!    depth test alone let a photon on one face of a surface thinner than
 //!    the depth bias (an open quad: zero) light the other face: a thin wall
-//!    lit through itself (GUIDE §2; tests/water_photons.rs measures 201 of
+//!    lit through itself (GUIDE §2; tests/suite/water_photons.rs measures 201 of
 //!    202 W/m² on the dark side before, 0 after). It also stops splats
 //!    spilling across creases (floor onto wall, dot = 0).
 //! 4. "denoise <kind> <k> x|y" (`denoise`, glsl/water_photons/denoise.comp):
@@ -52,7 +52,7 @@
 //!    image-space search has no data there and returned the wall top's
 //!    radiance or black, so the water's near edge looked cut short and
 //!    jagged. Measured on flat water behind a wall
-//!    (tests/water_photons.rs): hidden and visible floor pixels within
+//!    (tests/suite/water_photons.rs): hidden and visible floor pixels within
 //!    0.5% (defaults) of T(θ_s) T(θ_v) albedo E cos θ_s / (π n²).
 //!
 //! Radiometry. Physical mode (`intensity_mode` 0, default): a texel of

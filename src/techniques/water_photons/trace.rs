@@ -68,7 +68,7 @@ impl PhotonCounts {
 }
 
 /// Photons after the capacity, filled with this bit pattern at creation: a
-/// guard the trace must never touch (tests/water_photons.rs checks it).
+/// guard the trace must never touch (tests/suite/water_photons.rs checks it).
 pub const GUARD_PHOTONS: u32 = 4;
 pub const GUARD_WORD: u32 = 0xDEAD_BEEF;
 

@@ -4,7 +4,7 @@
 //! that use it; the on-disk pipeline cache loader ignores a corrupt or
 //! foreign file without failing.
 
-mod common;
+use crate::common;
 
 use caustics::params::Params;
 use caustics::renderer::Renderer;

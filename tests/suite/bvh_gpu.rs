@@ -18,7 +18,7 @@
 //! tolerances above are the ones asked for a GPU that contracts to FMA.
 //! Runtime: about 0.3 s for the three scenes.
 
-mod common;
+use crate::common;
 
 use caustics::frame::SceneGpu;
 use caustics::gpu::GpuTriangle;

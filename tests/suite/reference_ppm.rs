@@ -4,7 +4,7 @@
 //! photon counts, and against the light tracer where the two must not
 //! overlap.
 
-mod common;
+use crate::common;
 
 use caustics::radiometry::fresnel_dielectric;
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};

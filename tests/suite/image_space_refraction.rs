@@ -27,7 +27,7 @@
 //! - mirror_reflects_the_floor: 1490 mirror pixels whose reflection meets
 //!   the visible floor, worst relative error 0 (bound 1e-3).
 
-mod common;
+use crate::common;
 
 use caustics::params::{ParamSet, Params};
 use caustics::radiometry::fresnel_dielectric;

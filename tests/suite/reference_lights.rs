@@ -3,7 +3,7 @@
 //! light's form-factor irradiance, and what the camera sees of emitters
 //! (the `emitted` component: L S* E).
 
-mod common;
+use crate::common;
 
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use caustics::scene::Scene;

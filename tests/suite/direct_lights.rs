@@ -10,10 +10,10 @@
 //! area lights"); the images (actual, reference, FLIP map) are written to
 //! `$CARGO_TARGET_TMPDIR/test-output/` every run. 64², 2 M photons each.
 
-mod common;
+use crate::common;
 
 use caustics::params::{ParamSet, Params};
-use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
+use caustics::reference::Component;
 use caustics::renderer::Renderer;
 use caustics::scene::Scene;
 use caustics::techniques;
@@ -60,13 +60,9 @@ fn compare(name: &str, light: &str) -> (f64, f32) {
     let actual = render_direct(&ctx, load(), &[], all);
     let unoccluded = render_direct(&ctx, load(), &["sky_rays=0".to_string()], all);
     assert_finite(&actual);
-    let mut reference =
-        ReferenceRenderer::new(&ctx, load(), SIZE, SIZE, 0.0, ReferenceSettings::default())
-            .unwrap();
-    reference.trace(PHOTONS, |_, _| {}).unwrap();
-    let truth = reference.resolve(Component::All).unwrap();
+    let reference = reference_images(&ctx, &ReferenceRequest::new(&load(), SIZE, PHOTONS));
+    let truth = reference.whole(Component::All).to_vec();
     assert_finite(&truth);
-    drop(reference);
     let energy_unoccluded = energy(&unoccluded) / energy(&truth) - 1.0;
     let energy = energy(&actual) / energy(&truth) - 1.0;
     eprintln!("{name}: without sky occlusion: energy {energy_unoccluded:+.4}");
@@ -153,9 +149,8 @@ fn direct_on_ring_sky_with_sky_occlusion() {
     let mask = first_hit_mask(&scene, SIZE, false, |k| {
         k == caustics::scene::MaterialKind::Diffuse
     });
-    let mut reference = traced_reference(&ctx, scene.clone(), SIZE, PHOTONS);
-    let truth = masked(&reference.resolve(Component::Direct).unwrap(), &mask);
-    drop(reference);
+    let reference = traced_reference(&ctx, &scene, SIZE, PHOTONS);
+    let truth = masked(reference.whole(Component::Direct), &mask);
     let ldr = |img: &[f32]| caustics::compare::metrics::tonemap(img, exposure);
     let truth_ldr = ldr(&truth);
     let mut results = Vec::new();
@@ -257,17 +252,8 @@ fn image_space_caustics_from_a_small_rect_light() {
             r.render_frame(0.0).unwrap();
             r.radiance().unwrap()
         };
-        let mut reference = ReferenceRenderer::new(
-            &ctx,
-            scene(light),
-            SIZE,
-            SIZE,
-            0.0,
-            ReferenceSettings::default(),
-        )
-        .unwrap();
-        reference.trace(4_000_000, |_, _| {}).unwrap();
-        let truth = reference.resolve(Component::SurfaceCaustics).unwrap();
+        let reference = traced_reference(&ctx, &scene(light), SIZE, 4_000_000);
+        let truth = reference.whole(Component::SurfaceCaustics);
         let energy = energy(&actual) / energy(&truth) - 1.0;
         let (flip_mean, _) = flip(&tonemap(&actual), &tonemap(&truth), SIZE);
         (energy, flip_mean)

@@ -2,6 +2,9 @@
 //! scenes built in code, camera rays, and image statistics.
 #![allow(dead_code)]
 
+pub mod reference_cache;
+pub use reference_cache::{reference_images, ReferenceImages, ReferenceRequest};
+
 use caustics::frame::camera_matrices;
 use caustics::scene::*;
 use caustics::vk::{Context, ContextOptions};
@@ -558,16 +561,12 @@ pub fn ball_lens_rect_light(size: f32) -> String {
 }
 
 /// The reference of `scene` at `size`² with the default settings, traced
-/// with `photons` photons.
+/// with `photons` photons (or read from the reference cache).
 pub fn traced_reference(
     ctx: &Arc<Context>,
-    scene: Scene,
+    scene: &Scene,
     size: u32,
     photons: u64,
-) -> caustics::reference::ReferenceRenderer {
-    let settings = caustics::reference::ReferenceSettings::default();
-    let mut reference =
-        caustics::reference::ReferenceRenderer::new(ctx, scene, size, size, 0.0, settings).unwrap();
-    reference.trace(photons, |_, _| {}).unwrap();
-    reference
+) -> Arc<ReferenceImages> {
+    reference_images(ctx, &ReferenceRequest::new(scene, size, photons))
 }

@@ -49,7 +49,7 @@
 //! On failure, actual/reference/difference (FLIP map) PNGs go to
 //! `$CARGO_TARGET_TMPDIR/test-output/`.
 
-mod common;
+use crate::common;
 
 use caustics::params::{ParamSet, Params};
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};

@@ -34,7 +34,7 @@
 //!   energy -7.2%, FLIP mean 0.094 (reference halves 0.031); bounds 0.11
 //!   and 0.12. With the defaults (1000 samples, 8 clusters): -24.3%, 0.171.
 
-mod common;
+use crate::common;
 
 use caustics::frame::{FrameTargets, SceneGpu};
 use caustics::params::ParamSet;
@@ -474,7 +474,7 @@ fn caustics_vs_reference(
     seen_directly: bool,
     name: &str,
 ) -> Accuracy {
-    use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
+    use caustics::reference::{Component, ReferenceSettings};
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(scene_file);
     let scene = Scene::load(&path).unwrap();
     let exposure = scene.output.exposure;
@@ -485,19 +485,14 @@ fn caustics_vs_reference(
         photon_mapping: !seen_directly,
         ..ReferenceSettings::default()
     };
-    let mut reference =
-        ReferenceRenderer::new(ctx, scene.clone(), size, size, 0.0, settings).unwrap();
-    reference.trace(photons / 2, |_, _| {}).unwrap();
-    let half_a = masked(
-        &reference.resolve(Component::SurfaceCaustics).unwrap(),
-        &mask,
+    let reference = reference_images(
+        ctx,
+        &ReferenceRequest::new(&scene, size, photons)
+            .in_halves()
+            .with_settings(settings),
     );
-    reference.trace(photons / 2, |_, _| {}).unwrap();
-    let truth = masked(
-        &reference.resolve(Component::SurfaceCaustics).unwrap(),
-        &mask,
-    );
-    drop(reference);
+    let half_a = masked(reference.first_half(Component::SurfaceCaustics), &mask);
+    let truth = masked(reference.whole(Component::SurfaceCaustics), &mask);
     let (noise, _) = flip(&ldr(&second_half(&truth, &half_a)), &ldr(&half_a), size);
     let t = energy(&truth);
     let truth_ldr = ldr(&truth);

@@ -5,7 +5,7 @@
 //! rejection through the CLI (exit code 1, one line naming the file and the
 //! glTF path), and the loader's linear scaling.
 
-mod common;
+use crate::common;
 
 use caustics::params::{ParamSet, Params};
 use caustics::renderer::Renderer;
@@ -670,14 +670,11 @@ fn emissive_gltf_quad_equals_the_toml_rect_light() {
     assert!(worst <= 1e-5 * peak, "max difference {worst}, peak {peak}");
 
     // The reference: the floor's direct light and the lamp seen directly.
-    use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
+    use caustics::reference::Component;
     let render = |scene: Scene| {
         let ctx = validated_context();
-        let mut r =
-            ReferenceRenderer::new(&ctx, scene, 48, 48, 0.0, ReferenceSettings::default()).unwrap();
-        r.trace(2_000_000, |_, _| {}).unwrap();
-        let out = [Component::Direct, Component::Emitted].map(|c| energy(&r.resolve(c).unwrap()));
-        drop(r);
+        let r = traced_reference(&ctx, &scene, 48, 2_000_000);
+        let out = [Component::Direct, Component::Emitted].map(|c| energy(r.whole(c)));
         assert_validation_clean(&ctx);
         out
     };

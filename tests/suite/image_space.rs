@@ -106,7 +106,7 @@
 //!   photon pass and are bit-identical to recomputing; a new time and a
 //!   moved light recompute (bit-identical too).
 
-mod common;
+use crate::common;
 
 use caustics::params::{ParamSet, Params};
 use caustics::passes::caustic_map::GpuPhoton;
@@ -559,7 +559,7 @@ struct Bound {
 /// not estimate (docs/ARCHITECTURE.md, "What the ground truth does not
 /// cover"); the others read 0 in both images and stay in the FLIP mean.
 fn caustics_match_reference(name: &str, photons: u64, bounds: &[Bound]) {
-    use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
+    use caustics::reference::Component;
     use caustics::renderer::Renderer;
     let ctx = validated_context();
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -581,14 +581,13 @@ fn caustics_match_reference(name: &str, photons: u64, bounds: &[Bound]) {
         k == caustics::scene::MaterialKind::Diffuse
     });
     let masked = |img: Vec<f32>| masked(&img, &mask);
-    let mut reference =
-        ReferenceRenderer::new(&ctx, load(), SIZE, SIZE, 0.0, ReferenceSettings::default())
-            .unwrap();
     // Two halves, to measure the reference's own noise in FLIP terms.
-    reference.trace(photons / 2, |_, _| {}).unwrap();
-    let half_a = masked(reference.resolve(Component::SurfaceCaustics).unwrap());
-    reference.trace(photons / 2, |_, _| {}).unwrap();
-    let truth = masked(reference.resolve(Component::SurfaceCaustics).unwrap());
+    let reference = reference_images(
+        &ctx,
+        &ReferenceRequest::new(&load(), SIZE, photons).in_halves(),
+    );
+    let half_a = masked(reference.first_half(Component::SurfaceCaustics).to_vec());
+    let truth = masked(reference.whole(Component::SurfaceCaustics).to_vec());
     let half_b = second_half(&truth, &half_a);
     let (noise_flip, _) = flip(&tonemap(&half_b), &tonemap(&half_a), SIZE);
     let truth_ldr = tonemap(&truth);
@@ -596,10 +595,9 @@ fn caustics_match_reference(name: &str, photons: u64, bounds: &[Bound]) {
     let halves = (energy(&half_b) - energy(&half_a)) / t;
     println!(
         "{name}: reference L S+ D energy {t:.2} ({} M photons); its two halves differ by {halves:+.4} in energy, {noise_flip:.4} in FLIP mean",
-        reference.reference.photons / 1_000_000
+        reference.photons / 1_000_000
     );
     assert!(t > 0.0, "{name}: the reference has no caustic");
-    drop(reference);
     let direct = masked(frame("direct", &[]));
     let mut failures = Vec::new();
     for bound in bounds {

@@ -45,13 +45,13 @@
 //!   it reads -22.3%, with 2 -11.9% but +70% at g = 0.7); light
 //!   reflected inside the glass is not drawn (it is in the reference).
 
-mod common;
+use crate::common;
 
 use caustics::bvh::Bvh;
 use caustics::frame::{FrameTargets, SceneGpu};
 use caustics::params::ParamSet;
 use caustics::passes::light_views::{photon_view, specular_bounds};
-use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
+use caustics::reference::Component;
 use caustics::scene::{MaterialKind, Scene};
 use caustics::techniques::volume_lines::{GpuSegment, VolumeLines, VolumeLinesParams};
 use caustics::techniques::Technique;
@@ -173,26 +173,12 @@ fn matches_reference(ctx: &Arc<Context>, label: &str, scene: &Scene, photons: u6
     // volume gather along camera chains): pixels whose camera ray meets a
     // specular surface first are zeroed in both images.
     let mask = first_hit_mask(scene, SIZE, true, |k| k == MaterialKind::Diffuse);
-    let mut reference = ReferenceRenderer::new(
+    let reference = reference_images(
         ctx,
-        scene.clone(),
-        SIZE,
-        SIZE,
-        0.0,
-        ReferenceSettings::default(),
-    )
-    .unwrap();
-    reference.trace(photons / 2, |_, _| {}).unwrap();
-    let half_a = masked(
-        &reference.resolve(Component::VolumeCaustics).unwrap(),
-        &mask,
+        &ReferenceRequest::new(scene, SIZE, photons).in_halves(),
     );
-    reference.trace(photons / 2, |_, _| {}).unwrap();
-    let truth = masked(
-        &reference.resolve(Component::VolumeCaustics).unwrap(),
-        &mask,
-    );
-    drop(reference);
+    let half_a = masked(reference.first_half(Component::VolumeCaustics), &mask);
+    let truth = masked(reference.whole(Component::VolumeCaustics), &mask);
     let half_b = second_half(&truth, &half_a);
     let (noise_flip, _) = flip(&tonemap(&half_b), &tonemap(&half_a), SIZE);
     let t = energy(&truth);

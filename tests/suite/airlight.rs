@@ -21,14 +21,14 @@
 //!
 //! Measured values are in each bound's comment and in BENCHMARKS.md.
 
-mod common;
+use crate::common;
 
 use caustics::frame::{FrameTargets, SceneGpu};
 use caustics::params::{ParamSet, ParamSpec, Params};
 use caustics::passes::airlight::{Airlight, AirlightParams};
 use caustics::passes::direct_light::{DirectLight, DirectParams};
 use caustics::radiometry::spot_falloff;
-use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
+use caustics::reference::Component;
 use caustics::scene::{Density, LightKind, Medium, Scene};
 use caustics::vk::{Context, Profiler};
 use common::*;
@@ -467,22 +467,14 @@ fn against_reference_away(
     let keep = |img: &[f32]| masked(img, &comparable);
     let (whole, ms) = render_airlight_at(&ctx, &s, &[], REF_SIZE);
     let actual = keep(&whole);
-    let mut reference = ReferenceRenderer::new(
+    let reference = reference_images(
         &ctx,
-        s,
-        REF_SIZE,
-        REF_SIZE,
-        0.0,
-        ReferenceSettings::default(),
-    )
-    .unwrap();
-    reference.trace(PHOTONS / 2, |_, _| {}).unwrap();
-    let half_a = keep(&reference.resolve(Component::Airlight).unwrap());
-    reference.trace(PHOTONS / 2, |_, _| {}).unwrap();
-    let whole_truth = reference.resolve(Component::Airlight).unwrap();
+        &ReferenceRequest::new(&s, REF_SIZE, PHOTONS).in_halves(),
+    );
+    let half_a = keep(reference.first_half(Component::Airlight));
+    let whole_truth = reference.whole(Component::Airlight).to_vec();
     let truth = keep(&whole_truth);
     assert_finite(&truth);
-    drop(reference);
     let half_b = second_half(&truth, &half_a);
     let sum = |img: &[f32]| {
         img.chunks(4)

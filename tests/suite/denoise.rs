@@ -6,7 +6,7 @@
 //! Measured (lavapipe, Mesa 22.3.6, `cargo test --test denoise -- --nocapture`):
 //! see each test's comment; the bounds sit above the measurements with a margin.
 
-mod common;
+use crate::common;
 
 use caustics::scene::Camera;
 use caustics::techniques::water_photons::denoise::{

@@ -6,7 +6,7 @@
 //! between two passes of a frame (on lavapipe the profiler then records the
 //! frame into one command buffer instead of waiting after every pass).
 
-mod common;
+use crate::common;
 
 use caustics::vk::{Buffer, BufferUsage, Profiler, TimingSource};
 

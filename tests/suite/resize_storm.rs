@@ -7,7 +7,7 @@
 //! allocations after the storm equal those before it (within 1%, measured
 //! exactly equal), and the frame at the first size renders the same image.
 
-mod common;
+use crate::common;
 
 use caustics::params::Params;
 use caustics::renderer::Renderer;

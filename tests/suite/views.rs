@@ -8,10 +8,10 @@
 //! bounds are the measurements (BENCHMARKS.md, "Where users look") plus a
 //! margin: energy |measured| + 0.05, FLIP 1.25 x measured.
 
-mod common;
+use crate::common;
 
 use caustics::params::Params;
-use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
+use caustics::reference::Component;
 use caustics::renderer::Renderer;
 use caustics::scene::Scene;
 use caustics::techniques;
@@ -52,23 +52,14 @@ fn compare(scene: &str, technique: &str, overrides: &[&str], photons: u64, bound
     drop(renderer);
     ours.iter().for_each(|img| assert_finite(img));
 
-    let mut reference = ReferenceRenderer::new(
-        &ctx,
-        load(scene),
-        SIZE,
-        SIZE,
-        0.0,
-        ReferenceSettings::default(),
-    )
-    .unwrap();
-    reference.trace(photons, |_, _| {}).unwrap();
+    let reference = traced_reference(&ctx, &load(scene), SIZE, photons);
     let truth = [
-        reference.resolve(Component::Direct).unwrap(),
-        reference.resolve(Component::SurfaceCaustics).unwrap(),
-        reference.resolve(Component::All).unwrap(),
-    ];
-    let noise = reference.noise().unwrap().unwrap_or(f64::NAN);
-    drop(reference);
+        Component::Direct,
+        Component::SurfaceCaustics,
+        Component::All,
+    ]
+    .map(|c| reference.whole(c).to_vec());
+    let noise = reference.noise.unwrap_or(f64::NAN);
 
     let names = ["direct", "surface_caustics", "all"];
     let limits = [

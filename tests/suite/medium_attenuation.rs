@@ -20,10 +20,10 @@
 //! Measured (lavapipe, Mesa 22.3.6, 2 cores; `-- --nocapture`): see the
 //! constants' comments.
 
-mod common;
+use crate::common;
 
 use caustics::params::{ParamSet, Params};
-use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
+use caustics::reference::Component;
 use caustics::renderer::Renderer;
 use caustics::scene::{Density, Medium, Scene};
 use caustics::techniques;
@@ -207,23 +207,15 @@ fn sum_rgb(img: &[f32]) -> f64 {
 fn compare_with_reference(path: &str, name: &str) -> (f64, f32, f32) {
     let ctx = validated_context();
     let actual = render_direct(&ctx, without_lens(path), &[]);
-    let mut reference = ReferenceRenderer::new(
+    let reference = reference_images(
         &ctx,
-        without_lens(path),
-        SIZE,
-        SIZE,
-        0.0,
-        ReferenceSettings::default(),
-    )
-    .unwrap();
-    reference.trace(PHOTONS / 2, |_, _| {}).unwrap();
-    let half_a = reference.resolve(Component::Direct).unwrap();
-    reference.trace(PHOTONS / 2, |_, _| {}).unwrap();
-    let truth = reference.resolve(Component::Direct).unwrap();
+        &ReferenceRequest::new(&without_lens(path), SIZE, PHOTONS).in_halves(),
+    );
+    let half_a = reference.first_half(Component::Direct);
+    let truth = reference.whole(Component::Direct).to_vec();
     assert_finite(&truth);
-    drop(reference);
-    let half_b = second_half(&truth, &half_a);
-    let (noise_flip, _) = flip(&tonemap(&half_b), &tonemap(&half_a), SIZE);
+    let half_b = second_half(&truth, half_a);
+    let (noise_flip, _) = flip(&tonemap(&half_b), &tonemap(half_a), SIZE);
     let energy = (sum_rgb(&actual) - sum_rgb(&truth)).abs() / sum_rgb(&truth);
     let (flip_mean, flip_map) = flip(&tonemap(&actual), &tonemap(&truth), SIZE);
     eprintln!(
@@ -298,12 +290,8 @@ fn image_space_caustics_are_attenuated_like_the_reference() {
     let direct = frame("direct");
     assert_finite(&full);
     let caustic: Vec<f32> = full.iter().zip(&direct).map(|(a, b)| a - b).collect();
-    let mut reference =
-        ReferenceRenderer::new(&ctx, load(), SIZE, SIZE, 0.0, ReferenceSettings::default())
-            .unwrap();
-    reference.trace(CAUSTIC_PHOTONS, |_, _| {}).unwrap();
-    let truth = masked(reference.resolve(Component::SurfaceCaustics).unwrap());
-    drop(reference);
+    let reference = traced_reference(&ctx, &load(), SIZE, CAUSTIC_PHOTONS);
+    let truth = masked(reference.whole(Component::SurfaceCaustics).to_vec());
     let energy = (sum_rgb(&caustic) - sum_rgb(&truth)) / sum_rgb(&truth);
     let (flip_mean, flip_map) = flip(&tonemap(&caustic), &tonemap(&truth), SIZE);
     eprintln!("volume_cone caustics: relative energy {energy:+.4}, FLIP mean {flip_mean:.4}");

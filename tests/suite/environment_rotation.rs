@@ -7,7 +7,7 @@
 //! map follows the sun's stand-in). Both renderers draw two frames, so the
 //! per-frame random numbers agree. Validation on.
 
-mod common;
+use crate::common;
 
 use caustics::params::Params;
 use caustics::renderer::Renderer;

@@ -5,7 +5,7 @@
 //! descriptor set rewritten under a pending frame or a resource freed early
 //! shows up as a different image or a validation error.
 
-mod common;
+use crate::common;
 
 use caustics::params::Params;
 use caustics::renderer::Renderer;

@@ -5,7 +5,7 @@
 //! light placed where the motion puts it. `assets/scenes/moving_lights.toml`
 //! is the paper's dynamic-lighting scene (Wand & Straßer 2003, Fig. 7c).
 
-mod common;
+use crate::common;
 
 use caustics::params::Params;
 use caustics::renderer::Renderer;

@@ -1,7 +1,7 @@
 //! The ground-truth light tracer against analytic answers (GUIDE §3, issue: the
 //! reference must agree with them before any technique is judged against it).
 
-mod common;
+use crate::common;
 
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use common::*;

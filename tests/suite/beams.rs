@@ -7,7 +7,7 @@
 //! see each test's comment; BENCHMARKS.md has the comparisons with the
 //! reference.
 
-mod common;
+use crate::common;
 
 use caustics::bvh::Bvh;
 use caustics::frame::{camera_matrices, FrameTargets, SceneGpu};
@@ -533,13 +533,14 @@ fn reference_truth_with(
     settings: ReferenceSettings,
 ) -> Truth {
     let mask = first_hit_mask(scene, size, true, |k| k == MaterialKind::Diffuse);
-    let mut reference =
-        ReferenceRenderer::new(ctx, scene.clone(), size, size, 0.0, settings).unwrap();
-    reference.trace(photons / 2, |_, _| {}).unwrap();
-    let half_a = masked(&reference.resolve(component).unwrap(), &mask);
-    reference.trace(photons / 2, |_, _| {}).unwrap();
-    let img = masked(&reference.resolve(component).unwrap(), &mask);
-    drop(reference);
+    let reference = reference_images(
+        ctx,
+        &ReferenceRequest::new(scene, size, photons)
+            .in_halves()
+            .with_settings(settings),
+    );
+    let half_a = masked(reference.first_half(component), &mask);
+    let img = masked(reference.whole(component), &mask);
     let half_b = second_half(&img, &half_a);
     let (noise_flip, _) = flip(&tonemap(&half_b), &tonemap(&half_a), size);
     let halves = (energy(&half_b) - energy(&half_a)) / energy(&img);

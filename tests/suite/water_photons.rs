@@ -31,7 +31,7 @@
 //! - Host memory stays flat over 60 frames (`bench --memory-samples`): no
 //!   shader of the technique makes lavapipe recompile it at every bind.
 
-mod common;
+use crate::common;
 
 use caustics::cascades::CascadeLayout;
 use caustics::frame::{FrameTargets, SceneGpu};
@@ -546,7 +546,7 @@ fn masked_flip_mean(map: &caustics::compare::metrics::FlipMap, mask: &[bool]) ->
 /// time ratio. Every variant keeps the energy within 4%.
 #[test]
 fn pool_caustics_from_below_match_the_reference() {
-    use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
+    use caustics::reference::Component;
     use caustics::techniques::water_photons::CascadeFrame;
     let ctx = validated_context();
     let below = || {
@@ -555,12 +555,9 @@ fn pool_caustics_from_below_match_the_reference() {
         s.camera = camera(Vec3::new(0.5, 0.9, 2.6), Vec3::new(-0.3, 0.0, -1.0), 60.0);
         s
     };
-    let mut reference =
-        ReferenceRenderer::new(&ctx, below(), SIZE, SIZE, 0.0, ReferenceSettings::default())
-            .unwrap();
-    reference.trace(4_000_000, |_, _| {}).unwrap();
-    let truth = reference.resolve(Component::SurfaceCaustics).unwrap();
-    drop(reference);
+    let truth = traced_reference(&ctx, &below(), SIZE, 4_000_000)
+        .whole(Component::SurfaceCaustics)
+        .to_vec();
     let truth_ldr = tonemap(&scaled(&truth));
 
     // The compared pixels: those whose first hit is a diffuse surface

@@ -7,7 +7,7 @@
 //!
 //! The textures are written by the tests themselves into a temp folder.
 
-mod common;
+use crate::common;
 
 use caustics::params::{ParamSet, Params};
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
@@ -91,10 +91,9 @@ fn render_reference(
     size: u32,
     photons: u64,
 ) -> Vec<f32> {
-    let mut reference =
-        ReferenceRenderer::new(ctx, scene, size, size, 0.0, ReferenceSettings::default()).unwrap();
-    reference.trace(photons, |_, _| {}).unwrap();
-    let out = reference.resolve(Component::Direct).unwrap();
+    let out = traced_reference(ctx, &scene, size, photons)
+        .whole(Component::Direct)
+        .to_vec();
     assert_finite(&out);
     out
 }

@@ -21,7 +21,7 @@
 //! per-vertex bounds of 2e-4 to 1.5e-3. lavapipe's sin and cos are far more
 //! accurate than the 2^-11 the bound allows. Runtime about 0.2 s.
 
-mod common;
+use crate::common;
 
 use caustics::gpu::GpuWaterVertex;
 use caustics::passes::water_surface::WaterSurface;

@@ -12,7 +12,7 @@
 //!   the wall's L S+ D over the patch's centre against albedo/π ρ E: -0.35%
 //!   (bound 3%).
 
-mod common;
+use crate::common;
 
 use caustics::params::{ParamSet, Params};
 use caustics::reference::Component;
@@ -103,10 +103,9 @@ fn mixed_floor_under_a_constant_sky() {
          [[object]]\nshape = \"plane\"\nsize = [20.0, 20.0]\nmaterial = \"floor\"\n"
     );
     let ctx = validated_context();
-    let mut reference = traced_reference(&ctx, load(&text), SIZE, 2_000_000);
-    let all = reference.resolve(Component::All).unwrap();
-    let emitted = reference.resolve(Component::Emitted).unwrap();
-    drop(reference);
+    let reference = traced_reference(&ctx, &load(&text), SIZE, 2_000_000);
+    let all = reference.whole(Component::All);
+    let emitted = reference.whole(Component::Emitted);
     assert_finite(&all);
     let every = |_, _| true;
     let rel_all = mean(&all, every) / (a + rho) - 1.0;
@@ -154,9 +153,8 @@ fn mixed_plate_reflects_its_mirror_part() {
          [[object]]\nshape = \"plane\"\ncenter = [2.0, 0.0, 0.0]\nnormal = [-1.0, 0.0, 0.0]\nsize = [4.0, 4.0]\nmaterial = \"wall\"\n"
     );
     let ctx = validated_context();
-    let mut reference = traced_reference(&ctx, load(&text), SIZE, 4_000_000);
-    let caustic = reference.resolve(Component::SurfaceCaustics).unwrap();
-    drop(reference);
+    let reference = traced_reference(&ctx, &load(&text), SIZE, 4_000_000);
+    let caustic = reference.whole(Component::SurfaceCaustics);
     assert_finite(&caustic);
     // Pixel (x, y) sees the wall at (y, z) = (1 - (y + 1/2) 2 / size,
     // (x + 1/2) 2 / size - 1); the patch is |y| < 0.354, |z| < 0.5.
