@@ -38,6 +38,18 @@ impl std::fmt::Write for Fnv1a {
     }
 }
 
+/// A stable 64-bit hash (FNV-1a) of `parts`, each length-prefixed so that
+/// moving bytes between parts changes it; the tests' reference cache keys
+/// its code hash with it (tests/suite/common/reference_cache.rs).
+pub fn stable_hash<'a>(parts: impl IntoIterator<Item = &'a [u8]>) -> u64 {
+    let mut h = Fnv1a::new();
+    for part in parts {
+        h.bytes(&(part.len() as u64).to_le_bytes());
+        h.bytes(part);
+    }
+    h.0
+}
+
 /// What a reference image depends on, besides the scene.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ReferenceKey {

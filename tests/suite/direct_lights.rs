@@ -254,8 +254,8 @@ fn image_space_caustics_from_a_small_rect_light() {
         };
         let reference = traced_reference(&ctx, &scene(light), SIZE, 4_000_000);
         let truth = reference.whole(Component::SurfaceCaustics);
-        let energy = energy(&actual) / energy(&truth) - 1.0;
-        let (flip_mean, _) = flip(&tonemap(&actual), &tonemap(&truth), SIZE);
+        let energy = energy(&actual) / energy(truth) - 1.0;
+        let (flip_mean, _) = flip(&tonemap(&actual), &tonemap(truth), SIZE);
         (energy, flip_mean)
     };
     let (energy, flip_mean) = measure(&rect(0.05));

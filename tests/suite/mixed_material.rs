@@ -106,10 +106,10 @@ fn mixed_floor_under_a_constant_sky() {
     let reference = traced_reference(&ctx, &load(&text), SIZE, 2_000_000);
     let all = reference.whole(Component::All);
     let emitted = reference.whole(Component::Emitted);
-    assert_finite(&all);
+    assert_finite(all);
     let every = |_, _| true;
-    let rel_all = mean(&all, every) / (a + rho) - 1.0;
-    let rel_emitted = mean(&emitted, every) / rho - 1.0;
+    let rel_all = mean(all, every) / (a + rho) - 1.0;
+    let rel_emitted = mean(emitted, every) / rho - 1.0;
     let params = Params::resolve("direct", techniques::direct::DirectParams::specs(), &[]).unwrap();
     let direct = {
         let mut r = Renderer::new(&ctx, load(&text), "direct", &params, SIZE, SIZE, 0.0).unwrap();
@@ -155,7 +155,7 @@ fn mixed_plate_reflects_its_mirror_part() {
     let ctx = validated_context();
     let reference = traced_reference(&ctx, &load(&text), SIZE, 4_000_000);
     let caustic = reference.whole(Component::SurfaceCaustics);
-    assert_finite(&caustic);
+    assert_finite(caustic);
     // Pixel (x, y) sees the wall at (y, z) = (1 - (y + 1/2) 2 / size,
     // (x + 1/2) 2 / size - 1); the patch is |y| < 0.354, |z| < 0.5.
     let centre = |x: usize, y: usize| {
@@ -164,7 +164,7 @@ fn mixed_plate_reflects_its_mirror_part() {
         wy.abs() < 0.15 && wz.abs() < 0.25
     };
     let expected = wall / std::f64::consts::PI * rho * e;
-    let rel = mean(&caustic, centre) / expected - 1.0;
+    let rel = mean(caustic, centre) / expected - 1.0;
     println!("wall's L S+ D over the patch's centre: {rel:+.4} of albedo/π ρ E");
     assert!(rel.abs() < 0.03, "mirror part off by {rel:+.4}");
     assert_validation_clean(&ctx);

@@ -3,8 +3,9 @@
 //! the first request and then served from memory (other tests of the run)
 //! and from `target/tmp/reference-cache/` (later runs).
 //!
-//! The cache is content-addressed: the key hashes everything that decides
-//! the images, so a change of any input is a miss, never a stale hit:
+//! The cache is content-addressed (`caustics compare`'s `cache_key`, with
+//! the tests' additions): the key hashes everything that decides the
+//! images, so a change of any input is a miss, never a stale hit:
 //! - the scene as resolved (its `Debug` text: every position, material,
 //!   light and texel; Rust prints floats so that they read back exactly;
 //!   not the path it was loaded by),
@@ -23,11 +24,11 @@
 //! `CAUSTICS_REFERENCE_CACHE=off` traces everything anew (nothing read or
 //! written); deleting the folder does the same once.
 
+use caustics::compare::{cache_key, stable_hash, ReferenceKey};
 use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use caustics::scene::Scene;
 use caustics::vk::Context;
 use std::collections::HashMap;
-use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -197,36 +198,11 @@ impl ReferenceImages {
     }
 }
 
-/// A 128-bit content hash: two SipHash-1-3 streams with different keys
-/// (std's `DefaultHasher::new()` has fixed keys, so it is stable for a
-/// given toolchain; a toolchain that hashes otherwise only misses).
-struct ContentHash([std::collections::hash_map::DefaultHasher; 2]);
-
-impl ContentHash {
-    fn new() -> Self {
-        let mut h = [
-            std::collections::hash_map::DefaultHasher::new(),
-            std::collections::hash_map::DefaultHasher::new(),
-        ];
-        1u8.hash(&mut h[1]);
-        Self(h)
-    }
-    fn add(&mut self, bytes: &[u8]) {
-        for h in &mut self.0 {
-            bytes.len().hash(h);
-            h.write(bytes);
-        }
-    }
-    fn hex(&self) -> String {
-        format!("{:016x}{:016x}", self.0[0].finish(), self.0[1].finish())
-    }
-}
-
 /// The hash of the renderer's code as it is on disk now (see the module
 /// docs), computed once per process.
-fn code_hash() -> &'static str {
-    static HASH: OnceLock<String> = OnceLock::new();
-    HASH.get_or_init(|| {
+fn code_hash() -> u64 {
+    static HASH: OnceLock<u64> = OnceLock::new();
+    *HASH.get_or_init(|| {
         let root = Path::new(env!("CARGO_MANIFEST_DIR"));
         let mut files = Vec::new();
         for dir in ["src", "glsl"] {
@@ -236,12 +212,18 @@ fn code_hash() -> &'static str {
             files.push(root.join(file));
         }
         files.sort();
-        let mut h = ContentHash::new();
-        for f in files {
-            h.add(f.strip_prefix(root).unwrap().to_string_lossy().as_bytes());
-            h.add(&std::fs::read(&f).unwrap_or_default());
-        }
-        h.hex()
+        let parts: Vec<(String, Vec<u8>)> = files
+            .iter()
+            .map(|f| {
+                let name = f.strip_prefix(root).unwrap().to_string_lossy().into_owned();
+                (name, std::fs::read(f).unwrap_or_default())
+            })
+            .collect();
+        stable_hash(
+            parts
+                .iter()
+                .flat_map(|(name, bytes)| [name.as_bytes(), bytes.as_slice()]),
+        )
     })
 }
 
@@ -259,25 +241,30 @@ fn collect_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-fn key(ctx: &Context, req: &ReferenceRequest) -> String {
-    let mut h = ContentHash::new();
-    h.add(code_hash().as_bytes());
-    h.add(format!("{} {}", ctx.info.name, ctx.info.driver).as_bytes());
+/// `caustics compare`'s cache key (the resolved scene, the size, the
+/// settings, the reference shaders) with what the tests need beside it:
+/// the photon schedule, the host code and the device.
+fn key(device: &str, req: &ReferenceRequest) -> String {
     // The file a scene came from only resolved its relative paths while it
     // was loaded; the same file loaded by another path is the same scene.
     let scene = Scene {
         source: PathBuf::new(),
         ..req.scene.clone()
     };
-    h.add(format!("{scene:?}").as_bytes());
-    h.add(
-        format!(
-            "{}x{} {:?} {} {}",
-            req.width, req.height, req.settings, req.photons, req.halves
-        )
-        .as_bytes(),
-    );
-    h.hex()
+    let key = ReferenceKey {
+        width: req.width,
+        height: req.height,
+        time: 0.0,
+        diffuse_bounces: req.settings.diffuse_bounces,
+        budget: format!(
+            "photons {} in halves {}; code {:016x}; device {device}",
+            req.photons,
+            req.halves,
+            code_hash(),
+        ),
+        settings: format!("{:?}", req.settings),
+    };
+    cache_key(&scene, &key)
 }
 
 fn cache_dir() -> PathBuf {
@@ -297,7 +284,7 @@ pub fn reference_images(ctx: &Arc<Context>, req: &ReferenceRequest) -> Arc<Refer
     }
     type Slot = Arc<Mutex<Option<Arc<ReferenceImages>>>>;
     static SLOTS: OnceLock<Mutex<HashMap<String, Slot>>> = OnceLock::new();
-    let key = key(ctx, req);
+    let key = key(&format!("{} {}", ctx.info.name, ctx.info.driver), req);
     let slot = SLOTS
         .get_or_init(Default::default)
         .lock()
@@ -355,4 +342,71 @@ fn store(path: &Path, bytes: &[u8]) {
         let _ = std::fs::remove_file(&tmp);
         eprintln!("reference cache: could not store {}", path.display());
     }
+}
+
+/// Every input of the key changes it, the same inputs give the same key
+/// (whatever path the scene was loaded by), and an entry reads back as it
+/// was written while a torn one reads as a miss.
+#[test]
+fn reference_cache_key_and_entries() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/ball_lens.toml");
+    let scene = Scene::load(&path).unwrap();
+    let req = ReferenceRequest::new(&scene, 64, 1 << 20);
+    let base = key("lavapipe", &req);
+    let same_file = Scene::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/environments/../scenes/ball_lens.toml"),
+    )
+    .unwrap();
+    assert_eq!(
+        base,
+        key("lavapipe", &ReferenceRequest::new(&same_file, 64, 1 << 20))
+    );
+    let mut brighter = scene.clone();
+    brighter.lights[0].intensity *= 2.0;
+    let seeded = ReferenceSettings {
+        seed: 1,
+        ..ReferenceSettings::default()
+    };
+    let changed = [
+        key("another device", &req),
+        key("lavapipe", &ReferenceRequest::new(&brighter, 64, 1 << 20)),
+        key(
+            "lavapipe",
+            &ReferenceRequest {
+                width: 65,
+                ..req.clone()
+            },
+        ),
+        key(
+            "lavapipe",
+            &ReferenceRequest {
+                height: 65,
+                ..req.clone()
+            },
+        ),
+        key("lavapipe", &ReferenceRequest::new(&scene, 64, 1 << 21)),
+        key("lavapipe", &req.clone().in_halves()),
+        key("lavapipe", &req.clone().with_settings(seeded)),
+    ];
+    for (i, k) in changed.iter().enumerate() {
+        assert_ne!(*k, base, "input {i} left the key unchanged");
+    }
+
+    let images = ReferenceImages {
+        photons: 1 << 20,
+        noise: Some(0.25),
+        first_half: vec![vec![1.0, -2.5, f32::MAX, 0.0]; Component::NAMED.len()],
+        whole: vec![vec![0.5; 8]; Component::NAMED.len()],
+    };
+    let bytes = images.to_bytes();
+    let back = ReferenceImages::from_bytes(&bytes).expect("a whole entry");
+    assert_eq!(back.photons, images.photons);
+    assert_eq!(back.noise, images.noise);
+    assert_eq!(back.first_half, images.first_half);
+    assert_eq!(back.whole, images.whole);
+    assert!(ReferenceImages::from_bytes(&bytes[..bytes.len() - 1]).is_none());
+    let mut longer = bytes.clone();
+    longer.push(0);
+    assert!(ReferenceImages::from_bytes(&longer).is_none());
+    assert!(ReferenceImages::from_bytes(b"CAUREF00").is_none());
 }
