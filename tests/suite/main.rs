@@ -1,9 +1,12 @@
 //! The integration tests, one binary (one link of the crate instead of one
 //! per file). Each module is a test group, named as its file; run one group
 //! with `cargo test --test suite -- GROUP::` (e.g. `reference::`), one test
-//! with its full path. Every test opens its own validated lavapipe context
+//! with its full path. Every test that renders opens its own validated context
 //! (`common::validated_context`), so groups share nothing but the process
 //! and the reference cache (`common::reference_cache`).
+//!
+//! Two tests stay a binary of their own: tests/scene_scaling.rs measures wall
+//! time, which the suite's other tests, running beside it, would disturb.
 
 mod common;
 
@@ -37,7 +40,6 @@ mod reference_lights;
 mod reference_ppm;
 mod resize_storm;
 mod scene_loading;
-mod scene_scaling;
 mod scene_values;
 mod sync_validation;
 mod textures;
