@@ -9,9 +9,18 @@
 //! and cargo runs test binaries one after another, so nothing else runs
 //! beside it. Inside the suite, beside the reference renders, a doubling
 //! measured 3.06x (2026-12-03) and the test failed for the load, not for
-//! the loader.
+//! the loader. The glTF loader's test (thread CPU time) moved here from
+//! tests/suite/gltf.rs for the same reason: in the suite it read 3x once.
 
-use caustics::scene::Scene;
+#[allow(dead_code)]
+#[path = "suite/common/gltf_builder.rs"]
+mod gltf_builder;
+use gltf_builder::Gltf;
+
+use caustics::scene::gltf as loader;
+use caustics::scene::{Mesh, Scene};
+use glam::{Vec2, Vec3};
+use serde_json::json;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -155,4 +164,85 @@ fn obj_with_many_materials_loads_linearly() {
         .collect();
     let _ = std::fs::remove_dir_all(&root);
     assert_linear("OBJ of n quads and n MTL materials", &OBJ_SIZES, &times);
+}
+
+// ------------------------------------------------------------ glTF
+
+/// A grid of `n` x `n` quads (2 n² triangles) with normals and UVs, as .glb.
+fn grid_glb(dir: &Path, n: u32) -> PathBuf {
+    let mut m = Mesh::default();
+    let mut uv = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (u, v) = (i as f32 / n as f32, j as f32 / n as f32);
+            m.positions.push(Vec3::new(u, (u * 7.0).sin() * 0.05, v));
+            m.normals.push(Vec3::Y);
+            uv.push(Vec2::new(u, v));
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let a = j * (n + 1) + i;
+            m.indices.push([a, a + n + 1, a + 1]);
+            m.indices.push([a + 1, a + n + 1, a + n + 2]);
+        }
+    }
+    let mut g = Gltf::new();
+    let mesh = g.mesh(&m, true, None);
+    let uv_acc = g.vec2s(&uv);
+    g.root["meshes"][mesh]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uv_acc);
+    g.root_node(json!({"mesh": mesh}));
+    g.write_glb(dir, &format!("grid{n}"))
+}
+
+/// CPU time of the calling thread in seconds, from the scheduler's own
+/// accounting (`/proc/thread-self/schedstat`, nanoseconds): what the load
+/// costs, untouched by how many other processes share the cores.
+fn thread_cpu_seconds() -> f64 {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat")
+        .expect("/proc/thread-self/schedstat (Linux)");
+    let ns: u64 = text.split_whitespace().next().unwrap().parse().unwrap();
+    ns as f64 * 1e-9
+}
+
+/// The loader's CPU time on `path` (it runs on the calling thread).
+fn load_seconds(path: &Path) -> f64 {
+    let start = thread_cpu_seconds();
+    let a = loader::load(path).unwrap();
+    let s = thread_cpu_seconds() - start;
+    assert!(!a.mesh.indices.is_empty());
+    s
+}
+
+fn median(mut t: Vec<f64>) -> f64 {
+    t.sort_by(f64::total_cmp);
+    t[t.len() / 2]
+}
+
+/// Twice the triangles take at most about twice the time (3x allowed for
+/// noise; a quadratic step would give 4x). Timed as the thread's CPU time
+/// (wall clock on 2 cores shared with parallel tests and builds varied 3x
+/// between runs), the two sizes in turn, median of 7 each; both are large
+/// enough that the allocator serves them alike (fresh pages).
+#[test]
+fn loading_scales_linearly_with_the_triangle_count() {
+    let dir = std::env::temp_dir().join(format!("caustics-gltf-scaling-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    // 2 * 226² = 102,152 and 2 * 320² = 204,800 triangles.
+    let (small, large) = (grid_glb(&dir, 226), grid_glb(&dir, 320));
+    load_seconds(&small); // warm the file cache and the allocator
+    load_seconds(&large);
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    for _ in 0..7 {
+        a.push(load_seconds(&small));
+        b.push(load_seconds(&large));
+    }
+    let (a, b) = (median(a), median(b));
+    eprintln!(
+        "load (thread CPU time): 102,152 triangles {:.1} ms, 204,800 {:.1} ms",
+        a * 1e3,
+        b * 1e3
+    );
+    assert!(b < 3.0 * a, "{b} s for twice the triangles of {a} s");
 }

@@ -5,8 +5,9 @@
 //! (`common::validated_context`), so groups share nothing but the process
 //! and the reference cache (`common::reference_cache`).
 //!
-//! Two tests stay a binary of their own: tests/scene_scaling.rs measures wall
-//! time, which the suite's other tests, running beside it, would disturb.
+//! The loaders' scaling tests are a binary of their own,
+//! tests/scene_scaling.rs: they time the loaders, which the suite's other
+//! tests, running beside them, would disturb.
 
 mod common;
 

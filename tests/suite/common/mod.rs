@@ -2,6 +2,7 @@
 //! scenes built in code, camera rays, and image statistics.
 #![allow(dead_code)]
 
+pub mod gltf_builder;
 pub mod reference_cache;
 pub use reference_cache::{reference_images, ReferenceImages, ReferenceRequest};
 
