@@ -5,8 +5,8 @@
 use super::{Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::params::{ParamSet, Params};
-pub use crate::passes::direct_light::DirectParams;
 use crate::passes::direct_light::DirectLight;
+pub use crate::passes::direct_light::DirectParams;
 use crate::radiometry::Component;
 use crate::scene::Scene;
 use crate::vk::{Context, FrameRecorder, VkResult};

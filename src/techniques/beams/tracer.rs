@@ -10,12 +10,16 @@
 
 use super::bindings as bb;
 use crate::frame::{FrameTargets, SceneGpu};
+use crate::passes::light_views::photon_view;
 use crate::passes::light_views::{LightView, LightViewConsumer};
 use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::passes::surface_frame::SurfaceFrame;
-use crate::passes::light_views::photon_view;
 use crate::scene::{Density, Light, LightKind, Scene};
-use crate::vk::{begin_rendering, end_rendering, step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, MAX_FRAMES_IN_FLIGHT, VkResult, groups_8x8};
+use crate::vk::{
+    begin_rendering, end_rendering, groups_8x8, step, Access, BindingKind, Buffer, BufferUsage,
+    ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
+    GraphicsPipelineDesc, Image, ImageDesc, VkResult, MAX_FRAMES_IN_FLIGHT,
+};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
@@ -71,7 +75,8 @@ impl GpuBeam {
             return None;
         }
         Some(std::array::from_fn(|k| {
-            glam::Vec4::from(self.v[k]).truncate() + self.receiver[k] * glam::Vec4::from(self.e[k]).truncate()
+            glam::Vec4::from(self.v[k]).truncate()
+                + self.receiver[k] * glam::Vec4::from(self.e[k]).truncate()
         }))
     }
 }
@@ -310,10 +315,22 @@ impl BeamTracer {
         // sized for the deepest level (bounded by the beam capacity: a
         // level with more triangles than beams fits cannot be drawn anyway).
         let full = 2 * (base as u64).pow(2) * 4u64.pow(settings.levels);
-        let triangle_capacity = full.min(settings.beam_capacity as u64).max(2 * (base as u64).pow(2)) as u32;
+        let triangle_capacity = full
+            .min(settings.beam_capacity as u64)
+            .max(2 * (base as u64).pow(2)) as u32;
         let triangles = [
-            Buffer::new(ctx, "beam triangles A", triangle_capacity as u64 * 16, BufferUsage::Storage)?,
-            Buffer::new(ctx, "beam triangles B", triangle_capacity as u64 * 16, BufferUsage::Storage)?,
+            Buffer::new(
+                ctx,
+                "beam triangles A",
+                triangle_capacity as u64 * 16,
+                BufferUsage::Storage,
+            )?,
+            Buffer::new(
+                ctx,
+                "beam triangles B",
+                triangle_capacity as u64 * 16,
+                BufferUsage::Storage,
+            )?,
         ];
         let beams = Buffer::new(
             ctx,
@@ -368,26 +385,26 @@ impl BeamTracer {
         let surface_filtered = target("beam surface flux, filtered in x")?;
         use BindingKind::{Storage, StorageImage};
         let all = [
-                (bb::BEAMS_BINDING_TRIANGLES_A, Storage),
-                (bb::BEAMS_BINDING_TRIANGLES_B, Storage),
-                (bb::BEAMS_BINDING_BEAMS, Storage),
-                (bb::BEAMS_BINDING_COUNTERS, Storage),
-                (bb::BEAMS_BINDING_INDIRECT, Storage),
-                (bb::BEAMS_BINDING_FRONT_POSITION, StorageImage),
-                (bb::BEAMS_BINDING_FRONT_NORMAL, StorageImage),
-                (bb::BEAMS_BINDING_BACK_POSITION, StorageImage),
-                (bb::BEAMS_BINDING_BACK_NORMAL, StorageImage),
-                (bb::BEAMS_BINDING_OPAQUE_POSITION, StorageImage),
-                (bb::BEAMS_BINDING_OPAQUE_NORMAL, StorageImage),
-                (bb::BEAMS_BINDING_OPAQUE_ALBEDO, StorageImage),
-                (bb::BEAMS_BINDING_SPECULAR_POSITION, StorageImage),
-                (bb::BEAMS_BINDING_RECEIVERS, Storage),
-                (bb::BEAMS_BINDING_VOLUME, StorageImage),
-                (bb::BEAMS_BINDING_SURFACE, StorageImage),
-                (bb::BEAMS_BINDING_OPAQUE_RADIANCE, StorageImage),
-                (bb::BEAMS_BINDING_RADIANCE, StorageImage),
-                (bb::BEAMS_BINDING_SURFACE_FILTERED, StorageImage),
-            ];
+            (bb::BEAMS_BINDING_TRIANGLES_A, Storage),
+            (bb::BEAMS_BINDING_TRIANGLES_B, Storage),
+            (bb::BEAMS_BINDING_BEAMS, Storage),
+            (bb::BEAMS_BINDING_COUNTERS, Storage),
+            (bb::BEAMS_BINDING_INDIRECT, Storage),
+            (bb::BEAMS_BINDING_FRONT_POSITION, StorageImage),
+            (bb::BEAMS_BINDING_FRONT_NORMAL, StorageImage),
+            (bb::BEAMS_BINDING_BACK_POSITION, StorageImage),
+            (bb::BEAMS_BINDING_BACK_NORMAL, StorageImage),
+            (bb::BEAMS_BINDING_OPAQUE_POSITION, StorageImage),
+            (bb::BEAMS_BINDING_OPAQUE_NORMAL, StorageImage),
+            (bb::BEAMS_BINDING_OPAQUE_ALBEDO, StorageImage),
+            (bb::BEAMS_BINDING_SPECULAR_POSITION, StorageImage),
+            (bb::BEAMS_BINDING_RECEIVERS, Storage),
+            (bb::BEAMS_BINDING_VOLUME, StorageImage),
+            (bb::BEAMS_BINDING_SURFACE, StorageImage),
+            (bb::BEAMS_BINDING_OPAQUE_RADIANCE, StorageImage),
+            (bb::BEAMS_BINDING_RADIANCE, StorageImage),
+            (bb::BEAMS_BINDING_SURFACE_FILTERED, StorageImage),
+        ];
         // One set (and layout) per group of passes: each pass declares its
         // image bindings (`vk/pass.rs`), and a set holds only what its
         // shaders use; the buffers are written into every set that has them.
@@ -452,12 +469,20 @@ impl BeamTracer {
             &with(&layouts.beams),
             size_of::<RefinePush>() as u32,
         )?;
-        let args_pipeline =
-            ComputePipeline::new(ctx, "beams/args.comp", &with(&layouts.beams), size_of::<ArgsPush>() as u32)?;
-        let receivers_pipeline = ComputePipeline::new(ctx, "beams/receivers.comp", &with(&layouts.receivers), 0)?;
-        let apply_pipeline = ComputePipeline::new(ctx, "beams/apply.comp", &with(&layouts.apply), 4)?;
-        let composite_pipeline = ComputePipeline::new(ctx, "beams/composite.comp", &with(&layouts.composite), 0)?;
-        let filter_pipeline = ComputePipeline::new(ctx, "beams/filter.comp", &with(&layouts.filter), 8)?;
+        let args_pipeline = ComputePipeline::new(
+            ctx,
+            "beams/args.comp",
+            &with(&layouts.beams),
+            size_of::<ArgsPush>() as u32,
+        )?;
+        let receivers_pipeline =
+            ComputePipeline::new(ctx, "beams/receivers.comp", &with(&layouts.receivers), 0)?;
+        let apply_pipeline =
+            ComputePipeline::new(ctx, "beams/apply.comp", &with(&layouts.apply), 4)?;
+        let composite_pipeline =
+            ComputePipeline::new(ctx, "beams/composite.comp", &with(&layouts.composite), 0)?;
+        let filter_pipeline =
+            ComputePipeline::new(ctx, "beams/filter.comp", &with(&layouts.filter), 8)?;
         // A constant density (or none) gets fragments compiled without the
         // density field's code (a CPU rasteriser pays for it in every
         // fragment, as volume_lines measured).
@@ -571,8 +596,18 @@ impl BeamTracer {
         // receivers are overwritten after last frame's fragments.
         let set = &self.sets.receivers;
         rec.pass("beam receivers")
-            .storage_image(set, bb::BEAMS_BINDING_OPAQUE_POSITION, &surface.gbuffer().position, Access::ComputeRead)
-            .storage_image(set, bb::BEAMS_BINDING_OPAQUE_NORMAL, &surface.gbuffer().normal, Access::ComputeRead)
+            .storage_image(
+                set,
+                bb::BEAMS_BINDING_OPAQUE_POSITION,
+                &surface.gbuffer().position,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bb::BEAMS_BINDING_OPAQUE_NORMAL,
+                &surface.gbuffer().normal,
+                Access::ComputeRead,
+            )
             .storage_image(
                 set,
                 bb::BEAMS_BINDING_SPECULAR_POSITION,
@@ -581,10 +616,10 @@ impl BeamTracer {
             )
             .write(&self.receivers, Access::ComputeWrite)
             .record(|cmd| {
-            let groups = groups_8x8(targets.width, targets.height);
-            self.receivers_pipeline
-                .dispatch(cmd, &[&scene.set, set], &[], groups);
-        });
+                let groups = groups_8x8(targets.width, targets.height);
+                self.receivers_pipeline
+                    .dispatch(cmd, &[&scene.set, set], &[], groups);
+            });
         // The frame's statistics start from zero (after last frame's
         // copy to the host); both targets are cleared.
         rec.pass("beam clear")
@@ -592,22 +627,22 @@ impl BeamTracer {
             .overwrite(&self.surface, Access::ColorAttachment)
             .write(&self.counters, Access::TransferWrite)
             .record(|cmd| {
-            unsafe {
-                ctx.device
-                    .cmd_fill_buffer(cmd, self.counters.raw, 0, vk::WHOLE_SIZE, 0)
-            };
-            begin_rendering(
-                &ctx,
-                cmd,
-                self.volume.extent(),
-                &[
-                    (self.volume.view, Some([0.0; 4])),
-                    (self.surface.view, Some([0.0; 4])),
-                ],
-                None,
-            );
-            end_rendering(&ctx, cmd);
-        });
+                unsafe {
+                    ctx.device
+                        .cmd_fill_buffer(cmd, self.counters.raw, 0, vk::WHOLE_SIZE, 0)
+                };
+                begin_rendering(
+                    &ctx,
+                    cmd,
+                    self.volume.extent(),
+                    &[
+                        (self.volume.view, Some([0.0; 4])),
+                        (self.surface.view, Some([0.0; 4])),
+                    ],
+                    None,
+                );
+                end_rendering(&ctx, cmd);
+            });
     }
 
     /// Records "beam apply": the surface caustics into the opaque frame
@@ -623,7 +658,12 @@ impl BeamTracer {
             // picks the direction), so both are declared written.
             let set = &self.sets.filter;
             rec.pass("beam filter")
-                .storage_image(set, bb::BEAMS_BINDING_SURFACE, &self.surface, Access::ComputeWrite)
+                .storage_image(
+                    set,
+                    bb::BEAMS_BINDING_SURFACE,
+                    &self.surface,
+                    Access::ComputeWrite,
+                )
                 .overwrite_storage_image(
                     set,
                     bb::BEAMS_BINDING_SURFACE_FILTERED,
@@ -632,47 +672,72 @@ impl BeamTracer {
                 )
                 .read(&self.receivers, Access::ComputeRead)
                 .record(|cmd| {
-                let push = [self.surface_filter, 0];
-                self.filter_pipeline.dispatch(
-                    cmd,
-                    &[&scene.set, set],
-                    bytemuck::cast_slice(&push),
-                    groups,
-                );
-                // y: the intermediate -> the surface target (read-after-
-                // write one way, write-after-read the other).
-                step(&ctx, cmd)
-                    .write(&self.surface_filtered, Access::ComputeWrite)
-                    .write(&self.surface, Access::ComputeWrite)
-                    .emit();
-                let push = [self.surface_filter, 1];
-                self.filter_pipeline.dispatch(
-                    cmd,
-                    &[&scene.set, set],
-                    bytemuck::cast_slice(&push),
-                    groups,
-                );
-            });
+                    let push = [self.surface_filter, 0];
+                    self.filter_pipeline.dispatch(
+                        cmd,
+                        &[&scene.set, set],
+                        bytemuck::cast_slice(&push),
+                        groups,
+                    );
+                    // y: the intermediate -> the surface target (read-after-
+                    // write one way, write-after-read the other).
+                    step(&ctx, cmd)
+                        .write(&self.surface_filtered, Access::ComputeWrite)
+                        .write(&self.surface, Access::ComputeWrite)
+                        .emit();
+                    let push = [self.surface_filter, 1];
+                    self.filter_pipeline.dispatch(
+                        cmd,
+                        &[&scene.set, set],
+                        bytemuck::cast_slice(&push),
+                        groups,
+                    );
+                });
         }
         // The volumes' blended writes are read; the opaque frame was
         // written by direct lighting.
         let set = &self.sets.apply;
         rec.pass("beam apply")
-            .storage_image(set, bb::BEAMS_BINDING_SURFACE, &self.surface, Access::ComputeRead)
-            .storage_image(set, bb::BEAMS_BINDING_OPAQUE_POSITION, &surface.gbuffer().position, Access::ComputeRead)
-            .storage_image(set, bb::BEAMS_BINDING_OPAQUE_NORMAL, &surface.gbuffer().normal, Access::ComputeRead)
-            .storage_image(set, bb::BEAMS_BINDING_OPAQUE_ALBEDO, &surface.gbuffer().albedo, Access::ComputeRead)
-            .storage_image(set, bb::BEAMS_BINDING_OPAQUE_RADIANCE, surface.opaque(), Access::ComputeWrite)
+            .storage_image(
+                set,
+                bb::BEAMS_BINDING_SURFACE,
+                &self.surface,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bb::BEAMS_BINDING_OPAQUE_POSITION,
+                &surface.gbuffer().position,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bb::BEAMS_BINDING_OPAQUE_NORMAL,
+                &surface.gbuffer().normal,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bb::BEAMS_BINDING_OPAQUE_ALBEDO,
+                &surface.gbuffer().albedo,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bb::BEAMS_BINDING_OPAQUE_RADIANCE,
+                surface.opaque(),
+                Access::ComputeWrite,
+            )
             .record(|cmd| {
-            let e = surface.opaque().extent();
-            let groups = groups_8x8(e.width, e.height);
-            self.apply_pipeline.dispatch(
-                cmd,
-                &[&scene.set, set],
-                bytemuck::bytes_of(&self.volume_push.medium_steps),
-                groups,
-            );
-        });
+                let e = surface.opaque().extent();
+                let groups = groups_8x8(e.width, e.height);
+                self.apply_pipeline.dispatch(
+                    cmd,
+                    &[&scene.set, set],
+                    bytemuck::bytes_of(&self.volume_push.medium_steps),
+                    groups,
+                );
+            });
     }
 
     /// Records "beam composite" (the volume caustics added to the frame's
@@ -683,21 +748,31 @@ impl BeamTracer {
         let readback = &self.readbacks[rec.slot()];
         let set = &self.sets.composite;
         rec.pass("beam composite")
-            .storage_image(set, bb::BEAMS_BINDING_VOLUME, &self.volume, Access::ComputeRead)
-            .storage_image(set, bb::BEAMS_BINDING_RADIANCE, &targets.radiance, Access::ComputeWrite)
+            .storage_image(
+                set,
+                bb::BEAMS_BINDING_VOLUME,
+                &self.volume,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bb::BEAMS_BINDING_RADIANCE,
+                &targets.radiance,
+                Access::ComputeWrite,
+            )
             .read(&self.counters, Access::TransferRead)
             .write(readback, Access::TransferWrite)
             .record(|cmd| {
-            let groups = groups_8x8(targets.width, targets.height);
-            self.composite_pipeline
-                .dispatch(cmd, &[&scene.set, set], &[], groups);
-            let region = vk::BufferCopy::default().size(self.counters.size);
-            unsafe {
-                ctx.device
-                    .cmd_copy_buffer(cmd, self.counters.raw, readback.raw, &[region])
-            };
-            step(&ctx, cmd).read(readback, Access::HostRead).emit();
-        });
+                let groups = groups_8x8(targets.width, targets.height);
+                self.composite_pipeline
+                    .dispatch(cmd, &[&scene.set, set], &[], groups);
+                let region = vk::BufferCopy::default().size(self.counters.size);
+                unsafe {
+                    ctx.device
+                        .cmd_copy_buffer(cmd, self.counters.raw, readback.raw, &[region])
+                };
+                step(&ctx, cmd).read(readback, Access::HostRead).emit();
+            });
     }
 }
 
@@ -731,23 +806,27 @@ impl LightViewConsumer for BeamTracer {
             .write(&self.counters, Access::TransferWrite)
             .write(&self.indirect, Access::TransferWrite)
             .record(|cmd| {
-            let mut light_words = [0u32; bb::BEAMS_COUNTER_LIGHT_WORDS as usize];
-            light_words[bb::BEAMS_COUNTER_TRIS as usize] = first;
-            let mut args = [0u32; bb::BEAMS_INDIRECT_WORDS as usize];
-            args[0] = first.div_ceil(bb::BEAMS_REFINE_GROUP);
-            args[1] = 1;
-            args[2] = 1;
-            unsafe {
-                ctx.device.cmd_update_buffer(
-                    cmd,
-                    self.counters.raw,
-                    0,
-                    bytemuck::cast_slice(&light_words),
-                );
-                ctx.device
-                    .cmd_update_buffer(cmd, self.indirect.raw, 0, bytemuck::cast_slice(&args));
-            }
-        });
+                let mut light_words = [0u32; bb::BEAMS_COUNTER_LIGHT_WORDS as usize];
+                light_words[bb::BEAMS_COUNTER_TRIS as usize] = first;
+                let mut args = [0u32; bb::BEAMS_INDIRECT_WORDS as usize];
+                args[0] = first.div_ceil(bb::BEAMS_REFINE_GROUP);
+                args[1] = 1;
+                args[2] = 1;
+                unsafe {
+                    ctx.device.cmd_update_buffer(
+                        cmd,
+                        self.counters.raw,
+                        0,
+                        bytemuck::cast_slice(&light_words),
+                    );
+                    ctx.device.cmd_update_buffer(
+                        cmd,
+                        self.indirect.raw,
+                        0,
+                        bytemuck::cast_slice(&args),
+                    );
+                }
+            });
         for level in 0..=self.refine.grid[1] {
             push.grid[0] = level;
             // The level's arguments as indirect dispatch; the counters,
@@ -774,34 +853,40 @@ impl LightViewConsumer for BeamTracer {
                     ],
                 )
                 .record(|cmd| {
-                self.refine_pipeline.dispatch_indirect(
-                    cmd,
-                    &[&scene.set, set],
-                    bytemuck::bytes_of(&push),
-                    &self.indirect,
-                    12 * level as u64,
-                );
-                // The next level's arguments (and the draw's) from the
-                // counts this level appended (read-after-write), written
-                // after this level's indirect read (write-after-read).
-                step(&ctx, cmd)
-                    .read(&self.counters, Access::ComputeRead)
-                    .write(&self.indirect, Access::ComputeWrite)
-                    .emit();
-                self.args_pipeline.dispatch(
-                    cmd,
-                    &[&scene.set, set],
-                    bytemuck::bytes_of(&self.args),
-                    [1, 1, 1],
-                );
-            });
+                    self.refine_pipeline.dispatch_indirect(
+                        cmd,
+                        &[&scene.set, set],
+                        bytemuck::bytes_of(&push),
+                        &self.indirect,
+                        12 * level as u64,
+                    );
+                    // The next level's arguments (and the draw's) from the
+                    // counts this level appended (read-after-write), written
+                    // after this level's indirect read (write-after-read).
+                    step(&ctx, cmd)
+                        .read(&self.counters, Access::ComputeRead)
+                        .write(&self.indirect, Access::ComputeWrite)
+                        .emit();
+                    self.args_pipeline.dispatch(
+                        cmd,
+                        &[&scene.set, set],
+                        bytemuck::bytes_of(&self.args),
+                        [1, 1, 1],
+                    );
+                });
         }
         // The volumes (nothing to integrate without a medium), then the
         // caustic triangles.
         if let Some(volume) = &self.volume_pipeline {
             self.draw_beams(rec, scene, "beam volumes", &self.volume, volume);
         }
-        self.draw_beams(rec, scene, "beam caustics", &self.surface, &self.caustic_pipeline);
+        self.draw_beams(
+            rec,
+            scene,
+            "beam caustics",
+            &self.surface,
+            &self.caustic_pipeline,
+        );
     }
 }
 

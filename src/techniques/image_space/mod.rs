@@ -57,8 +57,8 @@
 use super::{Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::params::{ParamSet, Params};
-pub use crate::passes::caustic_map::ImageSpaceParams;
 use crate::passes::caustic_map::CausticMap;
+pub use crate::passes::caustic_map::ImageSpaceParams;
 use crate::passes::light_views::LightViews;
 use crate::passes::surface_frame::SurfaceFrame;
 use crate::radiometry::Component;

@@ -64,7 +64,10 @@ use crate::passes::surface_frame::SurfaceFrame;
 use crate::radiometry::Component;
 use crate::scene::{EnvironmentKind, Scene};
 use crate::shader_bindings as sb;
-use crate::vk::{step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageDesc, Sampler, VkResult, groups_8x8};
+use crate::vk::{
+    groups_8x8, step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context,
+    DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageDesc, Sampler, VkResult,
+};
 use ash::vk;
 use bindings as b;
 use bytemuck::{Pod, Zeroable};
@@ -176,7 +179,12 @@ impl Pinhole {
         let slots = emitter_slots(scene);
         let k = params.clusters;
         let triangles = scene_gpu.triangle_count.max(1) as u64;
-        let samples = Buffer::new(ctx, "pinhole samples", n as u64 * SAMPLE_BYTES, BufferUsage::Storage)?;
+        let samples = Buffer::new(
+            ctx,
+            "pinhole samples",
+            n as u64 * SAMPLE_BYTES,
+            BufferUsage::Storage,
+        )?;
         let state = Buffer::new(
             ctx,
             "pinhole state",
@@ -190,8 +198,18 @@ impl Pinhole {
             m as u64 * CANDIDATE_BYTES,
             BufferUsage::Storage,
         )?;
-        let heads = Buffer::new(ctx, "pinhole grid heads", 4 * hash_size as u64, BufferUsage::Storage)?;
-        let next = Buffer::new(ctx, "pinhole grid links", 4 * m as u64, BufferUsage::Storage)?;
+        let heads = Buffer::new(
+            ctx,
+            "pinhole grid heads",
+            4 * hash_size as u64,
+            BufferUsage::Storage,
+        )?;
+        let next = Buffer::new(
+            ctx,
+            "pinhole grid links",
+            4 * m as u64,
+            BufferUsage::Storage,
+        )?;
         let size = params.cube_size;
         let levels = 32 - size.leading_zeros();
         let light_map = Image::mipmapped(
@@ -224,7 +242,10 @@ impl Pinhole {
         // One set (and layout) per group of passes: the sampling passes'
         // buffers (glsl/pinhole/common.glsl) in all of them, plus the images
         // the light-map and receiver passes declare (`vk/pass.rs`).
-        let buffer_ids = all.iter().filter(|(_, kind)| *kind == Storage).map(|&(id, _)| id);
+        let buffer_ids = all
+            .iter()
+            .filter(|(_, kind)| *kind == Storage)
+            .map(|&(id, _)| id);
         let with_images = |images: &[u32]| {
             let used: Vec<u32> = buffer_ids.clone().chain(images.iter().copied()).collect();
             DescriptorSetLayout::of(ctx, &all, &used)
@@ -254,8 +275,11 @@ impl Pinhole {
             set.write_buffers(&buffers);
             Ok(set)
         };
-        let (set, light_map_set, receivers_set) =
-            (new_set(&layouts[0])?, new_set(&layouts[1])?, new_set(&layouts[2])?);
+        let (set, light_map_set, receivers_set) = (
+            new_set(&layouts[0])?,
+            new_set(&layouts[1])?,
+            new_set(&layouts[2])?,
+        );
         let mip_layout = DescriptorSetLayout::new(
             ctx,
             &[
@@ -277,7 +301,12 @@ impl Pinhole {
         let clusters = pipeline("pinhole/clusters.comp", &layouts[0])?;
         let light_maps = pipeline("pinhole/light_maps.comp", &layouts[1])?;
         let receivers = pipeline("pinhole/receivers.comp", &layouts[2])?;
-        let mips = ComputePipeline::new(ctx, "pinhole/mips.comp", &[&scene_gpu.layout, &mip_layout], 0)?;
+        let mips = ComputePipeline::new(
+            ctx,
+            "pinhole/mips.comp",
+            &[&scene_gpu.layout, &mip_layout],
+            0,
+        )?;
         let mut push = PinholePush {
             target: n,
             strategy: 0,
@@ -370,7 +399,8 @@ impl Pinhole {
                     first_candidate: first,
                     ..self.push
                 };
-                self.select.dispatch(cmd, &sets, bytemuck::bytes_of(&chunk), one);
+                self.select
+                    .dispatch(cmd, &sets, bytemuck::bytes_of(&chunk), one);
             }
         });
         rec.pass("pinhole gradients")
@@ -398,14 +428,27 @@ impl Pinhole {
             .record(|cmd| {
                 let s = self.push.cube_size.div_ceil(8);
                 let groups = [s, s, self.light_map.desc.layers];
-                self.light_maps.dispatch(cmd, &[&scene.set, set], push, groups);
+                self.light_maps
+                    .dispatch(cmd, &[&scene.set, set], push, groups);
             });
         let mut mips = rec.pass("pinhole light mips");
         for (l, set) in self.mip_sets.iter().enumerate() {
             let views = &self.light_map.level_views;
             mips = mips
-                .storage_view(set, b::PINHOLE_MIP_BINDING_SRC, &self.light_map, views[l], w)
-                .storage_view(set, b::PINHOLE_MIP_BINDING_DST, &self.light_map, views[l + 1], w);
+                .storage_view(
+                    set,
+                    b::PINHOLE_MIP_BINDING_SRC,
+                    &self.light_map,
+                    views[l],
+                    w,
+                )
+                .storage_view(
+                    set,
+                    b::PINHOLE_MIP_BINDING_DST,
+                    &self.light_map,
+                    views[l + 1],
+                    w,
+                );
         }
         mips.record(|cmd| {
             for (l, set) in self.mip_sets.iter().enumerate() {
@@ -420,7 +463,13 @@ impl Pinhole {
         let opaque = self.surface.opaque();
         let set = &self.receivers_set;
         rec.pass("pinhole receivers")
-            .sampled(set, b::PINHOLE_BINDING_LIGHT_MAP, &self.light_map, &self.sampler, r)
+            .sampled(
+                set,
+                b::PINHOLE_BINDING_LIGHT_MAP,
+                &self.light_map,
+                &self.sampler,
+                r,
+            )
             .storage_image(set, b::PINHOLE_BINDING_POSITION, &gbuffer.position, r)
             .storage_image(set, b::PINHOLE_BINDING_NORMAL, &gbuffer.normal, r)
             .storage_image(set, b::PINHOLE_BINDING_ALBEDO, &gbuffer.albedo, r)

@@ -69,21 +69,22 @@ impl PinholeParams {
         push.light_radius = self.light_radius;
         push.sun_cos = self.sun_radius.to_radians().cos();
         push.epsilon = self.epsilon;
-        push.flags = (if self.filter { b::PINHOLE_FLAG_FILTER } else { 0 })
-            | (if self.visibility {
-                b::PINHOLE_FLAG_VISIBILITY
-            } else {
-                0
-            })
-            | (if self.light_visibility {
-                b::PINHOLE_FLAG_LIGHT_VISIBILITY
-            } else {
-                0
-            })
-            | (if self.dielectrics {
-                b::PINHOLE_FLAG_DIELECTRICS
-            } else {
-                0
-            });
+        push.flags = (if self.filter {
+            b::PINHOLE_FLAG_FILTER
+        } else {
+            0
+        }) | (if self.visibility {
+            b::PINHOLE_FLAG_VISIBILITY
+        } else {
+            0
+        }) | (if self.light_visibility {
+            b::PINHOLE_FLAG_LIGHT_VISIBILITY
+        } else {
+            0
+        }) | (if self.dielectrics {
+            b::PINHOLE_FLAG_DIELECTRICS
+        } else {
+            0
+        });
     }
 }

@@ -9,7 +9,11 @@ use crate::passes::light_views::{LightView, LightViewConsumer};
 use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::passes::surface_frame::SurfaceFrame;
 use crate::scene::{Density, Scene};
-use crate::vk::{begin_rendering, end_rendering, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, VkResult, groups_8x8};
+use crate::vk::{
+    begin_rendering, end_rendering, groups_8x8, Access, BindingKind, Buffer, BufferUsage,
+    ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
+    GraphicsPipelineDesc, Image, ImageDesc, VkResult,
+};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
@@ -174,7 +178,10 @@ impl VolumeRays {
             DescriptorSetLayout::of(
                 ctx,
                 &all,
-                &[vb::VOLUME_LINES_BINDING_VOLUME, vb::VOLUME_LINES_BINDING_RADIANCE],
+                &[
+                    vb::VOLUME_LINES_BINDING_VOLUME,
+                    vb::VOLUME_LINES_BINDING_RADIANCE,
+                ],
             )?,
         ];
         let buffers = [
@@ -186,8 +193,11 @@ impl VolumeRays {
             set.write_buffers(&buffers);
             Ok(set)
         };
-        let (visibility_set, set, composite_set) =
-            (new_set(&layouts[0])?, new_set(&layouts[1])?, new_set(&layouts[2])?);
+        let (visibility_set, set, composite_set) = (
+            new_set(&layouts[0])?,
+            new_set(&layouts[1])?,
+            new_set(&layouts[2])?,
+        );
         let with = |layout| [&scene_gpu.layout, layout];
         let segment_pipeline = ComputePipeline::new(
             ctx,
@@ -286,22 +296,22 @@ impl VolumeRays {
             )
             .write(&self.visibility, Access::ComputeWrite)
             .record(|cmd| {
-            let groups = groups_8x8(targets.width, targets.height);
-            self.visibility_pipeline
-                .dispatch(cmd, &[&scene.set, set], &[], groups);
-        });
+                let groups = groups_8x8(targets.width, targets.height);
+                self.visibility_pipeline
+                    .dispatch(cmd, &[&scene.set, set], &[], groups);
+            });
         rec.pass("volume clear")
             .overwrite(&self.volume, Access::ColorAttachment)
             .record(|cmd| {
-            begin_rendering(
-                &ctx,
-                cmd,
-                self.volume.extent(),
-                &[(self.volume.view, Some([0.0; 4]))],
-                None,
-            );
-            end_rendering(&ctx, cmd);
-        });
+                begin_rendering(
+                    &ctx,
+                    cmd,
+                    self.volume.extent(),
+                    &[(self.volume.view, Some([0.0; 4]))],
+                    None,
+                );
+                end_rendering(&ctx, cmd);
+            });
     }
 
     /// Records "volume composite": B added to the frame's radiance (after
@@ -311,13 +321,23 @@ impl VolumeRays {
         // written by the surface frame's refraction pass.
         let set = &self.composite_set;
         rec.pass("volume composite")
-            .storage_image(set, bindings::VOLUME_LINES_BINDING_VOLUME, &self.volume, Access::ComputeRead)
-            .storage_image(set, bindings::VOLUME_LINES_BINDING_RADIANCE, &targets.radiance, Access::ComputeWrite)
+            .storage_image(
+                set,
+                bindings::VOLUME_LINES_BINDING_VOLUME,
+                &self.volume,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bindings::VOLUME_LINES_BINDING_RADIANCE,
+                &targets.radiance,
+                Access::ComputeWrite,
+            )
             .record(|cmd| {
-            let groups = groups_8x8(targets.width, targets.height);
-            self.composite_pipeline
-                .dispatch(cmd, &[&scene.set, set], &[], groups);
-        });
+                let groups = groups_8x8(targets.width, targets.height);
+                self.composite_pipeline
+                    .dispatch(cmd, &[&scene.set, set], &[], groups);
+            });
     }
 }
 
@@ -362,14 +382,14 @@ impl LightViewConsumer for VolumeRays {
                 ],
             )
             .record(|cmd| {
-            let groups = groups_8x8(self.buffer_size, self.buffer_size);
-            self.segment_pipeline.dispatch(
-                cmd,
-                &[&scene.set, &self.set],
-                bytemuck::bytes_of(&push),
-                groups,
-            );
-        });
+                let groups = groups_8x8(self.buffer_size, self.buffer_size);
+                self.segment_pipeline.dispatch(
+                    cmd,
+                    &[&scene.set, &self.set],
+                    bytemuck::bytes_of(&push),
+                    groups,
+                );
+            });
         // Segments pulled by the geometry shader and read again by
         // the fragments (so the next light's segment pass waits for
         // both); the distances read by the fragments.
@@ -378,16 +398,16 @@ impl LightViewConsumer for VolumeRays {
             .read(&self.segments, Access::GraphicsRead)
             .read(&self.visibility, Access::FragmentRead)
             .record(|cmd| {
-            let extent = self.volume.extent();
-            begin_rendering(&ctx, cmd, extent, &[(self.volume.view, None)], None);
-            self.line_pipeline.bind(
-                cmd,
-                &[&scene.set, &self.set],
-                bytemuck::bytes_of(&self.line_push),
-                extent,
-            );
-            unsafe { ctx.device.cmd_draw(cmd, self.draw_count, 1, 0, 0) };
-            end_rendering(&ctx, cmd);
-        });
+                let extent = self.volume.extent();
+                begin_rendering(&ctx, cmd, extent, &[(self.volume.view, None)], None);
+                self.line_pipeline.bind(
+                    cmd,
+                    &[&scene.set, &self.set],
+                    bytemuck::bytes_of(&self.line_push),
+                    extent,
+                );
+                unsafe { ctx.device.cmd_draw(cmd, self.draw_count, 1, 0, 0) };
+                end_rendering(&ctx, cmd);
+            });
     }
 }

@@ -172,7 +172,12 @@ impl VolumeLines {
         let caustic_views = if c.photon_buffer_size == params.volume_buffer_size {
             None
         } else {
-            Some(LightViews::new(ctx, scene, scene_gpu, c.photon_buffer_size)?)
+            Some(LightViews::new(
+                ctx,
+                scene,
+                scene_gpu,
+                c.photon_buffer_size,
+            )?)
         };
         let caustics = c.caustic_map(
             ctx,

@@ -115,4 +115,3 @@ pub fn water_bounds(water: &Water) -> (Vec3, Vec3) {
         ),
     )
 }
-

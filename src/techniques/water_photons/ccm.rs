@@ -5,10 +5,14 @@
 //! Cascade c's view-projection is Eq. 2 (`CascadeLayout::projection`) times
 //! the shared light view of Eq. 1 (`cascades::light_view`).
 
+use super::bindings;
 use crate::passes::water_surface::WaterSurface;
 use crate::scene::Water;
-use super::bindings;
-use crate::vk::{begin_rendering, end_rendering, Access, BindingKind, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, VkResult};
+use crate::vk::{
+    begin_rendering, end_rendering, Access, BindingKind, Context, DescriptorSet,
+    DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
+    VkResult,
+};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
@@ -62,8 +66,10 @@ impl Ccm {
             "ccm depth",
             desc(DEPTH_FORMAT, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT),
         )?;
-        let layout =
-            DescriptorSetLayout::new(ctx, &[(bindings::WP_BINDING_WATER_VERTICES, BindingKind::Storage)])?;
+        let layout = DescriptorSetLayout::new(
+            ctx,
+            &[(bindings::WP_BINDING_WATER_VERTICES, BindingKind::Storage)],
+        )?;
         let set = DescriptorSet::new(ctx, &layout)?;
         set.write_buffer(bindings::WP_BINDING_WATER_VERTICES, &surface.vertices);
         let mut desc =
@@ -100,28 +106,28 @@ impl Ccm {
             .overwrite(&self.depth, Access::DepthAttachment)
             .read(&self.surface.vertices, Access::VertexRead)
             .record(|cmd| {
-            let extent = self.position.extent();
-            for (c, view_proj) in view_projs.iter().enumerate() {
-                begin_rendering(
-                    &ctx,
-                    cmd,
-                    extent,
-                    &[
-                        (self.position.layer_views[c], Some([0.0; 4])),
-                        (self.normal.layer_views[c], Some([0.0; 4])),
-                    ],
-                    Some(self.depth.layer_views[c]),
-                );
-                let push = CcmPush {
-                    view_proj: view_proj.to_cols_array_2d(),
-                    grid: [self.grid[0], self.grid[1], 0, 0],
-                };
-                self.pipeline
-                    .bind(cmd, &[&self.set], bytemuck::bytes_of(&push), extent);
-                let vertices = 6 * self.grid[0] * self.grid[1];
-                unsafe { ctx.device.cmd_draw(cmd, vertices, 1, 0, 0) };
-                end_rendering(&ctx, cmd);
-            }
-        });
+                let extent = self.position.extent();
+                for (c, view_proj) in view_projs.iter().enumerate() {
+                    begin_rendering(
+                        &ctx,
+                        cmd,
+                        extent,
+                        &[
+                            (self.position.layer_views[c], Some([0.0; 4])),
+                            (self.normal.layer_views[c], Some([0.0; 4])),
+                        ],
+                        Some(self.depth.layer_views[c]),
+                    );
+                    let push = CcmPush {
+                        view_proj: view_proj.to_cols_array_2d(),
+                        grid: [self.grid[0], self.grid[1], 0, 0],
+                    };
+                    self.pipeline
+                        .bind(cmd, &[&self.set], bytemuck::bytes_of(&push), extent);
+                    let vertices = 6 * self.grid[0] * self.grid[1];
+                    unsafe { ctx.device.cmd_draw(cmd, vertices, 1, 0, 0) };
+                    end_rendering(&ctx, cmd);
+                }
+            });
     }
 }

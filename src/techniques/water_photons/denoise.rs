@@ -45,9 +45,12 @@
 //! sparse photon image (an adaptive kernel that gathers wide into dark
 //! pixels and narrow at bright ones adds energy around isolated photons).
 
-use crate::scene::{Camera, Light, LightKind, Scene};
 use super::bindings;
-use crate::vk::{copy_image, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageDesc, Profiler, TimingSource};
+use crate::scene::{Camera, Light, LightKind, Scene};
+use crate::vk::{
+    copy_image, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    FrameRecorder, Image, ImageDesc, Profiler, TimingSource,
+};
 use anyhow::{bail, ensure, Context as _};
 use ash::vk;
 use glam::Vec3;
@@ -226,7 +229,10 @@ impl Denoiser {
             &[
                 (bindings::DENOISE_BINDING_INPUT, BindingKind::StorageImage),
                 (bindings::DENOISE_BINDING_OUTPUT, BindingKind::StorageImage),
-                (bindings::DENOISE_BINDING_POSITION, BindingKind::StorageImage),
+                (
+                    bindings::DENOISE_BINDING_POSITION,
+                    BindingKind::StorageImage,
+                ),
             ],
         )?;
         let pipeline = ComputePipeline::new(
@@ -284,7 +290,8 @@ impl Denoiser {
         l_min: Vec3,
     ) {
         assert!(
-            caustics.extent() == self.scratch.extent() && position.extent() == self.scratch.extent(),
+            caustics.extent() == self.scratch.extent()
+                && position.extent() == self.scratch.extent(),
             "Denoiser::record: images of another size than it was built for"
         );
         let push = |axis: u32| Push {
@@ -304,9 +311,24 @@ impl Denoiser {
             // previous pass's y sub-pass has read it (write-after-read).
             let set = &self.set_x;
             rec.pass(&format!("denoise {kind} {k} x"))
-                .storage_image(set, bindings::DENOISE_BINDING_INPUT, caustics, Access::ComputeRead)
-                .storage_image(set, bindings::DENOISE_BINDING_POSITION, position, Access::ComputeRead)
-                .overwrite_storage_image(set, bindings::DENOISE_BINDING_OUTPUT, &self.scratch, Access::ComputeWrite)
+                .storage_image(
+                    set,
+                    bindings::DENOISE_BINDING_INPUT,
+                    caustics,
+                    Access::ComputeRead,
+                )
+                .storage_image(
+                    set,
+                    bindings::DENOISE_BINDING_POSITION,
+                    position,
+                    Access::ComputeRead,
+                )
+                .overwrite_storage_image(
+                    set,
+                    bindings::DENOISE_BINDING_OUTPUT,
+                    &self.scratch,
+                    Access::ComputeWrite,
+                )
                 .record(|cmd| {
                     self.pipeline.dispatch(
                         cmd,
@@ -320,9 +342,24 @@ impl Denoiser {
             // sub-pass has read them.
             let set = &self.set_y;
             rec.pass(&format!("denoise {kind} {k} y"))
-                .storage_image(set, bindings::DENOISE_BINDING_INPUT, &self.scratch, Access::ComputeRead)
-                .storage_image(set, bindings::DENOISE_BINDING_POSITION, position, Access::ComputeRead)
-                .overwrite_storage_image(set, bindings::DENOISE_BINDING_OUTPUT, caustics, Access::ComputeWrite)
+                .storage_image(
+                    set,
+                    bindings::DENOISE_BINDING_INPUT,
+                    &self.scratch,
+                    Access::ComputeRead,
+                )
+                .storage_image(
+                    set,
+                    bindings::DENOISE_BINDING_POSITION,
+                    position,
+                    Access::ComputeRead,
+                )
+                .overwrite_storage_image(
+                    set,
+                    bindings::DENOISE_BINDING_OUTPUT,
+                    caustics,
+                    Access::ComputeWrite,
+                )
                 .record(|cmd| {
                     self.pipeline.dispatch(
                         cmd,
@@ -392,8 +429,7 @@ pub fn adaptive_vs_fixed(
         for frame in 0..=frames {
             let timings = profiler.frame(|rec| {
                 let ctx = rec.ctx().clone();
-                rec.pass("denoise input copy")
-                    .record(|cmd| {
+                rec.pass("denoise input copy").record(|cmd| {
                     copy_image(&ctx, cmd, input, &work);
                 });
                 denoiser.record(

@@ -147,13 +147,13 @@ mod splat;
 mod trace;
 mod view;
 
-pub use cascade_frame::{water_bounds, CascadeFrame};
 use cascade_frame::water_uniform;
+pub use cascade_frame::{water_bounds, CascadeFrame};
 pub use ccm::Ccm;
 pub use denoise::{DenoiseParams, Denoiser};
+pub use params::{GpuWpParams, WaterPhotonsParams, WpParamsBuffer};
 pub use splat::{Composite, Splat};
 pub use trace::{GpuWaterPhoton, PhotonCounts, Trace, GUARD_PHOTONS, GUARD_WORD};
-pub use params::{GpuWpParams, WaterPhotonsParams, WpParamsBuffer};
 pub use view::WaterView;
 
 use super::{Technique, TechniqueBuild};
@@ -320,13 +320,7 @@ impl WaterPhotons {
             BufferUsage::Uniform,
         )?);
         let ccm = Ccm::new(ctx, &water, size, levels)?;
-        let trace = Trace::new(
-            ctx,
-            scene_gpu,
-            &params_buffer,
-            &layout,
-            capacity,
-        )?;
+        let trace = Trace::new(ctx, scene_gpu, &params_buffer, &layout, capacity)?;
         // The cascade count and the splat mode as pipeline constants
         // (bindings.rs, WP_SPEC_*), not uniform reads: lavapipe would
         // recompile the water view at every bind.

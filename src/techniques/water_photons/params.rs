@@ -1,8 +1,8 @@
 //! `water_photons`' parameters and the uniform block its passes share.
 
+use super::bindings;
 use super::denoise::DenoiseParams;
 use crate::passes::direct_light::DirectParams;
-use super::bindings;
 use crate::vk::Buffer;
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
@@ -64,4 +64,3 @@ const _: () = assert!(size_of::<GpuWpParams>() == 192);
 
 /// The uniform buffer holding `GpuWpParams`, shared by the passes.
 pub struct WpParamsBuffer(pub Buffer);
-

@@ -12,11 +12,15 @@
 //! on diffuse pixels, reading whichever image `Composite::new` was given
 //! (the caustic buffer, or a denoised copy of it).
 
+use super::bindings;
 use super::WpParamsBuffer;
 use crate::frame::SceneGpu;
 use crate::passes::gbuffer::{GBuffer, DEPTH_FORMAT};
-use super::bindings;
-use crate::vk::{begin_rendering_with_depth, end_rendering, Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, Sampler, Specialization, VkResult, groups_8x8};
+use crate::vk::{
+    begin_rendering_with_depth, end_rendering, groups_8x8, Access, BindingKind, Buffer,
+    ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
+    GraphicsPipelineDesc, Image, ImageDesc, Sampler, Specialization, VkResult,
+};
 use ash::vk;
 use std::sync::Arc;
 
@@ -114,19 +118,19 @@ impl Splat {
             .read(draw, Access::IndirectRead)
             .read(photons, Access::VertexRead)
             .record(|cmd| {
-            let extent = self.caustics.extent();
-            begin_rendering_with_depth(
-                &ctx,
-                cmd,
-                extent,
-                &[(self.caustics.view, Some([0.0; 4]))],
-                Some((gbuffer.depth.view, false)),
-            );
-            self.pipeline
-                .bind(cmd, &[&scene.set, &self.set], &[], extent);
-            unsafe { ctx.device.cmd_draw_indirect(cmd, draw.raw, 0, 1, 0) };
-            end_rendering(&ctx, cmd);
-        });
+                let extent = self.caustics.extent();
+                begin_rendering_with_depth(
+                    &ctx,
+                    cmd,
+                    extent,
+                    &[(self.caustics.view, Some([0.0; 4]))],
+                    Some((gbuffer.depth.view, false)),
+                );
+                self.pipeline
+                    .bind(cmd, &[&scene.set, &self.set], &[], extent);
+                unsafe { ctx.device.cmd_draw_indirect(cmd, draw.raw, 0, 1, 0) };
+                end_rendering(&ctx, cmd);
+            });
     }
 }
 
@@ -143,9 +147,18 @@ impl Composite {
             ctx,
             &[
                 (bindings::WP_BINDING_CAUSTICS, BindingKind::StorageImage),
-                (bindings::WP_BINDING_GBUFFER_POSITION, BindingKind::StorageImage),
-                (bindings::WP_BINDING_GBUFFER_NORMAL, BindingKind::StorageImage),
-                (bindings::WP_BINDING_GBUFFER_ALBEDO, BindingKind::StorageImage),
+                (
+                    bindings::WP_BINDING_GBUFFER_POSITION,
+                    BindingKind::StorageImage,
+                ),
+                (
+                    bindings::WP_BINDING_GBUFFER_NORMAL,
+                    BindingKind::StorageImage,
+                ),
+                (
+                    bindings::WP_BINDING_GBUFFER_ALBEDO,
+                    BindingKind::StorageImage,
+                ),
                 (bindings::WP_BINDING_RADIANCE, BindingKind::StorageImage),
             ],
         )?;
@@ -175,16 +188,41 @@ impl Composite {
         // writes before this read-modify-write.
         let set = &self.set;
         rec.pass("caustic composite")
-            .storage_image(set, bindings::WP_BINDING_CAUSTICS, caustics, Access::ComputeRead)
-            .storage_image(set, bindings::WP_BINDING_GBUFFER_POSITION, &gbuffer.position, Access::ComputeRead)
-            .storage_image(set, bindings::WP_BINDING_GBUFFER_NORMAL, &gbuffer.normal, Access::ComputeRead)
-            .storage_image(set, bindings::WP_BINDING_GBUFFER_ALBEDO, &gbuffer.albedo, Access::ComputeRead)
-            .storage_image(set, bindings::WP_BINDING_RADIANCE, radiance, Access::ComputeWrite)
+            .storage_image(
+                set,
+                bindings::WP_BINDING_CAUSTICS,
+                caustics,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bindings::WP_BINDING_GBUFFER_POSITION,
+                &gbuffer.position,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bindings::WP_BINDING_GBUFFER_NORMAL,
+                &gbuffer.normal,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bindings::WP_BINDING_GBUFFER_ALBEDO,
+                &gbuffer.albedo,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bindings::WP_BINDING_RADIANCE,
+                radiance,
+                Access::ComputeWrite,
+            )
             .record(|cmd| {
-            let e = radiance.extent();
-            let groups = groups_8x8(e.width, e.height);
-            self.pipeline
-                .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
-        });
+                let e = radiance.extent();
+                let groups = groups_8x8(e.width, e.height);
+                self.pipeline
+                    .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
+            });
     }
 }

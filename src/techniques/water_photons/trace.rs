@@ -9,11 +9,14 @@
 //! copied to a host-visible buffer each frame and reported (a logged warning
 //! and [`PhotonCounts`]).
 
+use super::bindings;
 use super::WpParamsBuffer;
 use crate::cascades::CascadeLayout;
 use crate::frame::SceneGpu;
-use super::bindings;
-use crate::vk::{step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageDesc, MAX_FRAMES_IN_FLIGHT, VkResult};
+use crate::vk::{
+    step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    DescriptorSetLayout, FrameRecorder, Image, ImageDesc, VkResult, MAX_FRAMES_IN_FLIGHT,
+};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
@@ -204,71 +207,86 @@ impl Trace {
             .overwrite(&self.slots, Access::TransferWrite)
             .write(&self.draw, Access::TransferWrite)
             .record(|cmd| {
-            let reset = DrawCounters {
-                vertex_count: 4,
-                ..Zeroable::zeroed()
-            };
-            let none = vk::ClearColorValue {
-                uint32: [u32::MAX; 4],
-            };
-            let all_layers = vk::ImageSubresourceRange {
-                aspect_mask: vk::ImageAspectFlags::COLOR,
-                base_mip_level: 0,
-                level_count: 1,
-                base_array_layer: 0,
-                layer_count: vk::REMAINING_ARRAY_LAYERS,
-            };
-            unsafe {
-                ctx.device
-                    .cmd_update_buffer(cmd, self.draw.raw, 0, bytemuck::bytes_of(&reset));
-                ctx.device.cmd_clear_color_image(
-                    cmd,
-                    self.slots.raw,
-                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                    &none,
-                    &[all_layers],
-                );
-            };
-        });
+                let reset = DrawCounters {
+                    vertex_count: 4,
+                    ..Zeroable::zeroed()
+                };
+                let none = vk::ClearColorValue {
+                    uint32: [u32::MAX; 4],
+                };
+                let all_layers = vk::ImageSubresourceRange {
+                    aspect_mask: vk::ImageAspectFlags::COLOR,
+                    base_mip_level: 0,
+                    level_count: 1,
+                    base_array_layer: 0,
+                    layer_count: vk::REMAINING_ARRAY_LAYERS,
+                };
+                unsafe {
+                    ctx.device
+                        .cmd_update_buffer(cmd, self.draw.raw, 0, bytemuck::bytes_of(&reset));
+                    ctx.device.cmd_clear_color_image(
+                        cmd,
+                        self.slots.raw,
+                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                        &none,
+                        &[all_layers],
+                    );
+                };
+            });
         // The reset before the atomics; the CCM attachments before the
         // storage-image reads; the photons after last frame's vertex reads;
         // the BVH after any refit.
         let set = &self.set;
         rec.pass("photon trace")
-            .storage_image(set, bindings::WP_BINDING_CCM_POSITION, ccm_position, Access::ComputeRead)
-            .storage_image(set, bindings::WP_BINDING_CCM_NORMAL, ccm_normal, Access::ComputeRead)
-            .storage_image(set, bindings::WP_BINDING_PHOTON_SLOTS, &self.slots, Access::ComputeWrite)
+            .storage_image(
+                set,
+                bindings::WP_BINDING_CCM_POSITION,
+                ccm_position,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bindings::WP_BINDING_CCM_NORMAL,
+                ccm_normal,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bindings::WP_BINDING_PHOTON_SLOTS,
+                &self.slots,
+                Access::ComputeWrite,
+            )
             .write(&self.draw, Access::ComputeWrite)
             .write(&self.photons, Access::ComputeWrite)
             .read(&scene.triangles, Access::ComputeRead)
             .record(|cmd| {
-            let per_row = (bindings::WP_TRACE_GROUP_SIZE * bindings::WP_TRACE_GROUPS_PER_ROW) as u64;
-            let groups = if self.threads <= per_row {
-                [
-                    self.threads.div_ceil(bindings::WP_TRACE_GROUP_SIZE as u64) as u32,
-                    1,
-                    1,
-                ]
-            } else {
-                [
-                    bindings::WP_TRACE_GROUPS_PER_ROW,
-                    self.threads.div_ceil(per_row) as u32,
-                    1,
-                ]
-            };
-            self.pipeline
-                .dispatch(cmd, &[&scene.set, set], &[], groups);
-            // The atomics done, the counts go to the host...
-            step(&ctx, cmd)
-                .read(&self.draw, Access::TransferRead)
-                .write(readback, Access::TransferWrite)
-                .emit();
-            let region = vk::BufferCopy::default().size(self.draw.size);
-            unsafe {
-                ctx.device
-                    .cmd_copy_buffer(cmd, self.draw.raw, readback.raw, &[region])
-            };
-            step(&ctx, cmd).read(readback, Access::HostRead).emit();
-        });
+                let per_row =
+                    (bindings::WP_TRACE_GROUP_SIZE * bindings::WP_TRACE_GROUPS_PER_ROW) as u64;
+                let groups = if self.threads <= per_row {
+                    [
+                        self.threads.div_ceil(bindings::WP_TRACE_GROUP_SIZE as u64) as u32,
+                        1,
+                        1,
+                    ]
+                } else {
+                    [
+                        bindings::WP_TRACE_GROUPS_PER_ROW,
+                        self.threads.div_ceil(per_row) as u32,
+                        1,
+                    ]
+                };
+                self.pipeline.dispatch(cmd, &[&scene.set, set], &[], groups);
+                // The atomics done, the counts go to the host...
+                step(&ctx, cmd)
+                    .read(&self.draw, Access::TransferRead)
+                    .write(readback, Access::TransferWrite)
+                    .emit();
+                let region = vk::BufferCopy::default().size(self.draw.size);
+                unsafe {
+                    ctx.device
+                        .cmd_copy_buffer(cmd, self.draw.raw, readback.raw, &[region])
+                };
+                step(&ctx, cmd).read(readback, Access::HostRead).emit();
+            });
     }
 }

@@ -10,12 +10,15 @@
 //! (`WP_SPEC_*`): as uniform reads they made lavapipe recompile the shader
 //! at every bind, +1.85 MB host memory a frame (BENCHMARKS.md, "Soak").
 
+use super::bindings;
 use super::WpParamsBuffer;
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::specular_gbuffer::SpecularGBuffer;
-use super::bindings;
-use crate::vk::{Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, Specialization, VkResult, groups_8x8};
+use crate::vk::{
+    groups_8x8, Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet,
+    DescriptorSetLayout, FrameRecorder, Image, Specialization, VkResult,
+};
 use std::sync::Arc;
 
 pub struct WaterView {
@@ -38,11 +41,23 @@ impl WaterView {
                 (bindings::WP_BINDING_PARAMS, BindingKind::Uniform),
                 (bindings::WP_BINDING_PHOTONS, BindingKind::Storage),
                 (bindings::WP_BINDING_PHOTON_SLOTS, BindingKind::StorageImage),
-                (bindings::WP_BINDING_OPAQUE_RADIANCE, BindingKind::StorageImage),
-                (bindings::WP_BINDING_GBUFFER_POSITION, BindingKind::StorageImage),
-                (bindings::WP_BINDING_FRONT_POSITION, BindingKind::StorageImage),
+                (
+                    bindings::WP_BINDING_OPAQUE_RADIANCE,
+                    BindingKind::StorageImage,
+                ),
+                (
+                    bindings::WP_BINDING_GBUFFER_POSITION,
+                    BindingKind::StorageImage,
+                ),
+                (
+                    bindings::WP_BINDING_FRONT_POSITION,
+                    BindingKind::StorageImage,
+                ),
                 (bindings::WP_BINDING_FRONT_NORMAL, BindingKind::StorageImage),
-                (bindings::WP_BINDING_BACK_POSITION, BindingKind::StorageImage),
+                (
+                    bindings::WP_BINDING_BACK_POSITION,
+                    BindingKind::StorageImage,
+                ),
                 (bindings::WP_BINDING_RADIANCE, BindingKind::StorageImage),
             ],
         )?;
@@ -85,18 +100,52 @@ impl WaterView {
         // to compute by the refraction pass's barrier.
         let set = &self.set;
         rec.pass("water view")
-            .storage_image(set, bindings::WP_BINDING_PHOTON_SLOTS, slots, Access::ComputeRead)
-            .storage_image(set, bindings::WP_BINDING_OPAQUE_RADIANCE, opaque, Access::ComputeRead)
-            .storage_image(set, bindings::WP_BINDING_GBUFFER_POSITION, &opaque_gbuffer.position, Access::ComputeRead)
-            .storage_image(set, bindings::WP_BINDING_FRONT_POSITION, &specular.front_position, Access::ComputeRead)
-            .storage_image(set, bindings::WP_BINDING_FRONT_NORMAL, &specular.front_normal, Access::ComputeRead)
-            .storage_image(set, bindings::WP_BINDING_BACK_POSITION, &specular.back_position, Access::ComputeRead)
-            .storage_image(set, bindings::WP_BINDING_RADIANCE, &targets.radiance, Access::ComputeWrite)
+            .storage_image(
+                set,
+                bindings::WP_BINDING_PHOTON_SLOTS,
+                slots,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bindings::WP_BINDING_OPAQUE_RADIANCE,
+                opaque,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bindings::WP_BINDING_GBUFFER_POSITION,
+                &opaque_gbuffer.position,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bindings::WP_BINDING_FRONT_POSITION,
+                &specular.front_position,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bindings::WP_BINDING_FRONT_NORMAL,
+                &specular.front_normal,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bindings::WP_BINDING_BACK_POSITION,
+                &specular.back_position,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bindings::WP_BINDING_RADIANCE,
+                &targets.radiance,
+                Access::ComputeWrite,
+            )
             .read(photons, Access::ComputeRead)
             .record(|cmd| {
-            let groups = groups_8x8(targets.width, targets.height);
-            self.pipeline
-                .dispatch(cmd, &[&scene.set, set], &[], groups);
-        });
+                let groups = groups_8x8(targets.width, targets.height);
+                self.pipeline.dispatch(cmd, &[&scene.set, set], &[], groups);
+            });
     }
 }
