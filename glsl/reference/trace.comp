@@ -4,7 +4,9 @@
 // Fresnel, Snell, total internal reflection, Beer-Lambert absorption inside
 // dielectrics) and through the medium (free-flight sampling against a
 // majorant with null collisions, Henyey-Greenstein scattering), and at every
-// diffuse hit and every medium collision connects it to the camera.
+// diffuse hit and every medium collision connects it to the camera, but for
+// photons straight from a point, spot or directional light: their direct
+// light (L D E, L V E) is camera.comp's, by shadow rays.
 //
 // Measurement (the pinhole camera's importance): a photon of flux Phi at x
 // adds to pixel j's mean radiance
@@ -328,6 +330,8 @@ void main() {
     float g = medium.sigma_s.w;
 
     for (uint depth = 0u; depth < pc.max_depth; ++depth) {
+        // Direct light (L D, L V) is camera.comp's for these photons.
+        bool straight_from_punctual_light = !extended && specular == 0u && !scattered_or_bounced;
         Hit hit;
         bool found = trace_closest(s.origin, s.dir, 0.0, 1e30, hit);
         float t_hit = found ? hit.t : 1e30;
@@ -350,7 +354,9 @@ void main() {
                     // Every tentative collision connects: E[sum] = integral of T sigma_s along the ray.
                     if (any(greaterThan(sigma_s, vec3(0.0)))) {
                         uint tag = tag_for(specular, scattered_or_bounced, true);
-                        connect_medium(x, s.dir, s.weight * sigma_s / majorant, g, tag, rng);
+                        // Straight from a punctual light: airlight, which
+                        // camera.comp samples along the camera rays.
+                        if (!straight_from_punctual_light) connect_medium(x, s.dir, s.weight * sigma_s / majorant, g, tag, rng);
                         if (pc.volume_capacity != 0u) store_volume_photon(x, s.dir, s.weight * sigma_s / majorant, tag);
                     }
                     float p_scatter = (sigma_s.r + sigma_s.g + sigma_s.b) / (3.0 * majorant);
@@ -384,12 +390,14 @@ void main() {
             vec3 ng_in = front ? ng : -ng; // the side the photon arrives on
             uint tag = tag_for(specular, scattered_or_bounced, false);
             vec3 albedo = hit_albedo(hit);
-            connect_surface(x, ng_in, s.weight, albedo, tag, rng);
             // A photon straight from a point, spot or directional light is
-            // the visible points' direct light (camera.comp samples it):
-            // every other one is gathered.
-            if (pc.gather != 0u && (specular > 0u || scattered_or_bounced || extended)) {
-                gather_surface(x, ng_in, s.weight, tag);
+            // direct light (L D), which camera.comp samples by shadow rays
+            // at every pixel's diffuse point, seen directly or through a
+            // specular chain: it is neither connected nor gathered. Every
+            // other photon is both.
+            if (!straight_from_punctual_light) {
+                connect_surface(x, ng_in, s.weight, albedo, tag, rng);
+                if (pc.gather != 0u) gather_surface(x, ng_in, s.weight, tag);
             }
             // The photon goes on by a `mixed` material's mirror part with
             // probability lum(specular), or diffusely (while diffuse bounces
