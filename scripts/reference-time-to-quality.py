@@ -11,7 +11,8 @@ converged image of the same scene, per scene, for one or more builds of it
 For each scene: a converged image, traced once by the first binary for
 --converged-seconds with its own seed and kept under
 target/tmp/time-to-quality/ (delete it to trace again); then, per binary,
-a ladder of runs with `--seconds 1, 2, 4, ...` (another seed) until the
+a ladder of runs with `--seconds 1, 2, 4, ...` (another seed; `--first`
+sets the first rung, `--extra "--pass-photons 16384"` smaller passes) until the
 FLIP falls below 0.05 or the ladder reaches --cap seconds. The seconds are
 the tracing time the binary reports (device start-up and pipeline
 compilation excluded, as Mitsuba's JIT warm-up is). The time to a FLIP is
@@ -95,7 +96,7 @@ OUR_OPTIONS = {"medium_box": ["--diffuse-bounces", "6"]}
 
 
 def mitsuba_measure(scene, size):
-    """Mitsuba's converged image (65536 samples per pixel, once) and a
+    """Mitsuba's converged image (16384 samples per pixel, once) and a
     measure(spp) for the ladder, in its fastest variant that runs here
     (`llvm_ad_rgb` with Debian's LLVM 19 unpacked, GUIDE §8, on every core).
     Each rung renders twice and times the second (JIT compilation excluded)."""
@@ -109,9 +110,9 @@ def mitsuba_measure(scene, size):
     path = f"{CACHE}/{scene}-{size}-mitsuba-converged.npy"
     if not os.path.exists(path):
         total = np.zeros((size, size, 3))
-        for k in range(16):
+        for k in range(4):
             total += np.asarray(mi.render(loaded, spp=4096, seed=1000 + k))[..., :3]
-        np.save(path, total / 16)
+        np.save(path, total / 4)
     converged = np.load(path)
 
     def measure(spp):
@@ -142,6 +143,7 @@ def main():
     p.add_argument("--binary", action="append", default=[], help="LABEL=PATH (repeatable)")
     p.add_argument("--converged-seconds", type=float, default=240)
     p.add_argument("--cap", type=float, default=256, help="longest rung (s)")
+    p.add_argument("--first", type=float, default=1, help="first rung (s; with small --pass-photons below 1)")
     p.add_argument("--mitsuba", action="store_true", help="also Mitsuba 3 (scripts/mitsuba_scenes.py)")
     p.add_argument("--extra", default="", help="more `caustics reference` options for every run")
     a = p.parse_args()
@@ -160,7 +162,7 @@ def main():
             def measure(seconds, binary=binary):
                 t, photons, image = ours(binary, scene, a.size, seconds, 7, f"/tmp/ttq-{label}.exr", extra)
                 return t, f"{photons / 1e6:.1f} M photons", image
-            rungs = ladder(f"{scene} {label}", measure, converged, scale, 1, a.cap)
+            rungs = ladder(f"{scene} {label}", measure, converged, scale, a.first, a.cap)
             results.append((scene, label, rungs))
         if a.mitsuba and scene in MITSUBA_INTEGRATORS:
             mi_converged, measure = mitsuba_measure(scene, a.size)

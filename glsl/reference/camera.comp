@@ -16,10 +16,11 @@
 // the environment's radiance, one that meets an area light's front face
 // adds its radiance, whether directly (depth 0: the background, a lamp) or
 // after specular bounces (in a mirror, through glass and water).
-// How the path space splits: direct light from the point, spot and
-// directional lights (L D S* E) is this pass's at every pixel's diffuse
-// point, seen directly (its first hit) or through a specular chain, by
-// shadow rays, which converge far sooner than photons landing there. Of
+// How the path space splits: the direct light of the point, spot,
+// directional, rect and triangle lights is this pass's, by shadow rays,
+// which converge far sooner than photons: at every pixel's diffuse point,
+// seen directly or through a specular chain (L D S* E), and along the
+// camera ray's first segment (single scattering, L V E). Of
 // every other path, a pixel sample whose first hit is diffuse is the light
 // tracer's (its camera connections, trace.comp), one whose first hit is
 // specular this pass's (the photon gather). So no path is counted twice.
@@ -43,41 +44,81 @@ vec3 mean_transmittance(vec3 o, vec3 d, float dist, inout uint rng) {
     return sum / float(TRANSMITTANCE_ESTIMATES);
 }
 
-// The share of light l's arriving irradiance that reaches o along
-// `to_light` (`dist` away; directional: 1e30): 0 when something blocks it,
-// else the medium's transmittance (ratio tracking, unbiased).
-vec3 light_visibility(vec3 o, vec3 to_light, float dist, inout uint rng) {
-    float reach = dist > 1e29 ? 1e30 : dist * (1.0 - 1e-4);
+// The share of a light's arriving irradiance that reaches o along
+// `to_light` from `dist` away (directional: 1e30): 0 when something blocks
+// the shadow ray, which stops `shorten` (relative) short of the light so as
+// not to meet an area light's own triangles, else the medium's
+// transmittance.
+vec3 light_visibility(vec3 o, vec3 to_light, float dist, float shorten, inout uint rng) {
+    float reach = dist > 1e29 ? 1e30 : dist * (1.0 - shorten);
     if (trace_any(o, to_light, 0.0, reach)) return vec3(0.0);
     float travel = dist > 1e29 ? 2.0 * frame.scene_sphere.w + length(o - frame.scene_sphere.xyz) : dist;
     return mean_transmittance(o, to_light, travel, rng);
 }
 
+const float PUNCTUAL_SHADOW_SHORTEN = 1e-4;
+const float AREA_SHADOW_SHORTEN = 1e-3; // as emitter_shadow_target
+
+// Radiance toward the eye from diffuse point x (normal n on the seen side,
+// albedo a): the direct light of every light camera.comp samples, each by
+// one shadow ray a pass: point, spot and directional lights exactly, rect
+// and triangle lights at a point uniform over their area
+//     E = L cos_y cos_x A / d^2   (pdf 1/A).
 vec3 direct_light(vec3 x, vec3 n, vec3 albedo, inout uint rng) {
     vec3 sum = vec3(0.0);
+    vec3 o = offset_origin(x, n);
     for (uint l = 0u; l < frame.counts.x; ++l) {
         vec3 to_light;
         float dist;
         vec3 e = light_irradiance(l, x, n, to_light, dist);
         if (all(equal(e, vec3(0.0)))) continue;
-        sum += e * light_visibility(offset_origin(x, n), to_light, dist, rng);
+        sum += e * light_visibility(o, to_light, dist, PUNCTUAL_SHADOW_SHORTEN, rng);
+    }
+    for (uint a = 0u; a < frame.components.y; ++a) {
+        Emitter em = emitters[a];
+        if (!emitter_sampled_by_camera(em)) continue;
+        vec3 y, ny;
+        float area;
+        sample_emitter_point(em, vec2(rng_next(rng), rng_next(rng)), y, ny, area);
+        vec3 v = y - x;
+        float dist = length(v);
+        vec3 w = v / dist;
+        float cos_x = dot(n, w), cos_y = -dot(ny, w);
+        if (!(cos_x > 0.0 && cos_y > 0.0)) continue;
+        vec3 e = em.radiance.rgb * (cos_x * cos_y * area / (dist * dist));
+        sum += e * light_visibility(o, w, dist, AREA_SHADOW_SHORTEN, rng);
     }
     return albedo / PI * sum;
 }
 
-// Single scattering of the punctual lights along the camera ray's first
-// segment, from the eye `o` along `d` to `t_end` (L V E, the airlight
-// component): the integral of T(o, x_t) sigma_s(x_t) p(theta) E(x_t)
-// V(x_t) dt over the segment's part inside the medium, AIRLIGHT_SAMPLES
-// stratified samples per light and pass. Point and spot lights: equiangular sampling (Kulla & Fajardo
-// 2012, "Importance sampling techniques for path tracing in participating
-// media", Sect. 4.1: t = delta + D tan(theta), pdf = D / ((theta_b -
-// theta_a)(D^2 + (t - delta)^2)), D the light's distance from the ray line
-// and delta its foot), which cancels the 1/d^2 near the light, over the
-// part of the segment inside a spot's cone; directional lights: uniform
-// in t. trace.comp leaves these paths to this estimate (its
-// photons straight from a punctual light connect no medium collision).
-const uint AIRLIGHT_SAMPLES = 4u; // stratified in u: the ball's shadow in a spot's cone
+// A distance t on [t0, t1] along o + t d for a light at p: equiangular
+// (Kulla & Fajardo 2012, "Importance sampling techniques for path tracing in
+// participating media", Sect. 4.1: t = delta + D tan(theta), pdf = D /
+// ((theta_b - theta_a)(D^2 + (t - delta)^2)), D the light's distance from
+// the ray line and delta its foot), which cancels the 1/d^2 near the light;
+// a light at infinity (directional): uniform.
+float sample_segment(vec3 p, bool at_infinity, vec3 o, vec3 d, float t0, float t1, float u, out float pdf) {
+    if (at_infinity) {
+        pdf = 1.0 / (t1 - t0);
+        return mix(t0, t1, u);
+    }
+    float foot = dot(p - o, d);
+    float D = max(length(p - (o + foot * d)), 1e-6);
+    float theta_a = atan((t0 - foot) / D), theta_b = atan((t1 - foot) / D);
+    float t = clamp(foot + D * tan(mix(theta_a, theta_b, u)), t0, t1);
+    float h = t - foot;
+    pdf = D / ((theta_b - theta_a) * (D * D + h * h));
+    return t;
+}
+
+// Single scattering along the camera ray's first segment, from the eye `o`
+// along `d` to `t_end` (L V E, the airlight component): the integral of
+// T(o, x_t) sigma_s(x_t) p(theta) E(x_t) V(x_t) dt over the segment's part
+// inside the medium (a spot's: inside its cone, `spot_cone_interval`), by
+// AIRLIGHT_SAMPLES samples per light and pass, stratified in t
+// (`sample_segment`; an area light: each about a point uniform over it,
+// E = L cos_y A / d^2). trace.comp leaves these paths to this estimate.
+const uint AIRLIGHT_SAMPLES = 4u; // the ball's shadow in a spot's cone needs a few
 vec3 airlight(vec3 o, vec3 d, float t_end, inout uint rng) {
     float segment_start = 0.0, segment_end = t_end;
     if (!medium_present() || !clip_to_medium(o, d, segment_start, segment_end) || !(segment_end > segment_start)) {
@@ -85,34 +126,44 @@ vec3 airlight(vec3 o, vec3 d, float t_end, inout uint rng) {
     }
     float g = medium.sigma_s.w;
     vec3 sum = vec3(0.0);
-    for (uint l = 0u; l < frame.counts.x; ++l) {
-        Light light = lights[l];
-        float t0 = segment_start, t1 = segment_end;
-        if (!spot_cone_interval(l, o, d, t0, t1)) continue;
-        for (uint k = 0u; k < AIRLIGHT_SAMPLES; ++k) {
-        float u = (float(k) + rng_next(rng)) / float(AIRLIGHT_SAMPLES);
-        float t, pdf;
-        if (floatBitsToUint(light.position.w) == LIGHT_DIRECTIONAL) {
-            t = mix(t0, t1, u);
-            pdf = 1.0 / (t1 - t0);
-        } else {
-            float foot = dot(light.position.xyz - o, d);
-            float D = max(length(light.position.xyz - (o + foot * d)), 1e-6);
-            float theta_a = atan((t0 - foot) / D), theta_b = atan((t1 - foot) / D);
-            t = clamp(foot + D * tan(mix(theta_a, theta_b, u)), t0, t1);
-            float h = t - foot;
-            pdf = D / ((theta_b - theta_a) * (D * D + h * h));
+    uint punctual = frame.counts.x;
+    for (uint l = 0u; l < punctual + frame.components.y; ++l) {
+        bool is_area = l >= punctual;
+        Emitter em;
+        if (is_area) {
+            em = emitters[l - punctual];
+            if (!emitter_sampled_by_camera(em)) continue;
         }
-        if (!(pdf > 0.0)) continue;
-        vec3 x = o + t * d;
-        vec3 sigma_s = medium.sigma_s.rgb * medium_density(x);
-        if (all(equal(sigma_s, vec3(0.0)))) continue;
-        vec3 to_light;
-        float dist;
-        vec3 e = light_arriving(l, x, to_light, dist);
-        if (all(equal(e, vec3(0.0)))) continue;
-        vec3 tr = mean_transmittance(o, d, t, rng) * light_visibility(x, to_light, dist, rng);
-        sum += tr * sigma_s * hg_phase(dot(to_light, d), g) * e / (pdf * float(AIRLIGHT_SAMPLES));
+        float t0 = segment_start, t1 = segment_end;
+        if (!is_area && !spot_cone_interval(l, o, d, t0, t1)) continue;
+        bool at_infinity = !is_area && floatBitsToUint(lights[l].position.w) == LIGHT_DIRECTIONAL;
+        for (uint k = 0u; k < AIRLIGHT_SAMPLES; ++k) {
+            vec3 p = is_area ? vec3(0.0) : lights[l].position.xyz;
+            vec3 np = vec3(0.0);
+            float area = 0.0;
+            if (is_area) sample_emitter_point(em, vec2(rng_next(rng), rng_next(rng)), p, np, area);
+            float pdf;
+            float u = (float(k) + rng_next(rng)) / float(AIRLIGHT_SAMPLES);
+            float t = sample_segment(p, at_infinity, o, d, t0, t1, u, pdf);
+            if (!(pdf > 0.0)) continue;
+            vec3 x = o + t * d;
+            vec3 sigma_s = medium.sigma_s.rgb * medium_density(x);
+            if (all(equal(sigma_s, vec3(0.0)))) continue;
+            vec3 to_light;
+            float dist;
+            vec3 e;
+            if (is_area) {
+                vec3 v = p - x;
+                dist = length(v);
+                to_light = v / dist;
+                e = em.radiance.rgb * (max(-dot(np, to_light), 0.0) * area / (dist * dist));
+            } else {
+                e = light_arriving(l, x, to_light, dist);
+            }
+            if (all(equal(e, vec3(0.0)))) continue;
+            float shorten = is_area ? AREA_SHADOW_SHORTEN : PUNCTUAL_SHADOW_SHORTEN;
+            vec3 tr = mean_transmittance(o, d, t, rng) * light_visibility(x, to_light, dist, shorten, rng);
+            sum += tr * sigma_s * hg_phase(dot(to_light, d), g) * e / (pdf * float(AIRLIGHT_SAMPLES));
         }
     }
     return sum;

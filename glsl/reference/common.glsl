@@ -180,6 +180,43 @@ void specular_bounce(inout SpecularState s, vec3 x, vec3 ng, vec3 ns, bool front
     }
 }
 
+// A point y uniform over area light `em` (pdf 1 / area) and the normal n
+// it emits along there: rect and triangle, one-sided (the triangle's front
+// being the side cross(p1 - p0, p2 - p0) points to; a triangle by Shirley's
+// warp, barycentrics (1 - sqrt(u1), sqrt(u1) (1 - u2), sqrt(u1) u2));
+// sphere: on the exact sphere, outward (A = 4 pi r^2), outside its
+// inscribed tessellation.
+void sample_emitter_point(Emitter em, vec2 u, out vec3 y, out vec3 n, out float area) {
+    uint kind = floatBitsToUint(em.position.w);
+    if (kind == EMITTER_TRIANGLE) {
+        vec3 e1 = em.normal.xyz, e2 = em.tangent.xyz;
+        n = normalize(cross(e1, e2));
+        float su = sqrt(u.x);
+        y = em.position.xyz + e1 * (su * (1.0 - u.y)) + e2 * (su * u.y);
+        area = em.normal.w;
+    } else if (kind == EMITTER_RECT) {
+        n = em.normal.xyz;
+        vec3 t = em.tangent.xyz;
+        vec3 b = cross(n, t);
+        y = em.position.xyz + t * ((u.x - 0.5) * em.normal.w) + b * ((u.y - 0.5) * em.tangent.w);
+        area = em.normal.w * em.tangent.w;
+    } else {
+        n = uniform_sphere(u);
+        float r = em.normal.w;
+        y = em.position.xyz + n * r;
+        area = 4.0 * PI * r * r;
+    }
+}
+
+// Area lights whose direct light camera.comp samples by shadow rays (so
+// trace.comp leaves their photons' first hits to it): rects and triangles.
+// Not spheres: a point on the exact sphere lies outside its tessellation,
+// which would block every shadow ray toward it.
+bool emitter_sampled_by_camera(Emitter em) {
+    uint kind = floatBitsToUint(em.position.w);
+    return kind == EMITTER_RECT || kind == EMITTER_TRIANGLE;
+}
+
 // A camera ray through a uniformly jittered point of pixel p (weight 1).
 SpecularState camera_ray(uvec2 p, inout uint rng) {
     vec2 jitter = vec2(rng_next(rng), rng_next(rng));

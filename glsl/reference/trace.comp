@@ -5,8 +5,8 @@
 // dielectrics) and through the medium (free-flight sampling against a
 // majorant with null collisions, Henyey-Greenstein scattering), and at every
 // diffuse hit and every medium collision connects it to the camera, but for
-// photons straight from a point, spot or directional light: their direct
-// light (L D E, L V E) is camera.comp's, by shadow rays.
+// photons straight from a point, spot, directional, rect or triangle light:
+// their direct light (L D E, L V E) is camera.comp's, by shadow rays.
 //
 // Measurement (the pinhole camera's importance): a photon of flux Phi at x
 // adds to pixel j's mean radiance
@@ -93,39 +93,15 @@ uint pick_light(float u, out float probability) {
 }
 
 // Emits a photon from area light `e`: a point uniform over its area (pdf
-// 1/A) and a cosine-weighted direction about its normal there (pdf
-// cos/pi), so every photon carries the power pi L A (rect and triangle:
-// one-sided, the triangle's front being the side cross(p1-p0, p2-p0)
-// points to; sphere: A = 4 pi r^2, outward at every point).
+// 1/A, `sample_emitter_point`) and a cosine-weighted direction about its
+// normal there (pdf cos/pi), so every photon carries the power pi L A.
 void emit_area(uint e, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) {
     Emitter em = emitters[e];
     vec2 u = vec2(rng_next(rng), rng_next(rng));
     vec2 v = vec2(rng_next(rng), rng_next(rng));
     vec3 n;
     float area;
-    uint kind = floatBitsToUint(em.position.w);
-    if (kind == EMITTER_TRIANGLE) {
-        // Uniform over the triangle: barycentrics (1 - sqrt(u1),
-        // sqrt(u1) (1 - u2), sqrt(u1) u2) (Shirley's warp, pdf 1/A).
-        vec3 e1 = em.normal.xyz, e2 = em.tangent.xyz;
-        n = normalize(cross(e1, e2));
-        float su = sqrt(u.x);
-        origin = em.position.xyz + e1 * (su * (1.0 - u.y)) + e2 * (su * u.y);
-        area = em.normal.w;
-    } else if (kind == EMITTER_RECT) {
-        n = em.normal.xyz;
-        vec3 t = em.tangent.xyz;
-        vec3 b = cross(n, t);
-        origin = em.position.xyz + t * ((u.x - 0.5) * em.normal.w) + b * ((u.y - 0.5) * em.tangent.w);
-        area = em.normal.w * em.tangent.w;
-    } else {
-        n = uniform_sphere(u);
-        float r = em.normal.w;
-        // On the exact sphere: outside its inscribed tessellation, which an
-        // outward ray cannot meet.
-        origin = em.position.xyz + n * r;
-        area = 4.0 * PI * r * r;
-    }
+    sample_emitter_point(em, u, origin, n, area);
     origin = offset_origin(origin, n);
     dir = cosine_hemisphere(v, n);
     flux = em.radiance.rgb * PI * area;
@@ -177,9 +153,9 @@ void emit(uint l, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) 
     Light light = lights[l];
     uint kind = floatBitsToUint(light.position.w);
     // A random choice per photon. (Stratifying it by invocation, aimed
-    // photons first, measured 2x slower on ball_lens at 128^2: the aimed
-    // photons then land together and their float atomics on the caustic's
-    // few pixels contend.)
+    // photons first, measured 2x slower on ball_lens at 128^2; not for the
+    // float atomics, which cost nothing measurable there: BENCHMARKS.md,
+    // "Ground truth: time to quality".)
     float choice = rng_next(rng);
     vec2 u = vec2(rng_next(rng), rng_next(rng));
     vec3 aim_center = pc.aim.xyz;
@@ -311,11 +287,14 @@ void main() {
     uint l = pick_light(rng_next(rng), light_probability);
     if (light_probability <= 0.0) return; // every light is black
     SpecularState s;
-    // Area lights and the environment have no shadow rays at the visible
-    // points (camera.comp samples only the punctual lights there), so their
-    // photons are gathered there from the first hit on.
     bool extended = l >= frame.counts.x;
     uint areas_end = frame.counts.x + frame.components.y;
+    // camera.comp samples the direct light of the point, spot and
+    // directional lights and of rect and triangle area lights by shadow
+    // rays; the environment's and sphere lights' photons are connected and
+    // gathered from their first hit on.
+    bool sampled_by_camera = !extended
+        || (l < areas_end && emitter_sampled_by_camera(emitters[l - frame.counts.x]));
     if (!extended) emit(l, rng, s.origin, s.dir, s.weight);
     else if (l < areas_end) emit_area(l - frame.counts.x, rng, s.origin, s.dir, s.weight);
     else emit_environment(l > areas_end, rng, s.origin, s.dir, s.weight);
@@ -331,7 +310,7 @@ void main() {
 
     for (uint depth = 0u; depth < pc.max_depth; ++depth) {
         // Direct light (L D, L V) is camera.comp's for these photons.
-        bool straight_from_punctual_light = !extended && specular == 0u && !scattered_or_bounced;
+        bool straight_from_sampled_light = sampled_by_camera && specular == 0u && !scattered_or_bounced;
         Hit hit;
         bool found = trace_closest(s.origin, s.dir, 0.0, 1e30, hit);
         float t_hit = found ? hit.t : 1e30;
@@ -354,9 +333,9 @@ void main() {
                     // Every tentative collision connects: E[sum] = integral of T sigma_s along the ray.
                     if (any(greaterThan(sigma_s, vec3(0.0)))) {
                         uint tag = tag_for(specular, scattered_or_bounced, true);
-                        // Straight from a punctual light: airlight, which
+                        // Straight from a sampled light: airlight, which
                         // camera.comp samples along the camera rays.
-                        if (!straight_from_punctual_light) connect_medium(x, s.dir, s.weight * sigma_s / majorant, g, tag, rng);
+                        if (!straight_from_sampled_light) connect_medium(x, s.dir, s.weight * sigma_s / majorant, g, tag, rng);
                         if (pc.volume_capacity != 0u) store_volume_photon(x, s.dir, s.weight * sigma_s / majorant, tag);
                     }
                     float p_scatter = (sigma_s.r + sigma_s.g + sigma_s.b) / (3.0 * majorant);
@@ -390,12 +369,11 @@ void main() {
             vec3 ng_in = front ? ng : -ng; // the side the photon arrives on
             uint tag = tag_for(specular, scattered_or_bounced, false);
             vec3 albedo = hit_albedo(hit);
-            // A photon straight from a point, spot or directional light is
-            // direct light (L D), which camera.comp samples by shadow rays
-            // at every pixel's diffuse point, seen directly or through a
-            // specular chain: it is neither connected nor gathered. Every
-            // other photon is both.
-            if (!straight_from_punctual_light) {
+            // A photon straight from a light camera.comp samples is direct
+            // light (L D), which it samples by shadow rays at every pixel's
+            // diffuse point, seen directly or through a specular chain: it
+            // is neither connected nor gathered. Every other photon is both.
+            if (!straight_from_sampled_light) {
                 connect_surface(x, ng_in, s.weight, albedo, tag, rng);
                 if (pc.gather != 0u) gather_surface(x, ng_in, s.weight, tag);
             }

@@ -167,6 +167,11 @@ pub struct ReferenceArgs {
     /// distribution. Unbiased for any share; more caustic photons.
     #[arg(long, allow_negative_numbers = true, default_value_t = 0.5)]
     pub aim_share: f32,
+    /// Photons per pass, a multiple of 64 from 64 to 16,777,216: a pass is
+    /// the unit of progress (its camera samples, its photons, its radius).
+    /// Smaller passes show a first image sooner.
+    #[arg(long, default_value_t = 1 << 18)]
+    pub pass_photons: u32,
     /// Path-type component to write: direct, surface_caustics, airlight, volume_caustics, other, all.
     #[arg(long, default_value = "all")]
     pub component: String,

@@ -14,6 +14,7 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
         radius,
         no_photon_mapping,
         aim_share,
+        pass_photons,
         component,
         diffuse_bounces,
         out,
@@ -27,6 +28,11 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
         if !(seconds.is_finite() && seconds > 0.0) {
             anyhow::bail!("--seconds must be a positive number, got {seconds}");
         }
+    }
+    if !(64..=1 << 24).contains(&pass_photons) || pass_photons % 64 != 0 {
+        anyhow::bail!(
+            "--pass-photons must be a multiple of 64 from 64 to 16777216, got {pass_photons}"
+        );
     }
     if let Some(r) = radius {
         if !(r.is_finite() && r > 0.0) {
@@ -43,6 +49,7 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
         radius,
         photon_mapping: !no_photon_mapping,
         aim_share,
+        batch: pass_photons,
         ..Default::default()
     };
     // Whole passes: say so when --photons is not a multiple of one.

@@ -163,7 +163,51 @@ fn photons_rounded_to_whole_passes_say_so() {
         "{stdout}"
     );
     assert!(stdout.contains("traced 262144 photons"), "{stdout}");
+    // Smaller passes: the count rounds to them.
+    let o = run(
+        &[
+            "reference",
+            "--scene",
+            &manifest("assets/scenes/ball_lens.toml"),
+            "--photons",
+            "100",
+            "--pass-photons",
+            "64",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--out",
+            dir.join("r.png").to_str().unwrap(),
+        ],
+        &[],
+    );
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        stdout.contains("traced 128 photons in 2 passes"),
+        "{stdout}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
+    for bad in ["100", "0", "33554432"] {
+        let o = run(
+            &[
+                "reference",
+                "--pass-photons",
+                bad,
+                "--out",
+                dir.join("r.png").to_str().unwrap(),
+            ],
+            &[],
+        );
+        one_line_error(
+            &o,
+            &[&format!(
+                "--pass-photons must be a multiple of 64 from 64 to 16777216, got {bad}"
+            )],
+        );
+        assert!(!dir.exists(), "nothing created at --out");
+    }
     // An absurd count (it overflowed the rounding and panicked) is refused.
     let o = run(
         &[
