@@ -140,50 +140,39 @@ fn a_scene_the_technique_cannot_use_fails_before_the_device() {
 #[test]
 fn photons_rounded_to_whole_passes_say_so() {
     let dir = out_dir("photons");
-    let o = run(
-        &[
-            "reference",
-            "--scene",
-            &manifest("assets/scenes/ball_lens.toml"),
-            "--photons",
-            "1",
-            "--width",
-            "8",
-            "--height",
-            "8",
-            "--out",
-            dir.join("r.png").to_str().unwrap(),
-        ],
-        &[],
-    );
-    let stdout = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = dir.join("r.png");
+    let ball_lens = manifest("assets/scenes/ball_lens.toml");
+    // An 8x8 reference of ball_lens: its stdout, after checking it succeeded.
+    let traced = |photons: &str, pass_photons: &str| {
+        let o = run(
+            &[
+                "reference",
+                "--scene",
+                &ball_lens,
+                "--photons",
+                photons,
+                "--pass-photons",
+                pass_photons,
+                "--width",
+                "8",
+                "--height",
+                "8",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &[],
+        );
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let stdout = traced("1", "262144");
     assert!(
         stdout.contains("--photons 1: rounded up to 262144, whole passes of 262144"),
         "{stdout}"
     );
     assert!(stdout.contains("traced 262144 photons"), "{stdout}");
     // Smaller passes: the count rounds to them.
-    let o = run(
-        &[
-            "reference",
-            "--scene",
-            &manifest("assets/scenes/ball_lens.toml"),
-            "--photons",
-            "100",
-            "--pass-photons",
-            "64",
-            "--width",
-            "8",
-            "--height",
-            "8",
-            "--out",
-            dir.join("r.png").to_str().unwrap(),
-        ],
-        &[],
-    );
-    let stdout = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = traced("100", "64");
     assert!(
         stdout.contains("traced 128 photons in 2 passes"),
         "{stdout}"
