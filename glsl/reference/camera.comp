@@ -212,11 +212,11 @@ void main() {
         if (s.inside) s.weight *= exp(-s.inside_absorption * hit.t);
         else s.weight *= mean_transmittance(s.origin, s.dir, hit.t, rng);
         if (diffuse && depth == 0u) {
-            // The first hit is diffuse: its direct light from the punctual
-            // lights (L D E) by a shadow ray here, every other path ending
-            // there by the light tracer's camera connections (trace.comp
-            // skips those of photons straight from a punctual light). A
-            // mixed material's mirror part goes on below.
+            // The first hit is diffuse: its direct light (L D E) by shadow
+            // rays here (`direct_light`), every other path ending there by
+            // the light tracer's camera connections (trace.comp skips those
+            // of photons straight from a light sampled here). A mixed
+            // material's mirror part goes on below.
             vec3 seen_side = front ? ng : -ng;
             add_pass(index, COMPONENT_DIRECT, s.weight * direct_light(x, seen_side, hit_albedo(hit), rng));
             if (!mixed) break;
