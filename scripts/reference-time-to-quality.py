@@ -21,6 +21,11 @@ flip-evaluator package's LDR-FLIP mean after the project's PNG tonemap
 (exposure, Reinhard x/(1+x), sRGB).
 
     pip install flip-evaluator openexr numpy   # mitsuba too, for --mitsuba
+
+--mitsuba runs Mitsuba's `llvm_ad_rgb`, which aborts with Debian 12's
+LLVM 15: unpack LLVM 19 beside it (`apt-get download libllvm19 && dpkg -x
+libllvm19_*.deb /tmp/llvm19/root`; that path is the default) or point
+DRJIT_LIBLLVM_PATH at a libLLVM.so.19.
 """
 import argparse
 import math
