@@ -4,7 +4,9 @@
 
 pub mod gltf_builder;
 pub mod reference_cache;
-pub use reference_cache::{reference_images, ReferenceImages, ReferenceRequest};
+pub use reference_cache::{
+    camera_side, reference_images, ReferenceImages, ReferenceRequest, CAMERA_SIDE_BATCH,
+};
 
 use caustics::frame::camera_matrices;
 use caustics::scene::*;
@@ -454,6 +456,24 @@ pub fn first_hit_mask(
                     let m = gpu[h.triangle as usize].p0[3].to_bits() as usize;
                     keep(s.materials[m].kind)
                 })
+        })
+        .collect()
+}
+
+/// `mask` (row-major, `size`²) with every pixel dropped that has a dropped
+/// pixel or the image border among its 8 neighbours: what a pixel-centre
+/// mask means for a renderer that jitters its rays over the pixel.
+pub fn eroded(mask: &[bool], size: u32) -> Vec<bool> {
+    let n = size as i64;
+    (0..n * n)
+        .map(|i| {
+            let (x, y) = (i % n, i / n);
+            (-1..=1).all(|dy| {
+                (-1..=1).all(|dx| {
+                    let (u, v) = (x + dx, y + dy);
+                    (0..n).contains(&u) && (0..n).contains(&v) && mask[(v * n + u) as usize]
+                })
+            })
         })
         .collect()
 }

@@ -68,6 +68,40 @@ impl<'a> ReferenceRequest<'a> {
     pub fn with_settings(self, settings: ReferenceSettings) -> Self {
         Self { settings, ..self }
     }
+
+    /// The same passes (per half too), each of `CAMERA_SIDE_BATCH` photons:
+    /// for comparisons that read only what `camera_side` says.
+    pub fn camera_side(self) -> Self {
+        let runs = if self.halves { 2 } else { 1 };
+        let (settings, photons) = camera_side(self.settings, self.photons / runs);
+        Self {
+            settings,
+            photons: photons * runs,
+            ..self
+        }
+    }
+}
+
+/// Photons per pass of a camera-side reference (`camera_side`).
+pub const CAMERA_SIDE_BATCH: u32 = 4096;
+
+/// Settings and photon count that trace the same number of passes as
+/// `settings` with `photons`, each of `CAMERA_SIDE_BATCH` photons. What
+/// the reference samples from the camera (from point, spot, directional,
+/// rect and triangle lights: the direct light, and the single scattering
+/// where no ray of the pixel meets glass first, glsl/reference/camera.comp)
+/// comes out bit for bit the same: the camera's random streams follow the
+/// pass and the pixel, and no photon from those lights adds to it
+/// (`reference::camera_side_components_do_not_depend_on_the_photons`).
+/// A comparison that reads only those components gets the same images for
+/// the camera's pass alone, where the photons were 90% of the time.
+pub fn camera_side(settings: ReferenceSettings, photons: u64) -> (ReferenceSettings, u64) {
+    let passes = photons.div_ceil(settings.batch as u64);
+    let settings = ReferenceSettings {
+        batch: CAMERA_SIDE_BATCH,
+        ..settings
+    };
+    (settings, passes * CAMERA_SIDE_BATCH as u64)
 }
 
 /// Every component of one reference render (RGBA f32, rows top to bottom).
