@@ -29,6 +29,10 @@ fn caustics(args: &[&str], cache: &Path) -> Output {
                 .unwrap_or_else(|| "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json".into()),
         )
         .env("XDG_CACHE_HOME", cache)
+        .env(
+            "MESA_SHADER_CACHE_DIR",
+            crate::common::mesa_shader_cache_dir(),
+        )
         .args(args)
         .output()
         .unwrap()

@@ -478,6 +478,20 @@ pub fn eroded(mask: &[bool], size: u32) -> Vec<bool> {
         .collect()
 }
 
+/// Mesa's shader cache for this user: `MESA_SHADER_CACHE_DIR`, else
+/// `$XDG_CACHE_HOME/mesa_shader_cache`, else `~/.cache/mesa_shader_cache`.
+/// A test that gives a child process a private `XDG_CACHE_HOME` passes
+/// this on as `MESA_SHADER_CACHE_DIR`: else lavapipe compiles every shader
+/// again there (12 s of the demo's first frame under validation).
+pub fn mesa_shader_cache_dir() -> PathBuf {
+    let var = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty());
+    var("MESA_SHADER_CACHE_DIR")
+        .map(PathBuf::from)
+        .or_else(|| var("XDG_CACHE_HOME").map(|d| PathBuf::from(d).join("mesa_shader_cache")))
+        .or_else(|| var("HOME").map(|h| PathBuf::from(h).join(".cache/mesa_shader_cache")))
+        .unwrap_or_else(|| std::env::temp_dir().join("mesa_shader_cache"))
+}
+
 /// rgb summed, the quantity compared per pixel.
 pub fn sum_rgb(img: &[f32], i: usize) -> f64 {
     (img[i * 4] + img[i * 4 + 1] + img[i * 4 + 2]) as f64
