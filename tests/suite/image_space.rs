@@ -60,6 +60,20 @@
 //!   | ring | +0.96%, 0.104 | +1.33%, 0.0758 | +1.32%, 0.0757 | - |
 //!   | gemstone | -0.48%, 0.030 | -0.36%, 0.0463 | +571%, 0.180 | - |
 //!
+//!   Since the reference samples direct light from the camera, its photons
+//!   all go to the caustics; the tests trace 4M (2026-12-03, issue 26:
+//!   half the time, every bound unchanged) and measure:
+//!
+//!   | scene | reference halves (2M vs 2M) | photon_mode 0 | 1 | 2 |
+//!   | --- | --- | --- | --- | --- |
+//!   | ball_lens | energy -0.02%, FLIP 0.018 | -1.75%, 0.0145 | -1.11%, 0.0592 | -2.23%, 0.0141 |
+//!   | ring | +0.03%, 0.052 | +0.26%, 0.0471 | +0.25%, 0.0471 | - |
+//!   | gemstone | +0.41%, 0.034 | -0.06%, 0.0469 | +572.5%, 0.180 | - |
+//!   | still_life | -0.29%, 0.018 | -2.45%, 0.0178 | - | - |
+//!
+//!   Gemstone's mode 1 reads 0.005 under its energy bound, which records a
+//!   known limit (below) rather than a tolerance.
+//!
 //!   (The reference follows paths of up to 128 interfaces; with its former
 //!   32 it missed 10% of the gemstone's caustic energy: mode 0 read +11.2%
 //!   against it, +0.3% with its own chains cut at the same depth.)
@@ -126,7 +140,9 @@ const CENTRE: Vec3 = Vec3::new(0.0, 1.6, 0.0);
 const RADIUS: f32 = 1.0;
 const ALBEDO: f32 = 0.8;
 const SIZE: u32 = 128;
-const PHOTONS_REFERENCE: u64 = 8_000_000;
+/// The reference's photons for the caustic comparisons: the smallest count
+/// whose measurements (the file's header) stay inside every bound.
+const PHOTONS_REFERENCE: u64 = 4_000_000;
 
 fn ball_scene(ior: Option<f32>, floor_y: f32) -> Scene {
     ball_scene_lit(ior, floor_y, point_light(LIGHT, INTENSITY))
@@ -707,7 +723,8 @@ fn gemstone_caustics_match_reference() {
 /// The default scene, a showcase (tinted glass, coloured receivers, a spot
 /// light), in the default photon mode, which `auto` renders it with.
 /// Measured on lavapipe: energy -0.0248, FLIP mean 0.0167 (the reference's
-/// two halves: +0.0008 and 0.0139); bounds as above.
+/// two halves: +0.0008 and 0.0139); at the 4M photons traced since
+/// 2026-12-03: -0.0245, 0.0178 (halves -0.0029 and 0.0178); bounds as above.
 #[test]
 fn still_life_caustics_match_reference() {
     caustics_match_reference(

@@ -36,6 +36,10 @@
 //!   volume_cone g = 0: +1.7%, 0.0212 (+0.3%, 0.0100);
 //!   volume_cone g = 0.7: +3.2%, 0.0133 (-3.2%, 0.0109);
 //!   smoke: +1.4%, 0.0214 (+0.07%, 0.0088).
+//!   The tests trace 1 M photons since 2026-12-03 (issue 26, half the
+//!   time, bounds unchanged): +15.2%, 0.0192 (-1.8%, 0.0108); +1.1%,
+//!   0.0218 (-0.2%, 0.0138); +3.4%, 0.0138 (-2.8%, 0.0129); smoke +1.1%,
+//!   0.0218 (-0.2%, 0.0116).
 //!   The lines' own radiometry is within 0.3% (above); what differs is the
 //!   light rays: Eq. 6.3.1's exit misses the sphere's true one, and near
 //!   the rim the approximated exit meets total internal reflection that a
@@ -205,7 +209,9 @@ fn matches_reference(ctx: &Arc<Context>, label: &str, scene: &Scene, photons: u6
     }
 }
 
-const PHOTONS_REFERENCE: u64 = 2_000_000;
+/// The smallest count whose measurements (the file's header) stay inside
+/// every bound.
+const PHOTONS_REFERENCE: u64 = 1_000_000;
 
 // Bounds: measured (see the file's header) plus a margin: energy
 // |measured| + 0.03, FLIP mean 1.25 x measured, rounded up to 0.005. The
