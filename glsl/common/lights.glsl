@@ -16,7 +16,9 @@ float spot_falloff(float cos_theta, float cos_outer, float cos_inner) {
 
 // Irradiance at x from light l on a surface facing it (I / d^2 with the
 // spot's falloff, or a directional light's E), ignoring visibility;
-// `to_light` (unit) and `dist` describe the shadow ray.
+// `to_light` (unit) and `dist` describe the shadow ray. 0 at the light's
+// own position: the 1 / d^2 singularity is integrable only across it (a
+// medium sample there), not at it.
 vec3 light_arriving(uint l, vec3 x, out vec3 to_light, out float dist) {
     Light light = lights[l];
     uint kind = floatBitsToUint(light.position.w);
@@ -27,11 +29,12 @@ vec3 light_arriving(uint l, vec3 x, out vec3 to_light, out float dist) {
     }
     vec3 v = light.position.xyz - x;
     dist = length(v);
-    to_light = v / dist;
+    to_light = v / max(dist, 1e-30);
     vec3 intensity = light.intensity.rgb;
     if (kind == LIGHT_SPOT) {
         intensity *= spot_falloff(dot(-to_light, light.direction.xyz), light.direction.w, light.intensity.w);
     }
+    if (dist < 1e-6) return vec3(0.0);
     return intensity / (dist * dist);
 }
 

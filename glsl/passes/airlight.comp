@@ -59,31 +59,6 @@ layout(push_constant) uniform Push {
     uint jitter;       // 1: per-pixel random stratum offset; 0: midpoints
 } pc;
 
-// Light arriving at x from light l without medium or occluders: intensity
-// over distance squared (point, spot with its falloff exactly as
-// lights.glsl) or irradiance (directional), the propagation direction
-// `dir_in` (light -> x) and the distance (1e30 for directional).
-vec3 incident(uint l, vec3 x, out vec3 dir_in, out float dist) {
-    Light light = lights[l];
-    uint kind = light_kind(l);
-    if (kind == LIGHT_DIRECTIONAL) {
-        dir_in = light.direction.xyz;
-        dist = 1e30;
-        return light.intensity.rgb;
-    }
-    vec3 v = x - light.position.xyz;
-    dist = length(v);
-    dir_in = v / max(dist, 1e-30);
-    vec3 intensity = light.intensity.rgb;
-    if (kind == LIGHT_SPOT) {
-        intensity *= spot_falloff(dot(dir_in, light.direction.xyz), light.direction.w, light.intensity.w);
-    }
-    // A sample on the light itself: the 1 / r^2 singularity is integrable
-    // only across it, not at it.
-    if (dist < 1e-6) return vec3(0.0);
-    return intensity / (dist * dist);
-}
-
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(p, imageSize(radiance)))) return;
@@ -116,11 +91,13 @@ void main() {
         if (density <= 0.0) continue;
         vec3 in_scatter = vec3(0.0);
         for (uint l = 0u; l < pc.lit_count; ++l) {
-            vec3 dir_in;
+            // What arrives without medium or occluders, and the
+            // propagation direction (light -> x) for the phase.
+            vec3 to_light;
             float dist;
-            vec3 li = incident(l, x, dir_in, dist);
+            vec3 li = light_arriving(l, x, to_light, dist);
             if (all(equal(li, vec3(0.0)))) continue;
-            vec3 to_light = -dir_in;
+            vec3 dir_in = -to_light;
             // A point in the medium has no surface: the lookup is offset
             // toward the light, with no slope (n = to_light).
             float v = l < pc.light_count ? shadow_visibility(l, x, to_light, to_light, 0)

@@ -59,6 +59,16 @@ vec3 light_visibility(vec3 o, vec3 to_light, float dist, float shorten, inout ui
 const float PUNCTUAL_SHADOW_SHORTEN = 1e-4;
 const float AREA_SHADOW_SHORTEN = 1e-3; // as emitter_shadow_target
 
+// What arrives at x, on a surface facing the light, from the point y (normal
+// ny) of an area light sampled uniformly over its area (pdf 1/A):
+// L cos_y A / d^2; `to_light` (unit) and `dist` describe the shadow ray.
+vec3 area_light_arriving(Emitter em, vec3 y, vec3 ny, float area, vec3 x, out vec3 to_light, out float dist) {
+    vec3 v = y - x;
+    dist = length(v);
+    to_light = v / dist;
+    return em.radiance.rgb * (max(-dot(ny, to_light), 0.0) * area / (dist * dist));
+}
+
 // Radiance toward the eye from diffuse point x (normal n on the seen side,
 // albedo a): the direct light of every light camera.comp samples, each by
 // one shadow ray a pass: point, spot and directional lights exactly, rect
@@ -80,12 +90,10 @@ vec3 direct_light(vec3 x, vec3 n, vec3 albedo, inout uint rng) {
         vec3 y, ny;
         float area;
         sample_emitter_point(em, vec2(rng_next(rng), rng_next(rng)), y, ny, area);
-        vec3 v = y - x;
-        float dist = length(v);
-        vec3 w = v / dist;
-        float cos_x = dot(n, w), cos_y = -dot(ny, w);
-        if (!(cos_x > 0.0 && cos_y > 0.0)) continue;
-        vec3 e = em.radiance.rgb * (cos_x * cos_y * area / (dist * dist));
+        vec3 w;
+        float dist;
+        vec3 e = area_light_arriving(em, y, ny, area, x, w, dist) * max(dot(n, w), 0.0);
+        if (all(equal(e, vec3(0.0)))) continue;
         sum += e * light_visibility(o, w, dist, AREA_SHADOW_SHORTEN, rng);
     }
     return albedo / PI * sum;
@@ -151,15 +159,8 @@ vec3 airlight(vec3 o, vec3 d, float t_end, inout uint rng) {
             if (all(equal(sigma_s, vec3(0.0)))) continue;
             vec3 to_light;
             float dist;
-            vec3 e;
-            if (is_area) {
-                vec3 v = p - x;
-                dist = length(v);
-                to_light = v / dist;
-                e = em.radiance.rgb * (max(-dot(np, to_light), 0.0) * area / (dist * dist));
-            } else {
-                e = light_arriving(l, x, to_light, dist);
-            }
+            vec3 e = is_area ? area_light_arriving(em, p, np, area, x, to_light, dist)
+                             : light_arriving(l, x, to_light, dist);
             if (all(equal(e, vec3(0.0)))) continue;
             float shorten = is_area ? AREA_SHADOW_SHORTEN : PUNCTUAL_SHADOW_SHORTEN;
             vec3 tr = mean_transmittance(o, d, t, rng) * light_visibility(x, to_light, dist, shorten, rng);

@@ -162,12 +162,18 @@ fn quadrature(s: &Scene, px: u32, py: u32, with_box: bool) -> DVec3 {
     let sigma_t = (m.sigma_s + m.sigma_a).as_dvec3();
     let light = s.lights[0];
     let directional = light.kind == LightKind::Directional;
+    let axis = light.direction.as_dvec3().normalize();
+    let cos_outer = light.cone_angle_deg.to_radians().cos();
+    let cos_inner = (light.cone_angle_deg - light.cone_falloff_deg)
+        .max(0.0)
+        .to_radians()
+        .cos();
     let f = |t: f64| -> DVec3 {
         let x = o + d * t;
         // Propagation direction light -> x, and the light's path through the
         // medium (to the light, or to the bounds against a directional one).
         let (dir_in, travel, falloff) = if directional {
-            let dir_in = light.direction.as_dvec3().normalize();
+            let dir_in = axis;
             let exit = slab(x, -dir_in, lo, hi).map_or(0.0, |(_, b)| b);
             (dir_in, exit, 1.0)
         } else {
@@ -175,12 +181,7 @@ fn quadrature(s: &Scene, px: u32, py: u32, with_box: bool) -> DVec3 {
             let r = v.length();
             let mut falloff = 1.0 / (r * r);
             if light.kind == LightKind::Spot {
-                let cos_outer = light.cone_angle_deg.to_radians().cos();
-                let cos_inner = (light.cone_angle_deg - light.cone_falloff_deg)
-                    .max(0.0)
-                    .to_radians()
-                    .cos();
-                let c = (v / r).dot(light.direction.as_dvec3().normalize()) as f32;
+                let c = (v / r).dot(axis) as f32;
                 falloff *= spot_falloff(c, cos_outer, cos_inner) as f64;
             }
             (v / r, r, falloff)
@@ -214,14 +215,19 @@ fn pixel(img: &[f32], px: u32, py: u32) -> DVec3 {
     DVec3::new(img[i] as f64, img[i + 1] as f64, img[i + 2] as f64)
 }
 
-/// Worst per-pixel, per-channel error against the quadrature, relative to
-/// the pixel's value or, where that is darker, to 1% of the channel's
+/// `quadrature` for every pixel, row by row (computed once per scene: it
+/// is most of these tests' time).
+fn quadrature_image(s: &Scene, with_box: bool) -> Vec<DVec3> {
+    (0..SIZE * SIZE)
+        .map(|i| quadrature(s, i % SIZE, i / SIZE, with_box))
+        .collect()
+}
+
+/// Worst per-pixel, per-channel error against the quadrature `q`, relative
+/// to the pixel's value or, where that is darker, to 1% of the channel's
 /// brightest pixel (outside a spot's cone the light vanishes smoothly and a
 /// relative error means nothing); and the relative error of the total.
-fn against_quadrature(s: &Scene, img: &[f32], with_box: bool) -> (f64, f64) {
-    let q: Vec<DVec3> = (0..SIZE * SIZE)
-        .map(|i| quadrature(s, i % SIZE, i / SIZE, with_box))
-        .collect();
+fn against_quadrature(q: &[DVec3], img: &[f32]) -> (f64, f64) {
     let peak = q.iter().fold(DVec3::ZERO, |m, v| m.max(*v));
     let (mut worst, mut sum_a, mut sum_q) = (0.0f64, 0.0, 0.0);
     for (i, q) in q.iter().enumerate() {
@@ -272,10 +278,11 @@ const MAX_JITTERED_TOTAL: f64 = 2e-3;
 
 fn check_analytic_scene(s: Scene, g: f32, bounds: PixelBounds) {
     let ctx = validated_context();
+    let q = quadrature_image(&s, false);
     let (img, _) = render_airlight(&ctx, &s, &["airlight_steps=512", "airlight_jitter=0"]);
-    let (worst, total) = against_quadrature(&s, &img, false);
+    let (worst, total) = against_quadrature(&q, &img);
     let (jittered, _) = render_airlight(&ctx, &s, &["airlight_steps=64"]);
-    let (worst_j, total_j) = against_quadrature(&s, &jittered, false);
+    let (worst_j, total_j) = against_quadrature(&q, &jittered);
     eprintln!(
         "g = {g}: 512 midpoints: worst pixel {worst:.2e}, total {total:.2e}; 64 jittered: worst pixel {worst_j:.2e}, total {total_j:.2e}"
     );
@@ -351,14 +358,14 @@ fn occluder_casts_a_volumetric_shadow() {
             .sum::<f64>()
     };
     let (sum_a, sum_b) = (rgb_sum(&a), rgb_sum(&b));
-    let (worst, total) = against_quadrature(&shadowed, &b, true);
+    let q = quadrature_image(&shadowed, true);
+    let (worst, total) = against_quadrature(&q, &b);
     // Pixels within 1% of the quadrature: shadow-map texels blur only the
     // volumetric shadow's boundary.
     let close = (0..SIZE * SIZE)
-        .filter(|i| {
-            let (px, py) = (i % SIZE, i / SIZE);
-            let q = quadrature(&shadowed, px, py, true);
-            let p = pixel(&b, px, py);
+        .filter(|&i| {
+            let q = q[i as usize];
+            let p = pixel(&b, i % SIZE, i / SIZE);
             (0..3).all(|c| (p[c] - q[c]).abs() <= 0.01 * q[c].max(1e-9))
         })
         .count() as f64
