@@ -532,9 +532,9 @@ fn against_reference_away(
 /// 16 M photons the energy errors were 0.0010-0.0011 (volume_cone) and
 /// 0.0003 (smoke). With the airlight sampled from the camera (2026-12-03,
 /// the same 8 passes with few photons each, over the pixels no ray of which
-/// meets glass first): energy 0.0048, 0.0049, 0.0047, 0.0071 (halves
-/// 0.0010-0.0091), FLIP 0.0066, 0.0107, 0.0046, 0.0111 (halves
-/// 0.0059-0.0141). Bounds: energy 2% (a phase with the cosine's sign
+/// meets glass first): energy 0.0042, 0.0042, 0.0040, 0.0055 (halves
+/// 0.0002-0.0098), FLIP 0.0067, 0.0107, 0.0046, 0.0111 (halves
+/// 0.0059-0.0142). Bounds: energy 2% (a phase with the cosine's sign
 /// flipped, or a missing transmittance, is off by far more), FLIP 0.025.
 const MAX_REF_ENERGY: f64 = 0.02;
 const MAX_REF_FLIP: f32 = 0.025;

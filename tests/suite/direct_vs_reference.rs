@@ -43,7 +43,7 @@
 //! flat facets; within the noise of those 560 pixels).
 //!
 //! Since the reference samples the point light from the camera (one
-//! shadow ray per pixel and pass, 2026-12-03), the same 122 passes read:
+//! shadow ray per pixel and pass, 2026-12-03), the same 124 passes read:
 //! energy 0.00004, masked blocks mean 0.0001, worst 0.0015; unmasked mean
 //! 0.0018, worst 0.037 (the sphere's edge pixels); FLIP mean 0.0081, FLIP
 //! between the halves 0.0041. The photon counts above are the light

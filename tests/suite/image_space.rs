@@ -51,8 +51,9 @@
 //!   least confusion of this strongly aberrated lens gathers more flux.
 //! - *_caustics_match_reference (assets/scenes/{ball_lens,ring,gemstone}.toml
 //!   at 128², time 0, default 512² photons and 512² maps; the caustic image
-//!   image_space minus direct vs the reference's L S+ D, 8M photons, fixed
-//!   seeds; FLIP mean of the two tonemapped images; 24-30 s per scene):
+//!   image_space minus direct vs the reference's L S+ D, fixed seeds; FLIP
+//!   mean of the two tonemapped images; measured at 8M photons, 24-30 s per
+//!   scene; the tests trace 4M since 2026-12-03, second table):
 //!
 //!   | scene | reference halves (4M vs 4M) | photon_mode 0 | 1 | 2 |
 //!   | --- | --- | --- | --- | --- |

@@ -9,8 +9,8 @@ use glam::Vec3;
 
 /// What the camera side samples (direct light and single scattering from
 /// spot and rect lights, through a heterogeneous and a homogeneous medium;
-/// the airlight where no ray of the pixel meets glass first) is the same
-/// bit for bit whatever the photons per pass: the premise of
+/// the airlight where no ray of the pixel meets a specular surface first)
+/// is the same bit for bit whatever the photons per pass: the premise of
 /// `common::camera_side`, with which the comparisons that read only those
 /// components skip the photons.
 #[test]
@@ -52,7 +52,7 @@ fn camera_side_components_do_not_depend_on_the_photons() {
 /// Point light over a diffuse plane: L = albedo / pi * I cos(theta) / r^2.
 /// (Measured: worst 16x16 block 0.5-0.7% at 16 M photons; at 8 M photon noise
 /// alone put the worst block between 0.7% and 0.95%. Sampled from the
-/// camera since 2026-12-03: 0.08% in the same 61 passes.)
+/// camera since 2026-12-03: 0.08% in the same 62 passes.)
 #[test]
 fn point_light_on_plane_matches_inverse_square_law() {
     let ctx = validated_context();
@@ -239,7 +239,7 @@ fn airlight_setup() -> AirlightSetup {
 /// Single-scattered airlight in a homogeneous medium against the numerical
 /// integral (measured: worst 32x32 block 1.1% at 16 M photons; 16x16 blocks
 /// at 8 M photons scatter by about 1% from photon noise alone; sampled from
-/// the camera since 2026-12-03: 0.09% in the same 61 passes).
+/// the camera since 2026-12-03: 0.09% in the same 62 passes).
 #[test]
 fn airlight_matches_numerical_single_scattering_integral() {
     let ctx = validated_context();

@@ -461,35 +461,34 @@ pub fn first_hit_mask(
 }
 
 /// `mask` (row-major, `size`²) with every pixel dropped that has a dropped
-/// pixel or the image border among its 8 neighbours: what a pixel-centre
-/// mask means for a renderer that jitters its rays over the pixel.
+/// pixel among its 8 neighbours (beyond the image border counts as kept):
+/// what a pixel-centre mask means for a renderer that jitters its rays
+/// over the pixel, where a surface's edge may cross a kept pixel.
 pub fn eroded(mask: &[bool], size: u32) -> Vec<bool> {
     let n = size as i64;
+    let kept =
+        |u: i64, v: i64| !(0..n).contains(&u) || !(0..n).contains(&v) || mask[(v * n + u) as usize];
     (0..n * n)
         .map(|i| {
             let (x, y) = (i % n, i / n);
-            (-1..=1).all(|dy| {
-                (-1..=1).all(|dx| {
-                    let (u, v) = (x + dx, y + dy);
-                    (0..n).contains(&u) && (0..n).contains(&v) && mask[(v * n + u) as usize]
-                })
-            })
+            (-1..=1).all(|dy| (-1..=1).all(|dx| kept(x + dx, y + dy)))
         })
         .collect()
 }
 
-/// Mesa's shader cache for this user: `MESA_SHADER_CACHE_DIR`, else
-/// `$XDG_CACHE_HOME/mesa_shader_cache`, else `~/.cache/mesa_shader_cache`.
-/// A test that gives a child process a private `XDG_CACHE_HOME` passes
-/// this on as `MESA_SHADER_CACHE_DIR`: else lavapipe compiles every shader
-/// again there (12 s of the demo's first frame under validation).
+/// Where Mesa keeps this user's shader cache, as `MESA_SHADER_CACHE_DIR`
+/// names it (Mesa adds `mesa_shader_cache` to that folder): the variable
+/// itself, else `$XDG_CACHE_HOME`, else `~/.cache`. A test that gives a
+/// child process a private `XDG_CACHE_HOME` passes this on: else lavapipe
+/// compiles every shader again there (12 s of the demo's first frame
+/// under validation).
 pub fn mesa_shader_cache_dir() -> PathBuf {
     let var = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty());
     var("MESA_SHADER_CACHE_DIR")
+        .or_else(|| var("XDG_CACHE_HOME"))
         .map(PathBuf::from)
-        .or_else(|| var("XDG_CACHE_HOME").map(|d| PathBuf::from(d).join("mesa_shader_cache")))
-        .or_else(|| var("HOME").map(|h| PathBuf::from(h).join(".cache/mesa_shader_cache")))
-        .unwrap_or_else(|| std::env::temp_dir().join("mesa_shader_cache"))
+        .or_else(|| var("HOME").map(|h| PathBuf::from(h).join(".cache")))
+        .unwrap_or_else(std::env::temp_dir)
 }
 
 /// rgb summed, the quantity compared per pixel.

@@ -89,7 +89,8 @@ pub const CAMERA_SIDE_BATCH: u32 = 4096;
 /// `settings` with `photons`, each of `CAMERA_SIDE_BATCH` photons. What
 /// the reference samples from the camera (from point, spot, directional,
 /// rect and triangle lights: the direct light, and the single scattering
-/// where no ray of the pixel meets glass first, glsl/reference/camera.comp)
+/// where no ray of the pixel meets a specular surface first: glass, a
+/// mirror or a mixed material; glsl/reference/camera.comp)
 /// comes out bit for bit the same: the camera's random streams follow the
 /// pass and the pixel, and no photon from those lights adds to it
 /// (`reference::camera_side_components_do_not_depend_on_the_photons`).
