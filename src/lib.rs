@@ -3,6 +3,7 @@
 
 pub mod app;
 pub mod bvh;
+pub mod cache_dir;
 pub mod cascades;
 pub mod compare;
 pub mod environment;

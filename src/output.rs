@@ -282,11 +282,40 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> anyhow::
 }
 
 /// Reads an EXR back as RGBA f32 (tests and comparisons).
+/// Refuses, in one message naming the file, anything but a regular file
+/// holding an OpenEXR image (a PNG holds display values, not radiance) and
+/// any texel that is not finite or whose rgb is negative. Decoding keeps
+/// the image crate's default limits (at most 512 MiB allocated).
 pub fn read_exr(path: &Path) -> anyhow::Result<(u32, u32, Vec<f32>)> {
-    let img = image::open(path)
-        .with_context(|| format!("cannot read {}", path.display()))?
-        .into_rgba32f();
-    Ok((img.width(), img.height(), img.into_raw()))
+    let cannot_read = || format!("cannot read {}", path.display());
+    if !std::fs::metadata(path).with_context(cannot_read)?.is_file() {
+        anyhow::bail!("{}: not a regular file", path.display());
+    }
+    let reader = image::ImageReader::open(path)
+        .with_context(cannot_read)?
+        .with_guessed_format()
+        .with_context(cannot_read)?;
+    if reader.format() != Some(image::ImageFormat::OpenExr) {
+        anyhow::bail!(
+            "{}: not an OpenEXR image (linear radiance is read from EXR files only)",
+            path.display()
+        );
+    }
+    let img = reader.decode().with_context(cannot_read)?.into_rgba32f();
+    let (width, height) = (img.width(), img.height());
+    let texels = img.into_raw();
+    let bad = texels
+        .chunks_exact(4)
+        .position(|t| !t.iter().all(|v| v.is_finite()) || t[..3].iter().any(|v| *v < 0.0));
+    if let Some(i) = bad {
+        let (x, y) = (i as u32 % width, i as u32 / width);
+        anyhow::bail!(
+            "{}: texel ({x}, {y}) is {:?}: radiance must be finite and non-negative",
+            path.display(),
+            &texels[4 * i..4 * i + 3]
+        );
+    }
+    Ok((width, height, texels))
 }
 
 #[cfg(test)]

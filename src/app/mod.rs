@@ -83,14 +83,9 @@ pub fn parse_present_mode(s: &str) -> anyhow::Result<vk::PresentModeKHR> {
 }
 
 /// Where the demo keeps the driver's pipeline cache between runs:
-/// `$XDG_CACHE_HOME/caustics/pipelines.bin`, else `~/.cache/caustics/...`;
-/// none when neither variable is set.
+/// `pipelines.bin` in [`crate::cache_dir::cache_dir`]; none without one.
 fn pipeline_cache_file() -> Option<PathBuf> {
-    let base = std::env::var_os("XDG_CACHE_HOME")
-        .filter(|v| !v.is_empty())
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))?;
-    Some(base.join("caustics").join("pipelines.bin"))
+    Some(crate::cache_dir::cache_dir()?.join("pipelines.bin"))
 }
 
 /// Runs the demo until the window closes (or `--frames N --exit`). Fails on

@@ -73,8 +73,7 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
     let names = technique_names(&args.techniques)?;
     let from_file = match &args.reference {
         Some(path) => {
-            let (w, h, rgba) = output::read_exr(path)
-                .with_context(|| format!("--reference {}", path.display()))?;
+            let (w, h, rgba) = output::read_exr(path).context("--reference")?;
             if (w, h) != (width, height) {
                 anyhow::bail!(
                     "--reference {}: the image is {w}x{h}, the comparison {width}x{height} (set --width and --height)",
@@ -238,14 +237,10 @@ fn technique_names(list: &str) -> anyhow::Result<Vec<&'static str>> {
     Ok(names)
 }
 
-/// The cache folder for references: $XDG_CACHE_HOME/caustics/references,
-/// else ~/.cache/caustics/references; None without either.
+/// The cache folder for references: `references` in
+/// [`caustics::cache_dir::cache_dir`]; None without one.
 fn cache_root() -> Option<PathBuf> {
-    let base = std::env::var_os("XDG_CACHE_HOME")
-        .filter(|v| !v.is_empty())
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| Path::new(&h).join(".cache")))?;
-    Some(base.join("caustics").join("references"))
+    Some(caustics::cache_dir::cache_dir()?.join("references"))
 }
 
 /// The reference from the cache, or traced (and then cached).

@@ -234,7 +234,7 @@ pub struct CompareArgs {
     /// Frames timed per technique, after one warm-up frame.
     #[arg(long, default_value_t = 5)]
     pub frames: u32,
-    /// Trace the reference even when the cache ($XDG_CACHE_HOME/caustics/references) holds it, and do not store it.
+    /// Trace the reference even when the cache (`references` in $CAUSTICS_CACHE_DIR, else $XDG_CACHE_HOME/caustics) holds it, and do not store it.
     #[arg(long)]
     pub no_cache: bool,
     /// Output folder.

@@ -53,8 +53,8 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
         ..Default::default()
     };
     // Whole passes: say so when --photons is not a multiple of one.
-    let batch = u64::from(settings.batch.div_ceil(64) * 64);
-    let rounded = photons.div_ceil(batch) * batch;
+    let batch = settings.pass_photons();
+    let rounded = settings.passes_for(photons) * batch;
     if seconds.is_none() && rounded != photons {
         println!("--photons {photons}: rounded up to {rounded}, whole passes of {batch}");
     }

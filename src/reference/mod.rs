@@ -49,6 +49,18 @@ pub struct ReferenceSettings {
     pub aim_share: f32,
 }
 
+impl ReferenceSettings {
+    /// Photons one pass traces: `batch` rounded up to whole workgroups of 64.
+    pub fn pass_photons(&self) -> u64 {
+        u64::from(self.batch.div_ceil(64)) * 64
+    }
+
+    /// Whole passes that trace at least `photons`.
+    pub fn passes_for(&self, photons: u64) -> u64 {
+        photons.div_ceil(self.pass_photons())
+    }
+}
+
 /// The volume radius starts this many surface radii wide: a 3D density
 /// needs a wider kernel than a 2D one for the same photon count.
 pub const VOLUME_RADIUS_FACTOR: f32 = 3.0;

@@ -206,7 +206,7 @@ impl Reference {
     }
 
     fn pass_photons(&self) -> u64 {
-        self.settings.batch.div_ceil(64) as u64 * 64
+        self.settings.pass_photons()
     }
 
     fn push(&self, seed: u32, component: Component) -> Push {
@@ -279,7 +279,7 @@ impl Reference {
                 .write(&self.stats, Access::ComputeWrite)
                 .emit();
             self.trace
-                .dispatch(cmd, &sets, push, [self.settings.batch.div_ceil(64), 1, 1]);
+                .dispatch(cmd, &sets, push, [(self.pass_photons() / 64) as u32, 1, 1]);
         });
         if self.volume_capacity > 0 {
             rec.pass("reference volume gather")

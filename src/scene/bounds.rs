@@ -21,8 +21,9 @@ pub const MAX_EMISSIVE_TRIANGLES: usize = 1024;
 impl Scene {
     /// Checks the scene at `time` (seconds): every object's transform
     /// finite and its vertices within [`MAX_WORLD_EXTENT`] of the origin,
-    /// every light's intensity within the radiometric bound and its power
-    /// finite. The error is one line naming the scene file and the field.
+    /// so too the camera's eye and target and every point and spot light,
+    /// every light's intensity within 0 and the radiometric bound and its
+    /// power finite. The error is one line naming the scene file and the field.
     pub fn check_at(&self, time: f32) -> Result<(), String> {
         let at = |field: String, why: String| {
             format!(
@@ -80,6 +81,18 @@ impl Scene {
                 ));
             }
         }
+        let camera_far = self
+            .camera
+            .eye
+            .abs()
+            .max(self.camera.target.abs())
+            .max_element();
+        if camera_far.is_nan() || camera_far > MAX_WORLD_EXTENT {
+            return Err(at(
+                "camera".into(),
+                format!("the eye or the target lies {camera_far:e} m from the origin, beyond {MAX_WORLD_EXTENT:e} m"),
+            ));
+        }
         let (_, radius) = self.bounding_sphere(time);
         for (i, l) in self.lights.iter().enumerate() {
             let largest = l.intensity.max_element();
@@ -87,6 +100,19 @@ impl Scene {
                 return Err(at(
                     format!("light[{i}]"),
                     format!("intensity {largest:e} is beyond {MAX_RADIOMETRIC:e}"),
+                ));
+            }
+            if l.intensity.min_element() < 0.0 {
+                return Err(at(
+                    format!("light[{i}]"),
+                    format!("intensity {} is negative", l.intensity),
+                ));
+            }
+            let far = l.position.abs().max_element();
+            if l.kind != super::LightKind::Directional && (far.is_nan() || far > MAX_WORLD_EXTENT) {
+                return Err(at(
+                    format!("light[{i}]"),
+                    format!("its position lies {far:e} m from the origin, beyond {MAX_WORLD_EXTENT:e} m"),
                 ));
             }
             // Above every kind's power (radiometry::light_power: 4π I at

@@ -426,3 +426,54 @@ fn a_scene_over_the_storage_buffer_limit_is_refused() {
     assert!(!dir.exists(), "nothing created at --out");
     let _ = std::fs::remove_file(scene);
 }
+
+/// `compare --reference` takes linear radiance only (issue 31): a PNG
+/// (display values) and an EXR with a negative or infinite texel are
+/// refused in one line naming the file, before the device, and no
+/// comparison folder is made.
+#[test]
+fn compare_reference_must_be_finite_non_negative_exr() {
+    let dir = out_dir("compare-reference");
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("reference.png");
+    caustics::output::write_png(&png, 8, 8, &[128; 8 * 8 * 4]).unwrap();
+    let negative = dir.join("negative.exr");
+    let mut texels = vec![1.0f32; 8 * 8 * 4];
+    texels[4 * 9] = -0.5;
+    caustics::output::write_exr(&negative, 8, 8, &texels).unwrap();
+    let infinite = dir.join("infinite.exr");
+    texels[4 * 9] = f32::INFINITY;
+    caustics::output::write_exr(&infinite, 8, 8, &texels).unwrap();
+    let out = dir.join("out");
+    for (reference, needle) in [
+        (&png, "not an OpenEXR image"),
+        (&negative, "texel (1, 1)"),
+        (&infinite, "finite and non-negative"),
+        (&dir, "not a regular file"),
+    ] {
+        let o = run(
+            &[
+                "compare",
+                "--scene",
+                &manifest("assets/scenes/ball_lens.toml"),
+                "--width",
+                "8",
+                "--height",
+                "8",
+                "--reference",
+                reference.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &[],
+        );
+        let line = one_line_error(&o, &["--reference", needle]);
+        assert!(line.contains(reference.to_str().unwrap()), "{line}");
+        assert!(
+            !String::from_utf8_lossy(&o.stdout).contains("device"),
+            "{line}"
+        );
+        assert!(!out.exists(), "{line}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

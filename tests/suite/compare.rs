@@ -28,11 +28,7 @@ fn caustics(args: &[&str], cache: &Path) -> Output {
             std::env::var_os("VK_DRIVER_FILES")
                 .unwrap_or_else(|| "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json".into()),
         )
-        .env("XDG_CACHE_HOME", cache)
-        .env(
-            "MESA_SHADER_CACHE_DIR",
-            crate::common::mesa_shader_cache_dir(),
-        )
+        .env("CAUSTICS_CACHE_DIR", cache)
         .args(args)
         .output()
         .unwrap()

@@ -109,11 +109,7 @@ fn run_demo(args: &[&str], cache_home: &Path) -> Run {
             std::env::var_os("VK_DRIVER_FILES").unwrap_or_else(|| LAVAPIPE_ICD.into()),
         )
         .env("RUST_LOG", "warn")
-        .env("XDG_CACHE_HOME", cache_home)
-        .env(
-            "MESA_SHADER_CACHE_DIR",
-            crate::common::mesa_shader_cache_dir(),
-        )
+        .env("CAUSTICS_CACHE_DIR", cache_home)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -178,7 +174,7 @@ fn demo_resizes_and_exits_cleanly_under_validation() {
     assert!(stdout.contains("tonemap"), "no per-pass timings: {report}");
     // The pipeline cache was saved for the next start (at least its
     // 32-byte header: lavapipe's cache holds no pipelines).
-    let cache = cache_home.join("caustics/pipelines.bin");
+    let cache = cache_home.join("pipelines.bin");
     let saved = std::fs::metadata(&cache).map(|m| m.len()).unwrap_or(0);
     assert!(
         saved >= 32,

@@ -778,6 +778,29 @@ fn a_glb_is_a_scene_with_its_camera_lights_and_a_floor() {
         .all(|p| p.y < 0.0 && p.y > -0.01));
 }
 
+/// A GLB's header length is the file's (issue 31: a file longer than its
+/// header said was accepted); a shorter one was already refused.
+#[test]
+fn a_glb_longer_or_shorter_than_its_header_is_refused() {
+    let dir = temp_dir("glb-length");
+    let mut g = Gltf::new();
+    let mesh = g.mesh(&shapes::cuboid(Vec3::splat(-1.0), Vec3::ONE), true, None);
+    g.root_node(json!({"mesh": mesh}));
+    let path = g.write_glb(&dir, "sized");
+    let bytes = std::fs::read(&path).unwrap();
+    assert!(Scene::load(&path).is_ok());
+    for (name, edited) in [
+        ("longer", [&bytes[..], &[0u8; 16]].concat()),
+        ("shorter", bytes[..bytes.len() - 4].to_vec()),
+    ] {
+        let p = dir.join(format!("{name}.glb"));
+        std::fs::write(&p, edited).unwrap();
+        let e = format!("{:#}", Scene::load(&p).expect_err(name));
+        assert!(e.contains(p.to_str().unwrap()) && e.contains("GLB"), "{e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+}
+
 #[test]
 fn a_file_without_camera_or_lights_gets_a_framing_camera_and_a_sun() {
     let dir = temp_dir("defaults");
@@ -926,6 +949,17 @@ fn bad_files() -> Vec<Bad> {
                 g.root["accessors"][n.as_u64().unwrap() as usize]["count"] = json!(1000);
             },
         },
+        // Issue 31: stride x count wrapped to a small size and passed the
+        // bounds check ("POSITION has 0", or the primitive dropped).
+        Bad {
+            name: "accessor_count_overflow",
+            at: "meshes[0].primitives[0].attributes.POSITION",
+            says: "bufferView",
+            edit: |g, _| {
+                let n = g.root["meshes"][0]["primitives"][0]["attributes"]["POSITION"].clone();
+                g.root["accessors"][n.as_u64().unwrap() as usize]["count"] = json!(1u64 << 62);
+            },
+        },
         Bad {
             name: "normal_type",
             at: "meshes[0].primitives[0].attributes.NORMAL",
@@ -982,6 +1016,56 @@ fn bad_files() -> Vec<Bad> {
                 for _ in 0..9 {
                     g.root_node(json!({"extensions": {"KHR_lights_punctual": {"light": 0}}}));
                 }
+            },
+        },
+        // Issue 31: values outside the extensions' schemas and the scene
+        // bounds were accepted (clamped, or an all-black image).
+        Bad {
+            name: "negative_light",
+            at: "extensions.KHR_lights_punctual.lights[0]",
+            says: "must be 0 or more",
+            edit: |g, _| {
+                g.root["extensions"] = json!({"KHR_lights_punctual": {"lights": [
+                    {"type": "point", "intensity": -5.0}]}});
+                g.root_node(json!({"extensions": {"KHR_lights_punctual": {"light": 0}}}));
+            },
+        },
+        Bad {
+            name: "light_far_away",
+            at: "light[0]",
+            says: "beyond",
+            edit: |g, _| {
+                // A diffuse material: the default one's warning is a line of its own.
+                g.root["materials"] = json!([{"pbrMetallicRoughness": {"metallicFactor": 0.0}}]);
+                g.root["meshes"][0]["primitives"][0]["material"] = json!(0);
+                g.root["extensions"] = json!({"KHR_lights_punctual": {"lights": [
+                    {"type": "point", "intensity": 5.0}]}});
+                g.root_node(json!({"extensions": {"KHR_lights_punctual": {"light": 0}},
+                                   "translation": [1e20, 0.0, 0.0]}));
+            },
+        },
+        Bad {
+            name: "camera_far_away",
+            at: "camera",
+            says: "beyond",
+            edit: |g, _| {
+                // A diffuse material: the default one's warning is a line of its own.
+                g.root["materials"] = json!([{"pbrMetallicRoughness": {"metallicFactor": 0.0}}]);
+                g.root["meshes"][0]["primitives"][0]["material"] = json!(0);
+                g.root["cameras"] =
+                    json!([{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}]);
+                g.root_node(json!({"camera": 0, "translation": [0.0, 0.0, 1e20]}));
+            },
+        },
+        Bad {
+            name: "attenuation_distance_zero",
+            at: "materials[0].extensions.KHR_materials_volume.attenuationDistance",
+            says: "must be above 0",
+            edit: |g, _| {
+                g.root["materials"] = json!([{"extensions": {
+                    "KHR_materials_transmission": {"transmissionFactor": 1.0},
+                    "KHR_materials_volume": {"thicknessFactor": 0.5, "attenuationDistance": 0.0}}}]);
+                g.root["meshes"][0]["primitives"][0]["material"] = json!(0);
             },
         },
         Bad {
@@ -1055,7 +1139,7 @@ fn bad_files_fail_with_one_line_naming_the_file_and_the_gltf_path() {
 
     // The same through a TOML scene's `shape = "gltf"`: located at the
     // object's `path`, then the file and the glTF path.
-    let bad = &bad_files()[7];
+    let bad = &bad_files()[8];
     write_bad(&dir, bad);
     let scene = dir.join("scene.toml");
     let text = format!(

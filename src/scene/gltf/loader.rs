@@ -58,20 +58,26 @@ impl Loader<'_> {
                 view.index()
             )));
         }
+        // Sizes from the file are checked as they multiply: a count of
+        // 2^62 must not wrap to a small size that fits the view.
         let buffer_len = self.buffers[view.buffer().index()].len();
-        if view.offset() + view.length() > buffer_len {
+        let view_end = view.offset().checked_add(view.length());
+        if view_end.is_none_or(|end| end > buffer_len) {
             return Err(fail(format!(
-                "bufferView {} (bytes {}..{}) runs past the end of buffer {} ({buffer_len} bytes)",
+                "bufferView {} ({} bytes from byte {}) runs past the end of buffer {} ({buffer_len} bytes)",
                 view.index(),
+                view.length(),
                 view.offset(),
-                view.offset() + view.length(),
                 view.buffer().index()
             )));
         }
-        let end = a.offset() + stride * (a.count() - 1) + elem;
-        if end > view.length() {
+        let end = stride
+            .checked_mul(a.count() - 1)
+            .and_then(|b| b.checked_add(a.offset()))
+            .and_then(|b| b.checked_add(elem));
+        if end.is_none_or(|end| end > view.length()) {
             return Err(fail(format!(
-                "{} elements from byte {} need {end} bytes, bufferView {} has {}",
+                "{} elements of {elem} bytes, {stride} apart, from byte {} do not fit bufferView {} ({} bytes)",
                 a.count(),
                 a.offset(),
                 view.index(),
@@ -269,6 +275,17 @@ impl Loader<'_> {
             (_, None) => format!("{label}#default"),
         };
         let name = format!("{}:{label}", self.file_name);
+        // KHR_materials_volume: a distance of 0 or less is outside the
+        // extension's schema (exclusive minimum 0), not "opaque".
+        if let (Some(v), Some(i)) = (m.volume(), m.index()) {
+            let d = v.attenuation_distance();
+            if d.is_nan() || d <= 0.0 {
+                return Err((self.fail)(
+                    &format!("materials[{i}].extensions.KHR_materials_volume.attenuationDistance"),
+                    format!("is {d}: must be above 0"),
+                ));
+            }
+        }
         let (material, coverage, notes) = convert_material(name.clone(), m);
         let mut texture = self.texture_ref(m)?;
         if let (Some(t), Coverage::Mask(threshold)) = (texture.as_mut(), coverage) {
@@ -423,10 +440,25 @@ impl Loader<'_> {
 
     /// A `KHR_lights_punctual` light on a node, in project units
     /// ([`LUMENS_PER_WATT`]): it shines down the node's -z.
-    pub(super) fn light(&mut self, l: &::gltf::khr_lights_punctual::Light, world: Mat4) {
+    /// Negative values, which the extension's schema forbids, are refused.
+    pub(super) fn light(
+        &mut self,
+        l: &::gltf::khr_lights_punctual::Light,
+        world: Mat4,
+    ) -> Result<(), GltfError> {
         use ::gltf::khr_lights_punctual::Kind;
-        let power =
-            Vec3::from(l.color()).max(Vec3::ZERO) * l.intensity().max(0.0) / LUMENS_PER_WATT;
+        let at = format!("extensions.KHR_lights_punctual.lights[{}]", l.index());
+        let color = Vec3::from(l.color());
+        if !(l.intensity() >= 0.0 && color.min_element() >= 0.0) {
+            return Err((self.fail)(
+                &at,
+                format!(
+                    "intensity {} and color {color}: both must be 0 or more",
+                    l.intensity()
+                ),
+            ));
+        }
+        let power = color * l.intensity() / LUMENS_PER_WATT;
         let direction = world
             .transform_vector3(Vec3::NEG_Z)
             .try_normalize()
@@ -454,5 +486,6 @@ impl Loader<'_> {
             }
         }
         self.asset.lights.push(light);
+        Ok(())
     }
 }

@@ -165,6 +165,21 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
     };
     let bytes = std::fs::read(path).map_err(|e| fail("", format!("cannot read glTF file: {e}")))?;
     let (json_bytes, blob) = if bytes.starts_with(b"glTF") {
+        // The header's length is the whole file's (glTF 2.0, 4.4.2): bytes
+        // past it are not part of the asset, a file cut short is damaged.
+        let declared = bytes
+            .get(8..12)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        if declared.is_some_and(|n| n as usize != bytes.len()) {
+            return Err(fail(
+                "",
+                format!(
+                    "not a valid GLB container: its header gives a length of {} bytes, the file has {}",
+                    declared.unwrap_or(0),
+                    bytes.len()
+                ),
+            ));
+        }
         let glb = ::gltf::Glb::from_slice(&bytes)
             .map_err(|e| fail("", format!("not a valid GLB container: {e}")))?;
         (glb.json, glb.bin)
@@ -293,7 +308,7 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
             }
         }
         if let Some(light) = node.light() {
-            reader.light(&light, world);
+            reader.light(&light, world)?;
         }
         let children: Vec<_> = node.children().collect();
         stack.extend(children.into_iter().rev().map(|c| (c, world)));

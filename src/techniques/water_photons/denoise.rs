@@ -305,69 +305,53 @@ impl Denoiser {
             1,
         ];
         let kind = self.config.kind.name();
+        // Each pass: x reads the caustics (written by the splats or the
+        // previous pass) and overwrites all of the scratch image, after the
+        // previous pass's y sub-pass has read it (write-after-read); y reads
+        // the scratch and rewrites every caustic pixel, whose old contents
+        // are discarded once the x sub-pass has read them.
+        let sub_passes = [
+            (
+                "x",
+                &self.set_x,
+                caustics,
+                &self.scratch,
+                bindings::DENOISE_AXIS_X,
+            ),
+            (
+                "y",
+                &self.set_y,
+                &self.scratch,
+                caustics,
+                bindings::DENOISE_AXIS_Y,
+            ),
+        ];
         for k in 0..self.config.passes {
-            // Reads the caustics (written by the splats or the previous
-            // pass) and overwrites all of the scratch image, after the
-            // previous pass's y sub-pass has read it (write-after-read).
-            let set = &self.set_x;
-            rec.pass(&format!("denoise {kind} {k} x"))
-                .storage_image(
-                    set,
-                    bindings::DENOISE_BINDING_INPUT,
-                    caustics,
-                    Access::ComputeRead,
-                )
-                .storage_image(
-                    set,
-                    bindings::DENOISE_BINDING_POSITION,
-                    position,
-                    Access::ComputeRead,
-                )
-                .overwrite_storage_image(
-                    set,
-                    bindings::DENOISE_BINDING_OUTPUT,
-                    &self.scratch,
-                    Access::ComputeWrite,
-                )
-                .record(|cmd| {
-                    self.pipeline.dispatch(
-                        cmd,
-                        &[set],
-                        bytemuck::bytes_of(&push(bindings::DENOISE_AXIS_X)),
-                        groups,
+            for (name, set, input, output, axis) in sub_passes {
+                rec.pass(&format!("denoise {kind} {k} {name}"))
+                    .storage_image(
+                        set,
+                        bindings::DENOISE_BINDING_INPUT,
+                        input,
+                        Access::ComputeRead,
                     )
-                });
-            // The x sub-pass's output becomes the input; every caustic pixel
-            // is rewritten, so its old contents are discarded once the x
-            // sub-pass has read them.
-            let set = &self.set_y;
-            rec.pass(&format!("denoise {kind} {k} y"))
-                .storage_image(
-                    set,
-                    bindings::DENOISE_BINDING_INPUT,
-                    &self.scratch,
-                    Access::ComputeRead,
-                )
-                .storage_image(
-                    set,
-                    bindings::DENOISE_BINDING_POSITION,
-                    position,
-                    Access::ComputeRead,
-                )
-                .overwrite_storage_image(
-                    set,
-                    bindings::DENOISE_BINDING_OUTPUT,
-                    caustics,
-                    Access::ComputeWrite,
-                )
-                .record(|cmd| {
-                    self.pipeline.dispatch(
-                        cmd,
-                        &[set],
-                        bytemuck::bytes_of(&push(bindings::DENOISE_AXIS_Y)),
-                        groups,
+                    .storage_image(
+                        set,
+                        bindings::DENOISE_BINDING_POSITION,
+                        position,
+                        Access::ComputeRead,
                     )
-                });
+                    .overwrite_storage_image(
+                        set,
+                        bindings::DENOISE_BINDING_OUTPUT,
+                        output,
+                        Access::ComputeWrite,
+                    )
+                    .record(|cmd| {
+                        self.pipeline
+                            .dispatch(cmd, &[set], bytemuck::bytes_of(&push(axis)), groups)
+                    });
+            }
         }
     }
 }

@@ -476,21 +476,6 @@ pub fn eroded(mask: &[bool], size: u32) -> Vec<bool> {
         .collect()
 }
 
-/// Where Mesa keeps this user's shader cache, as `MESA_SHADER_CACHE_DIR`
-/// names it (Mesa adds `mesa_shader_cache` to that folder): the variable
-/// itself, else `$XDG_CACHE_HOME`, else `~/.cache`. A test that gives a
-/// child process a private `XDG_CACHE_HOME` passes this on: else lavapipe
-/// compiles every shader again there (12 s of the demo's first frame
-/// under validation).
-pub fn mesa_shader_cache_dir() -> PathBuf {
-    let var = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty());
-    var("MESA_SHADER_CACHE_DIR")
-        .or_else(|| var("XDG_CACHE_HOME"))
-        .map(PathBuf::from)
-        .or_else(|| var("HOME").map(|h| PathBuf::from(h).join(".cache")))
-        .unwrap_or_else(std::env::temp_dir)
-}
-
 /// rgb summed, the quantity compared per pixel.
 pub fn sum_rgb(img: &[f32], i: usize) -> f64 {
     (img[i * 4] + img[i * 4 + 1] + img[i * 4 + 2]) as f64

@@ -97,7 +97,7 @@ pub const CAMERA_SIDE_BATCH: u32 = 4096;
 /// A comparison that reads only those components gets the same images for
 /// the camera's pass alone, where the photons were 90% of the time.
 pub fn camera_side(settings: ReferenceSettings, photons: u64) -> (ReferenceSettings, u64) {
-    let passes = photons.div_ceil(settings.batch as u64);
+    let passes = settings.passes_for(photons);
     let settings = ReferenceSettings {
         batch: CAMERA_SIDE_BATCH,
         ..settings
