@@ -1,9 +1,13 @@
 //! Writing images: EXR holds linear radiance (32-bit float, the truth), PNG
 //! holds the tonemapped 8-bit sRGB display image. Outputs are written to
 //! temporary names in their folder and renamed together at the end
-//! ([`write_files`], or [`Batch`] for files written as they are made), so a failure, or a process interrupted by a signal
-//! (whose handler calls [`abandon_temporaries`]), never leaves a partial
-//! file, nor one image of a pair without the other.
+//! ([`write_files`], or [`Batch`] for files written as they are made), so
+//! a failure, or a process interrupted by a signal (whose handler calls
+//! [`abandon_temporaries`]), never leaves a partial file, nor one image of
+//! a pair without the other, and the files they replace stay whole until
+//! every new one is in place. Only regular files are replaced (never a
+//! link, FIFO or device: [`check_replaceable`]); what a killed run left is
+//! removed by the next run writing the same names.
 
 use anyhow::Context as _;
 use std::fs::File;
@@ -57,6 +61,7 @@ pub fn prepare(out: &Path) -> anyhow::Result<(PathBuf, PathBuf)> {
         if p.is_dir() {
             anyhow::bail!("--out {}: {} is a folder", out.display(), p.display());
         }
+        check_replaceable(p).with_context(|| format!("--out {}", out.display()))?;
     }
     Ok((exr, png))
 }
@@ -101,6 +106,28 @@ pub fn check_writable(path: &Path, option: &str) -> anyhow::Result<()> {
             )
         }),
     }
+}
+
+/// An output replaces only a regular file: renaming a temporary over a
+/// symbolic link, a FIFO or a device node would replace the link or the
+/// node itself (as root, `/dev/full` became a regular file).
+pub fn check_replaceable(path: &Path) -> anyhow::Result<()> {
+    let Ok(meta) = std::fs::symlink_metadata(path) else {
+        return Ok(()); // nothing there (or unreadable: the write will say)
+    };
+    let what = if meta.file_type().is_symlink() {
+        "a symbolic link"
+    } else if meta.is_dir() {
+        "a folder"
+    } else if !meta.is_file() {
+        "a FIFO, socket or device"
+    } else {
+        return Ok(());
+    };
+    anyhow::bail!(
+        "{}: {what}; an output replaces only a regular file",
+        path.display()
+    )
 }
 
 fn folder_of(path: &Path) -> PathBuf {
@@ -171,11 +198,13 @@ impl Batch {
         let dir = folder_of(f.path);
         std::fs::create_dir_all(&dir)
             .with_context(|| format!("cannot create folder {}", dir.display()))?;
+        check_replaceable(f.path)?;
         let name = f
             .path
             .file_name()
             .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
-        let tmp = dir.join(format!(".{name}.{}.partial", std::process::id()));
+        remove_stale_temporaries(&dir, &name);
+        let tmp = sibling_temporary(f.path, "partial");
         // Created with the lock held: after a signal's handler took it,
         // no temporary can appear.
         let file = {
@@ -204,20 +233,53 @@ impl Batch {
         self.written.is_empty()
     }
 
-    /// Renames every temporary into place, in the order written; on a
-    /// failure removes those already renamed (and, on drop, the rest).
+    /// Renames every temporary into place, in the order written. The files
+    /// they replace are moved aside first (`.NAME.PID.previous`) and
+    /// removed only once every new file is in place: on a failure the new
+    /// files already renamed are removed and the previous ones put back,
+    /// so the earlier output survives whole (and, on drop, the
+    /// temporaries go).
     pub fn commit(mut self) -> anyhow::Result<()> {
         let mut list = temporaries();
-        for (i, (tmp, path)) in self.written.iter().enumerate() {
-            if let Err(e) = std::fs::rename(tmp, path) {
-                for (_, done) in &self.written[..i] {
-                    let _ = std::fs::remove_file(done);
+        for (_, path) in &self.written {
+            check_replaceable(path)?;
+        }
+        // (final path, where its previous file waits, if it had one)
+        let mut placed: Vec<(PathBuf, Option<PathBuf>)> = Vec::new();
+        let mut failure = None;
+        for (tmp, path) in &self.written {
+            let previous = path.is_file().then(|| sibling_temporary(path, "previous"));
+            if let Some(previous) = &previous {
+                if let Err(e) = std::fs::rename(path, previous) {
+                    failure = Some((e, format!("cannot write {}", path.display())));
+                    break;
                 }
-                let message = format!("cannot write {}", path.display());
-                self.written.drain(..i);
-                return Err(e).context(message);
+            }
+            if let Err(e) = std::fs::rename(tmp, path) {
+                if let Some(previous) = &previous {
+                    let _ = std::fs::rename(previous, path);
+                }
+                failure = Some((e, format!("cannot write {}", path.display())));
+                break;
             }
             list.retain(|p| p != tmp);
+            placed.push((path.clone(), previous));
+        }
+        if let Some((e, message)) = failure {
+            for (path, previous) in placed.iter().rev() {
+                let _ = std::fs::remove_file(path);
+                if let Some(previous) = previous {
+                    let _ = std::fs::rename(previous, path);
+                }
+            }
+            let placed: Vec<&PathBuf> = placed.iter().map(|(p, _)| p).collect();
+            self.written.retain(|(_, p)| !placed.contains(&p));
+            return Err(e).context(message);
+        }
+        for (_, previous) in placed {
+            if let Some(previous) = previous {
+                let _ = std::fs::remove_file(previous);
+            }
         }
         self.written.clear();
         Ok(())
@@ -231,6 +293,59 @@ impl Drop for Batch {
         for (tmp, _) in &self.written {
             let _ = std::fs::remove_file(tmp);
             list.retain(|p| p != tmp);
+        }
+    }
+}
+
+/// A hidden file beside `path` for this process: `.NAME.PID.KIND`.
+fn sibling_temporary(path: &Path, kind: &str) -> PathBuf {
+    let name = path
+        .file_name()
+        .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
+    folder_of(path).join(format!(".{name}.{}.{kind}", std::process::id()))
+}
+
+/// Removes what a killed run left beside output `name` in `dir`: its
+/// `.NAME.PID.partial` temporaries and `.NAME.PID.previous` files whose
+/// process no longer runs (`/proc/PID` is gone; where there is no `/proc`,
+/// nothing is removed). A `.previous` file of a dead run is the earlier
+/// output it had moved aside; it goes back in place when no output took it.
+fn remove_stale_temporaries(dir: &Path, name: &str) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let prefix = format!(".{name}.");
+    for entry in entries.flatten() {
+        let file = entry.file_name().to_string_lossy().into_owned();
+        let Some(rest) = file.strip_prefix(&prefix) else {
+            continue;
+        };
+        let Some((pid, kind)) = rest.split_once('.') else {
+            continue;
+        };
+        let alive = pid.parse::<u32>().is_ok_and(|pid| {
+            pid == std::process::id() || Path::new("/proc").join(pid.to_string()).exists()
+        });
+        if alive || pid.parse::<u32>().is_err() {
+            continue;
+        }
+        let stale = entry.path();
+        match kind {
+            "partial" => {
+                let _ = std::fs::remove_file(&stale);
+            }
+            "previous" => {
+                let output = dir.join(name);
+                if output.exists() {
+                    let _ = std::fs::remove_file(&stale);
+                } else {
+                    let _ = std::fs::rename(&stale, &output);
+                }
+            }
+            _ => {}
         }
     }
 }
@@ -326,19 +441,22 @@ mod tests {
     fn failed_rename_leaves_no_partial_file() {
         let dir = std::env::temp_dir().join(format!("caustics-output-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
-        // The target is a folder: the temporary file is written, the rename fails.
+        // The target is a folder: refused before anything is written.
         let target = dir.join("x.png");
         std::fs::create_dir_all(&target).unwrap();
         let e = write_png(&target, 1, 1, &[0, 0, 0, 255]).expect_err("a folder is in the way");
-        assert!(e.to_string().contains("cannot write"), "{e:#}");
-        // A pair: the EXR renamed first is removed when the PNG fails.
+        assert!(e.to_string().contains("a folder"), "{e:#}");
+        // A pair whose PNG cannot be placed: the earlier EXR survives as it was.
         let exr = dir.join("x.exr");
+        std::fs::write(&exr, "earlier output").unwrap();
         let e = write_files(vec![
             exr_file(&exr, 1, 1, &[0.0; 4]),
             png_file(&target, 1, 1, &[0, 0, 0, 255]),
         ])
         .expect_err("a folder is in the way");
-        assert!(e.to_string().contains("cannot write"), "{e:#}");
+        assert!(e.to_string().contains("a folder"), "{e:#}");
+        assert_eq!(std::fs::read_to_string(&exr).unwrap(), "earlier output");
+        std::fs::remove_file(&exr).unwrap();
         let left: Vec<_> = std::fs::read_dir(&dir)
             .unwrap()
             .map(|e| e.unwrap().file_name())
@@ -385,6 +503,58 @@ mod tests {
         batch.write(png_file(&b, 1, 1, &[0, 0, 0, 255])).unwrap();
         batch.commit().unwrap();
         assert_eq!(names(&dir), vec!["a.exr", "b.png"]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Issue 31: an output path holding a symbolic link or a FIFO is
+    /// refused and left as it was; a replaced regular file is replaced
+    /// only once the new one is complete; temporaries of a run killed
+    /// with SIGKILL are removed by the next run into the same place.
+    #[test]
+    fn outputs_replace_only_regular_files_and_clean_up_after_killed_runs() {
+        let dir = std::env::temp_dir().join(format!("caustics-replace-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let kept = dir.join("kept.txt");
+        std::fs::write(&kept, "not an image").unwrap();
+        let link = dir.join("link.png");
+        std::os::unix::fs::symlink(&kept, &link).unwrap();
+        let fifo = dir.join("fifo.png");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        let mut special = vec![(link.clone(), "symbolic link")];
+        if made.is_ok_and(|s| s.success()) {
+            special.push((fifo.clone(), "FIFO"));
+        }
+        for (path, what) in &special {
+            let e = write_png(path, 1, 1, &[0, 0, 0, 255]).expect_err("refused");
+            assert!(e.to_string().contains(what), "{e:#}");
+            let e = prepare(path).expect_err("refused before rendering");
+            assert!(format!("{e:#}").contains(what), "{e:#}");
+        }
+        assert!(std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read_to_string(&kept).unwrap(), "not an image");
+
+        // A run killed between writing and renaming (a PID that no longer
+        // runs): its temporary goes; its moved-aside earlier output comes back.
+        let out = dir.join("r.png");
+        let dead = u32::MAX - 1;
+        std::fs::write(dir.join(format!(".r.png.{dead}.partial")), "half").unwrap();
+        std::fs::write(dir.join(format!(".q.png.{dead}.previous")), "earlier q").unwrap();
+        write_png(&out, 1, 1, &[0, 0, 0, 255]).unwrap();
+        write_png(&dir.join("q.png"), 1, 1, &[0, 0, 0, 255]).unwrap();
+        let mut left: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        let mut expected = vec!["kept.txt", "link.png", "q.png", "r.png"];
+        if special.len() == 2 {
+            expected.insert(0, "fifo.png");
+        }
+        assert_eq!(left, expected);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

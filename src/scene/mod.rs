@@ -35,12 +35,38 @@ use std::path::Path;
 /// use them.
 pub const DEFAULT_SCENE: &str = "assets/scenes/still_life.toml";
 
+/// Where [`DEFAULT_SCENE`] is: under the working directory (a checkout),
+/// else under a folder above the executable (`target/release/caustics` of
+/// a checkout run from elsewhere), else under the checkout the binary was
+/// built from (`cargo install --path .`); the first when none has it (its
+/// error then names the path as given).
+pub fn default_scene_path() -> std::path::PathBuf {
+    let relative = Path::new(DEFAULT_SCENE);
+    let exe = std::env::current_exe().ok();
+    let above_exe = exe.iter().flat_map(|e| e.ancestors().skip(1));
+    std::iter::once(Path::new(""))
+        .chain(above_exe)
+        .chain(std::iter::once(Path::new(env!("CARGO_MANIFEST_DIR"))))
+        .map(|dir| dir.join(relative))
+        .find(|p| p.is_file())
+        .unwrap_or_else(|| relative.to_path_buf())
+}
+
 impl Scene {
     /// Reads and validates a scene file. Relative paths inside it (OBJ meshes,
     /// density grids) resolve against the file's folder. A `.gltf` or `.glb`
     /// file is a whole scene of its own ([`gltf::scene`] with the default
     /// options: a floor, the file's camera and lights or defaults).
+    /// The default scene ([`DEFAULT_SCENE`]) is found from any working
+    /// directory ([`default_scene_path`]).
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let found;
+        let path = if path == Path::new(DEFAULT_SCENE) {
+            found = default_scene_path();
+            found.as_path()
+        } else {
+            path
+        };
         let start = std::time::Instant::now();
         let scene = if gltf::is_gltf_path(path) {
             gltf::scene(path, &gltf::GltfSceneOptions::default())?

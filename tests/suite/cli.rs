@@ -738,3 +738,23 @@ fn every_canonical_scene_reference_renders() {
         assert!(!name.contains(".partial"), "{name} left behind");
     }
 }
+
+/// Issue 31: the default scene is a path relative to a checkout; run from
+/// any other folder, the binary finds it above itself (a checkout's
+/// `target/`) instead of failing with "cannot read scene file".
+#[test]
+fn the_default_scene_is_found_from_any_folder() {
+    let dir = temp_dir("default-scene");
+    std::fs::create_dir_all(&dir).unwrap();
+    let o = caustics()
+        .current_dir(&dir)
+        .args([
+            "render", "--width", "16", "--height", "16", "--out", "x.exr",
+        ])
+        .output()
+        .expect("run the caustics binary");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    check_exr(&dir.join("x.exr"), 16, 16);
+    let _ = std::fs::remove_dir_all(&dir);
+}
