@@ -12,6 +12,7 @@ mod bounds;
 mod error;
 mod file;
 pub mod gltf;
+pub mod input;
 mod node;
 pub mod obj;
 pub mod shapes;
@@ -84,9 +85,11 @@ impl Scene {
     }
 
     fn load_toml(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
-            path: path.to_path_buf(),
-            source,
+        let text = input::read_text_limited(path, input::MAX_SCENE_BYTES).map_err(|why| {
+            SceneError::Read {
+                path: path.to_path_buf(),
+                source: std::io::Error::other(why),
+            }
         })?;
         Self::from_str(&text, path)
     }

@@ -236,8 +236,8 @@ pub fn check_mtl_values(m: &tobj::Material) -> Result<(), String> {
 /// Reads an OBJ file (and the MTL files it names, relative to it).
 /// The error is a message that names the file.
 pub fn load(path: &Path) -> Result<ObjMesh, String> {
-    let bytes =
-        std::fs::read(path).map_err(|e| format!("cannot open OBJ file {}: {e}", path.display()))?;
+    let bytes = super::input::read_limited(path, super::input::MAX_OBJ_BYTES)
+        .map_err(|e| format!("cannot open OBJ file {}: {e}", path.display()))?;
     check_relative_indices(&bytes)
         .map_err(|(line, why)| format!("OBJ file {}:{line}: {why}", path.display()))?;
     let mut reader = &bytes[..];
@@ -251,7 +251,7 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
     };
     let (models, materials) = tobj::load_obj_buf(&mut reader, &options, |mtl: &Path| {
         let full = dir.join(mtl);
-        let result = std::fs::read_to_string(&full)
+        let result = super::input::read_text_limited(&full, super::input::MAX_MTL_BYTES)
             .map_err(|e| format!("cannot read it: {e}"))
             .and_then(|text| complete_colours(&text))
             .and_then(|text| {
@@ -415,7 +415,7 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
 /// that is not finite: its 1-based line and its text. Read again only when
 /// loading has found one, so loading stays one pass.
 fn first_non_finite(path: &Path, keyword: &str) -> Option<(usize, String)> {
-    let text = std::fs::read_to_string(path).ok()?;
+    let text = super::input::read_text_limited(path, super::input::MAX_OBJ_BYTES).ok()?;
     text.lines().enumerate().find_map(|(i, line)| {
         let mut words = line.split_whitespace();
         let bad = words.next() == Some(keyword)

@@ -31,6 +31,8 @@ pub fn srgb_to_linear(c: f32) -> f32 {
 /// (EXR) are linear already. Alpha, when the file has it, is kept as it is
 /// (coverage, never sRGB-encoded) for cut-outs. The error says why.
 pub fn load(path: &Path) -> Result<Texture, String> {
+    crate::scene::input::check_regular(path)
+        .map_err(|e| format!("cannot open texture {}: {e}", path.display()))?;
     let reader = image::ImageReader::open(path)
         .map_err(|e| format!("cannot open texture {}: {e}", path.display()))?
         .with_guessed_format()

@@ -477,3 +477,66 @@ fn compare_reference_must_be_finite_non_negative_exr() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 31: a FIFO anywhere in a scene hung the program, `/dev/zero` was
+/// read until memory ran out. Each is now one line naming the file, at
+/// once (the child is killed after 60 s, which fails the test).
+#[test]
+fn special_files_in_a_scene_are_refused_without_reading_them() {
+    let dir = out_dir("special-inputs");
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("mesh.obj");
+    let made = Command::new("mkfifo").arg(&fifo).status();
+    assert!(made.is_ok_and(|s| s.success()), "mkfifo");
+    let scene = dir.join("scene.toml");
+    std::fs::write(
+        &scene,
+        "[camera]\neye = [0.0, 1.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nfov_y = 40.0\n\n\
+         [[light]]\nkind = \"point\"\nposition = [0.0, 3.0, 0.0]\nintensity = [10.0, 10.0, 10.0]\n\n\
+         [[material]]\nname = \"m\"\nkind = \"diffuse\"\nalbedo = 0.5\n\n\
+         [[object]]\nshape = \"mesh\"\npath = \"mesh.obj\"\nmaterial = \"m\"\n",
+    )
+    .unwrap();
+    let fifo_scene = dir.join("fifo.toml");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo_scene)
+        .status()
+        .unwrap()
+        .success());
+    let cases = [
+        (scene.clone(), "a FIFO, socket or device"),
+        (fifo_scene.clone(), "a FIFO, socket or device"),
+        (PathBuf::from("/dev/zero"), "not a regular file"),
+        (dir.clone(), "a folder"),
+    ];
+    for (path, needle) in cases {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_caustics"))
+            .args([
+                "render",
+                "--scene",
+                path.to_str().unwrap(),
+                "--width",
+                "8",
+                "--height",
+                "8",
+            ])
+            .args(["--out", dir.join("x.png").to_str().unwrap()])
+            .env("VK_DRIVER_FILES", LAVAPIPE_ICD)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let start = std::time::Instant::now();
+        while child.try_wait().unwrap().is_none() {
+            if start.elapsed() > std::time::Duration::from_secs(60) {
+                let _ = child.kill();
+                panic!("{}: still running after 60 s", path.display());
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let o = child.wait_with_output().unwrap();
+        one_line_error(&o, &[needle]);
+        assert!(!dir.join("x.png").exists());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

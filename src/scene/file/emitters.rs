@@ -77,6 +77,8 @@ fn sky(t: &Tbl, rotate_deg: f32) -> R<Sky> {
 /// radiance. Other formats, undecodable or truncated files and negative or
 /// non-finite texels are refused; the message names the file.
 pub fn load_hdr(path: &Path) -> Result<Texture, String> {
+    crate::scene::input::check_regular(path)
+        .map_err(|e| format!("cannot open environment image {}: {e}", path.display()))?;
     let reader = image::ImageReader::open(path)
         .map_err(|e| format!("cannot open environment image {}: {e}", path.display()))?
         .with_guessed_format()

@@ -114,20 +114,25 @@ fn density_table(t: &Tbl, dir: &Path) -> R<Density> {
             }
         }
         let full = dir.join(rel);
-        let bytes = std::fs::read(&full).map_err(|e| {
+        // The grid holds exactly its texels: its size is checked before
+        // anything is read, and no more than that is read.
+        let count = dims.iter().map(|&d| d as u64).product::<u64>();
+        let cannot_read = |e: String| {
             t.err(
                 "grid",
                 format!("cannot read density grid {}: {e}", full.display()),
             )
-        })?;
-        let count = dims.iter().map(|&d| d as u64).product::<u64>();
-        if bytes.len() as u64 != count * 4 {
+        };
+        crate::scene::input::check_regular(&full).map_err(cannot_read)?;
+        let size = std::fs::metadata(&full)
+            .map_err(|e| cannot_read(e.to_string()))?
+            .len();
+        if size != count * 4 {
             return Err(t.err(
                 "grid",
                 format!(
-                    "density grid {} has {} bytes; dims {}x{}x{} need {} (little-endian f32, x fastest)",
+                    "density grid {} has {size} bytes; dims {}x{}x{} need {} (little-endian f32, x fastest)",
                     full.display(),
-                    bytes.len(),
                     dims[0],
                     dims[1],
                     dims[2],
@@ -135,10 +140,17 @@ fn density_table(t: &Tbl, dir: &Path) -> R<Density> {
                 ),
             ));
         }
-        let values: Vec<f32> = bytes
-            .chunks_exact(4)
-            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-            .collect();
+        let bytes = crate::scene::input::read_limited(&full, count * 4).map_err(cannot_read)?;
+        let mut values: Vec<f32> = Vec::new();
+        values
+            .try_reserve_exact(count as usize)
+            .map_err(|_| cannot_read(format!("cannot allocate {} bytes for it", count * 4)))?;
+        values.extend(
+            bytes
+                .chunks_exact(4)
+                .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])),
+        );
+        drop(bytes);
         if let Some((i, v)) = values
             .iter()
             .enumerate()

@@ -46,7 +46,8 @@ pub(super) fn read_uri(uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
         return base64_decode(payload).ok_or_else(|| "invalid base64 data".into());
     }
     let file = uri_file(uri, dir).ok_or_else(|| format!("unsupported URI scheme in `{uri}`"))?;
-    std::fs::read(&file).map_err(|e| format!("cannot read {}: {e}", file.display()))
+    crate::scene::input::read_limited(&file, crate::scene::input::MAX_GLTF_BYTES)
+        .map_err(|e| format!("cannot read {}: {e}", file.display()))
 }
 
 /// The file a non-`data:` URI names: `file:` or relative (percent-decoded).

@@ -163,7 +163,8 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
         at: at.to_owned(),
         message,
     };
-    let bytes = std::fs::read(path).map_err(|e| fail("", format!("cannot read glTF file: {e}")))?;
+    let bytes = crate::scene::input::read_limited(path, crate::scene::input::MAX_GLTF_BYTES)
+        .map_err(|e| fail("", format!("cannot read glTF file: {e}")))?;
     let (json_bytes, blob) = if bytes.starts_with(b"glTF") {
         // The header's length is the whole file's (glTF 2.0, 4.4.2): bytes
         // past it are not part of the asset, a file cut short is damaged.
