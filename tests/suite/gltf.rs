@@ -916,6 +916,42 @@ fn bad_files() -> Vec<Bad> {
             says: "cannot read",
             edit: |g, _| g.root["buffers_uri_override"] = json!("gone.bin"),
         },
+        // Issue 31: URIs are confined to the glTF file's folder.
+        Bad {
+            name: "file_scheme_buffer",
+            at: "buffers[0].uri",
+            says: "a scheme",
+            edit: |g, _| g.root["buffers_uri_override"] = json!("file:///etc/passwd"),
+        },
+        Bad {
+            name: "absolute_buffer",
+            at: "buffers[0].uri",
+            says: "an absolute path",
+            edit: |g, _| g.root["buffers_uri_override"] = json!("/etc/passwd"),
+        },
+        Bad {
+            name: "encoded_parent_buffer",
+            at: "buffers[0].uri",
+            says: "climbs above the folder",
+            edit: |g, _| g.root["buffers_uri_override"] = json!("sub/%2e%2e/%2E%2E/passwd"),
+        },
+        Bad {
+            name: "link_outside",
+            at: "buffers[0].uri",
+            says: "a link that resolves outside the folder",
+            edit: |g, dir| {
+                let link = dir.join("outside.bin");
+                let _ = std::fs::remove_file(&link);
+                std::os::unix::fs::symlink("/etc/hostname", &link).unwrap();
+                g.root["buffers_uri_override"] = json!("outside.bin");
+            },
+        },
+        Bad {
+            name: "parent_image",
+            at: "images[0].uri",
+            says: "climbs above the folder",
+            edit: |g, _| g.root["images"] = json!([{"uri": "../secret.png"}]),
+        },
         Bad {
             name: "missing_image",
             at: "images[0].uri",
@@ -1139,7 +1175,7 @@ fn bad_files_fail_with_one_line_naming_the_file_and_the_gltf_path() {
 
     // The same through a TOML scene's `shape = "gltf"`: located at the
     // object's `path`, then the file and the glTF path.
-    let bad = &bad_files()[8];
+    let bad = &bad_files()[13];
     write_bad(&dir, bad);
     let scene = dir.join("scene.toml");
     let text = format!(

@@ -45,23 +45,50 @@ pub(super) fn read_uri(uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
             .ok_or("only base64 data URIs are supported")?;
         return base64_decode(payload).ok_or_else(|| "invalid base64 data".into());
     }
-    let file = uri_file(uri, dir).ok_or_else(|| format!("unsupported URI scheme in `{uri}`"))?;
+    let file = uri_file(uri, dir)?;
     crate::scene::input::read_limited(&file, crate::scene::input::MAX_GLTF_BYTES)
         .map_err(|e| format!("cannot read {}: {e}", file.display()))
 }
 
-/// The file a non-`data:` URI names: `file:` or relative (percent-decoded).
-pub(super) fn uri_file(uri: &str, dir: &Path) -> Option<PathBuf> {
-    if let Some(p) = uri
-        .strip_prefix("file://")
-        .or_else(|| uri.strip_prefix("file:"))
-    {
-        return Some(PathBuf::from(percent_decode(p)));
-    }
+/// The file a non-`data:` URI names: a relative reference, percent-decoded,
+/// inside the glTF file's folder tree (issue 31: a downloaded asset must
+/// not read `/etc/passwd`). Refused: any scheme (`file:` included),
+/// absolute paths, `..` that climbs above the folder (checked after
+/// percent-decoding, so `%2e%2e/` too), and a link inside the folder that
+/// resolves outside it.
+pub(super) fn uri_file(uri: &str, dir: &Path) -> Result<PathBuf, String> {
+    use std::path::Component;
+    let refuse = |why: &str| {
+        Err(format!(
+            "URI `{uri}`: {why}; only files inside the glTF file's folder are read"
+        ))
+    };
     if uri.contains(':') {
-        return None;
+        return refuse("a scheme (file:, http:, ...) or drive");
     }
-    Some(dir.join(percent_decode(uri)))
+    let decoded = PathBuf::from(percent_decode(uri));
+    let mut depth = 0usize;
+    for c in decoded.components() {
+        match c {
+            Component::Normal(_) => depth += 1,
+            Component::CurDir => {}
+            Component::ParentDir if depth > 0 => depth -= 1,
+            Component::ParentDir => return refuse("it climbs above the folder"),
+            Component::RootDir | Component::Prefix(_) => return refuse("an absolute path"),
+        }
+    }
+    let file = dir.join(&decoded);
+    let folder = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    if let (Ok(resolved), Ok(folder)) = (file.canonicalize(), folder.canonicalize()) {
+        if !resolved.starts_with(&folder) {
+            return refuse("a link that resolves outside the folder");
+        }
+    }
+    Ok(file)
 }
 
 pub(super) fn percent_decode(s: &str) -> String {
@@ -120,8 +147,7 @@ pub(super) fn check_images(document: &Document, dir: &Path, fail: Fail) -> Resul
                 continue;
             }
             let at = format!("images[{}].uri", image.index());
-            let file = uri_file(uri, dir)
-                .ok_or_else(|| fail(&at, format!("unsupported URI scheme in `{uri}`")))?;
+            let file = uri_file(uri, dir).map_err(|e| fail(&at, e))?;
             if !file.is_file() {
                 return Err(fail(
                     &at,

@@ -397,9 +397,7 @@ impl Loader<'_> {
                     let bytes = read_uri(uri, self.dir).map_err(|e| (self.fail)(&at, e))?;
                     return texture::decode(&bytes, &embedded).map_err(|e| (self.fail)(&at, e));
                 }
-                let file = uri_file(uri, self.dir).ok_or_else(|| {
-                    (self.fail)(&at, format!("unsupported URI scheme in `{uri}`"))
-                })?;
+                let file = uri_file(uri, self.dir).map_err(|e| (self.fail)(&at, e))?;
                 texture::load(&file).map_err(|e| (self.fail)(&at, e))
             }
         }
