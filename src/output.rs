@@ -108,14 +108,38 @@ pub fn check_writable(path: &Path, option: &str) -> anyhow::Result<()> {
     }
 }
 
+/// Files (device and inode) that no output may replace: the scene's own
+/// inputs, registered by the command once the scene is loaded.
+static INPUTS: Mutex<Vec<(u64, u64)>> = Mutex::new(Vec::new());
+
+/// Forbids every output from replacing any of `files` (the scene file, its
+/// meshes, textures, environment map, ...), whatever path names them.
+pub fn protect_inputs(files: &[PathBuf]) {
+    use std::os::unix::fs::MetadataExt;
+    let mut inputs = INPUTS.lock().unwrap_or_else(|e| e.into_inner());
+    for f in files {
+        if let Ok(m) = std::fs::metadata(f) {
+            inputs.push((m.dev(), m.ino()));
+        }
+    }
+}
+
 /// An output replaces only a regular file: renaming a temporary over a
 /// symbolic link, a FIFO or a device node would replace the link or the
-/// node itself (as root, `/dev/full` became a regular file).
+/// node itself (as root, `/dev/full` became a regular file); nor one of
+/// the scene's inputs ([`protect_inputs`]).
 pub fn check_replaceable(path: &Path) -> anyhow::Result<()> {
+    use std::os::unix::fs::MetadataExt;
     let Ok(meta) = std::fs::symlink_metadata(path) else {
         return Ok(()); // nothing there (or unreadable: the write will say)
     };
-    let what = if meta.file_type().is_symlink() {
+    let input = INPUTS
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .contains(&(meta.dev(), meta.ino()));
+    let what = if input {
+        "one of the scene's input files"
+    } else if meta.file_type().is_symlink() {
         "a symbolic link"
     } else if meta.is_dir() {
         "a folder"
@@ -125,7 +149,7 @@ pub fn check_replaceable(path: &Path) -> anyhow::Result<()> {
         return Ok(());
     };
     anyhow::bail!(
-        "{}: {what}; an output replaces only a regular file",
+        "{}: {what}; an output replaces only a regular file that is not an input",
         path.display()
     )
 }

@@ -92,6 +92,8 @@ fn pipeline_cache_file() -> Option<PathBuf> {
 /// any error, on validation errors and on leaked Vulkan objects.
 pub fn run(options: DemoOptions) -> anyhow::Result<()> {
     let scene = Scene::load(&options.scene)?;
+    // Screenshots never replace a file the scene was read from.
+    crate::output::protect_inputs(&crate::scene::input::files_read());
     if std::env::var_os("DISPLAY").is_none() && std::env::var_os("WAYLAND_DISPLAY").is_none() {
         anyhow::bail!(
             "demo needs a display: neither DISPLAY nor WAYLAND_DISPLAY is set (run it in a desktop session, or under `xvfb-run`)"

@@ -347,9 +347,11 @@ pub fn check_validation(ctx: Arc<Context>) -> anyhow::Result<()> {
 
 /// Loads the scene and checks what it derives at `time` (transforms, light
 /// power: `Scene::check_at`) before any device work.
+/// Every file the scene read is then protected from the command's outputs.
 pub fn load_scene(path: &Path, time: f32) -> anyhow::Result<Scene> {
     let scene = Scene::load(path)?;
     scene.check_at(time).map_err(anyhow::Error::msg)?;
+    caustics::output::protect_inputs(&caustics::scene::input::files_read());
     Ok(scene)
 }
 

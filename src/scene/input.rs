@@ -5,7 +5,19 @@
 //! cannot fill the memory. The errors say why; the caller names the file.
 
 use std::io::Read;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// Every file this process has opened as a scene input, so that the
+/// command writing images can refuse to overwrite one of them
+/// (`output::protect_inputs`).
+static FILES_READ: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// The files read as scene inputs so far (scene files, meshes, materials,
+/// glTF files and buffers, grids, textures, environment images).
+pub fn files_read() -> Vec<PathBuf> {
+    FILES_READ.lock().map(|v| v.clone()).unwrap_or_default()
+}
 
 /// A scene's TOML text: scenes keep geometry in OBJ or glTF files, and a
 /// TOML document takes tens of times its size in memory while parsed.
@@ -18,10 +30,14 @@ pub const MAX_MTL_BYTES: u64 = 64 << 20;
 /// `byteLength` are 32-bit in practice (the GLB header's field is a u32).
 pub const MAX_GLTF_BYTES: u64 = u32::MAX as u64;
 
-/// Err (why) unless `path` is a regular file, or a symbolic link to one.
+/// Err (why) unless `path` is a regular file, or a symbolic link to one;
+/// Ok records it as read ([`files_read`]).
 pub fn check_regular(path: &Path) -> Result<(), String> {
     let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
     if meta.is_file() {
+        if let Ok(mut files) = FILES_READ.lock() {
+            files.push(path.to_path_buf());
+        }
         return Ok(());
     }
     let what = if meta.is_dir() {

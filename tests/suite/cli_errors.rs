@@ -540,3 +540,44 @@ fn special_files_in_a_scene_are_refused_without_reading_them() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 31: an output path that names one of the scene's own inputs (here
+/// its albedo texture, given as `--out`, and the same file reached as the
+/// PNG written beside an EXR) was overwritten with exit 0.
+#[test]
+fn an_output_never_replaces_a_scene_input() {
+    let dir = out_dir("input-as-output");
+    std::fs::create_dir_all(&dir).unwrap();
+    let texture = dir.join("tex.png");
+    caustics::output::write_png(&texture, 2, 2, &[200; 16]).unwrap();
+    let before = std::fs::read(&texture).unwrap();
+    let scene = dir.join("scene.toml");
+    std::fs::write(
+        &scene,
+        "[camera]\neye = [0.0, 2.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nfov_y = 40.0\n\n\
+         [[light]]\nkind = \"point\"\nposition = [0.0, 3.0, 0.0]\nintensity = [10.0, 10.0, 10.0]\n\n\
+         [[material]]\nname = \"m\"\nkind = \"diffuse\"\nalbedo_texture = \"tex.png\"\n\n\
+         [[object]]\nshape = \"plane\"\nsize = [4.0, 4.0]\nmaterial = \"m\"\n",
+    )
+    .unwrap();
+    for out in [texture.clone(), dir.join("tex.exr")] {
+        let o = run(
+            &[
+                "render",
+                "--scene",
+                scene.to_str().unwrap(),
+                "--width",
+                "8",
+                "--height",
+                "8",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &[],
+        );
+        one_line_error(&o, &["tex.png", "one of the scene's input files"]);
+        assert_eq!(std::fs::read(&texture).unwrap(), before);
+        assert!(!dir.join("tex.exr").exists());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
