@@ -115,6 +115,18 @@ fn hdr_image_environment_loads_relative_to_the_scene() {
         "path =",
         "not an HDR image",
     );
+    // Issue 31: texels far above the radiometric bound (1e10) loaded and
+    // the render failed at its end with a NaN naming no file.
+    let mut texels = vec![1.0f32; 4 * 2 * 4];
+    texels[4 * 5] = 1.5e20;
+    caustics::output::write_exr(&dir.join("hot.exr"), 4, 2, &texels).unwrap();
+    rejects(
+        &with("hot.exr"),
+        &file,
+        "light[0].path",
+        "path =",
+        "texel (1, 1) is [1.5e20",
+    );
     let bytes = std::fs::read(dir.join("env.hdr")).unwrap();
     std::fs::write(dir.join("cut.hdr"), &bytes[..bytes.len() / 2]).unwrap();
     rejects(

@@ -104,13 +104,19 @@ pub fn load_hdr(path: &Path) -> Result<Texture, String> {
         ));
     }
     let texels: Vec<[f32; 3]> = decoded.into_rgb32f().pixels().map(|p| p.0).collect();
-    if let Some(i) = texels
-        .iter()
-        .position(|t| t.iter().any(|c| !(c.is_finite() && *c >= 0.0)))
-    {
+    // The radiometric bound of every scene value (docs/SCENES.md, Bounds):
+    // above it the table's sums and the photons' flux leave the f32 range
+    // and the render would fail at its end with a NaN naming no file.
+    let bound = crate::scene::MAX_RADIOMETRIC as f32;
+    if let Some(i) = texels.iter().position(|t| {
+        t.iter()
+            .any(|c| !(c.is_finite() && *c >= 0.0 && *c <= bound))
+    }) {
         return Err(format!(
-            "environment image {}: texel {i} is {:?}, not a finite non-negative radiance",
+            "environment image {}: texel ({}, {}) is {:?}, not a radiance within 0 and {bound:e}",
             path.display(),
+            i as u32 % width,
+            i as u32 / width,
             texels[i]
         ));
     }
