@@ -55,16 +55,67 @@ pub fn decode(bytes: &[u8], name: &Path) -> Result<Texture, String> {
     from_image(decoded, name)
 }
 
-fn from_image(decoded: DynamicImage, path: &Path) -> Result<Texture, String> {
-    let (width, height) = (decoded.width(), decoded.height());
-    if width == 0 || height == 0 {
-        return Err(format!("texture {} is empty", path.display()));
+/// Largest side a decoded texture keeps before its float copies are made
+/// (4 x MAX_LAYER_SIZE, so the layer's own filtering still has 4 texels per
+/// texel to average): an 8192² PNG of 261 KB took 4.3 GB as floats and
+/// mip chain, a 16384 x 8192 one aborted (issue 31).
+pub const MAX_DECODED_SIDE: u32 = 4 * MAX_LAYER_SIZE;
+
+/// `decoded` box-filtered by the smallest whole factor that brings both
+/// sides to [`MAX_DECODED_SIDE`] or below, in linear values (8- and 16-bit
+/// images are sRGB: averaging their codes would darken every contrast),
+/// a strip of rows at a time so that no full-size float copy is made.
+/// Smaller images are returned as they are.
+fn shrink_large(decoded: DynamicImage) -> DynamicImage {
+    let (w, h) = (decoded.width(), decoded.height());
+    let k = w.max(h).div_ceil(MAX_DECODED_SIDE);
+    if k <= 1 {
+        return decoded;
     }
     let linear = matches!(
         decoded,
         DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
     );
+    let (nw, nh) = (w.div_ceil(k), h.div_ceil(k));
+    let mut out = Rgba32FImage::new(nw, nh);
+    for oy in 0..nh {
+        let rows = k.min(h - oy * k);
+        let strip = decoded.crop_imm(0, oy * k, w, rows).into_rgba32f();
+        for ox in 0..nw {
+            let cols = k.min(w - ox * k);
+            let mut sum = [0.0f64; 4];
+            for y in 0..rows {
+                for x in ox * k..ox * k + cols {
+                    let p = strip.get_pixel(x, y).0;
+                    for c in 0..4 {
+                        let v = if linear || c == 3 {
+                            p[c]
+                        } else {
+                            srgb_to_linear(p[c])
+                        };
+                        sum[c] += v as f64;
+                    }
+                }
+            }
+            let n = (rows * cols) as f64;
+            out.put_pixel(ox, oy, image::Rgba(sum.map(|v| (v / n) as f32)));
+        }
+    }
+    DynamicImage::ImageRgba32F(out)
+}
+
+fn from_image(decoded: DynamicImage, path: &Path) -> Result<Texture, String> {
+    let (width, height) = (decoded.width(), decoded.height());
+    if width == 0 || height == 0 {
+        return Err(format!("texture {} is empty", path.display()));
+    }
     let has_alpha = decoded.color().has_alpha();
+    let decoded = shrink_large(decoded);
+    let (width, height) = (decoded.width(), decoded.height());
+    let linear = matches!(
+        decoded,
+        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
+    );
     let rgba = decoded.into_rgba32f();
     let texels: Vec<[f32; 3]> = rgba
         .pixels()
@@ -268,6 +319,34 @@ mod tests {
             texels,
             alpha: Vec::new(),
         }
+    }
+
+    /// Issue 31: a texture wider than MAX_DECODED_SIDE is box-filtered
+    /// before its float copies, in linear values: black and white columns
+    /// average to 0.5, not to the 0.216 of their averaged sRGB codes.
+    #[test]
+    fn large_textures_shrink_in_linear_values() {
+        let (w, h) = (MAX_DECODED_SIDE * 2 + 1, 3);
+        let img = image::RgbImage::from_fn(w, h, |x, _| {
+            image::Rgb(if x % 2 == 0 { [255; 3] } else { [0; 3] })
+        });
+        let t = from_image(DynamicImage::ImageRgb8(img), Path::new("wide.png")).unwrap();
+        // 8193 columns: boxes of 3 (the smallest factor to 4096 or less),
+        // holding 2 white columns of 3, then 1 of 3, alternately.
+        assert_eq!((t.width, t.height), (w.div_ceil(3), 1));
+        assert!(
+            (t.texels[0][0] - 2.0 / 3.0).abs() < 1e-5,
+            "{:?}",
+            t.texels[0]
+        );
+        assert!(
+            (t.texels[1][0] - 1.0 / 3.0).abs() < 1e-5,
+            "{:?}",
+            t.texels[1]
+        );
+        let small = image::RgbImage::from_pixel(4, 4, image::Rgb([128; 3]));
+        let t = from_image(DynamicImage::ImageRgb8(small), Path::new("small.png")).unwrap();
+        assert_eq!((t.width, t.height), (4, 4));
     }
 
     #[test]
