@@ -127,6 +127,7 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
     let options = frame.options()?;
     if let Some(path) = &json {
         output::check_writable(path, "--json")?;
+        output::check_replaceable(path).context("--json")?;
     }
     let (ctx, mut renderer) = start(&run, loaded, &params, options, &device)?;
     let (scene, technique) = (&run.scene, &run.technique);
