@@ -3,9 +3,10 @@
 //! signals; on one it removes the temporaries being written
 //! (`output::abandon_temporaries`, whose lock it keeps, so none is created
 //! or renamed into place after it) and ends the process with 128 + the
-//! signal number. While the progressive `reference` traces
-//! ([`FinishOnSignal`]), the first signal only asks it to stop after the
-//! pass in flight and write what it has; a second one ends it as above.
+//! signal number. While the progressive `reference` traces, or `bench`
+//! times frames ([`FinishOnSignal`]), the first signal only asks it to stop
+//! after the pass or frame in flight and write what it has; a second one
+//! ends it as above.
 //! SIGKILL cannot be caught: there, the temporary names at least keep
 //! partial files off the output names.
 
@@ -27,7 +28,7 @@ pub fn install() -> anyhow::Result<()> {
             for signal in signals.forever() {
                 let name = if signal == SIGINT { "SIGINT" } else { "SIGTERM" };
                 if FINISH.load(Ordering::SeqCst) && !REQUESTED.swap(true, Ordering::SeqCst) {
-                    eprintln!("{name}: finishing the pass in flight, then writing the images (again to stop at once)");
+                    eprintln!("{name}: finishing the pass or frame in flight, then writing what there is (again to stop at once)");
                     continue;
                 }
                 let _held = output::abandon_temporaries();

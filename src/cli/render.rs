@@ -158,7 +158,17 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
         }
     };
     let mut memory = Vec::with_capacity(memory_samples as usize);
-    for i in 0..frames {
+    // A SIGINT or SIGTERM ends the timed frames after the one in flight;
+    // what was timed is printed and written (marked partial).
+    let finish = super::interrupt::FinishOnSignal::new();
+    eprintln!("timing {frames} frames (SIGINT or SIGTERM: stop after the frame in flight and report what was timed)");
+    let asked = frames;
+    let mut frames = frames;
+    for i in 0..asked {
+        if finish.requested() {
+            frames = i;
+            break;
+        }
         renderer.submit_frame(scene.time + (warmup + i) as f32 / 60.0)?;
         if i % 64 == 63 {
             take(renderer.take_timings());
@@ -197,6 +207,11 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
         }
     }
     take(renderer.finish()?);
+    drop(finish);
+    let partial = frames < asked;
+    if frames == 0 {
+        anyhow::bail!("interrupted before the first timed frame; nothing to report");
+    }
     // Wall clock over the timed frames, the final wait included: what a
     // frame costs when frames overlap.
     let interval_ms = start.elapsed().as_secs_f64() * 1e3 / frames as f64;
@@ -211,12 +226,17 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
     check_validation(ctx)?;
     let passes = stats_per_pass(by_pass);
     println!(
-        "bench {} on {} at {}x{}, {} frames after {} warm-up, {} in flight ({}):",
+        "bench {} on {} at {}x{}, {} frames{} after {} warm-up, {} in flight ({}):",
         technique,
         scene.scene.display(),
         scene.width,
         scene.height,
         frames,
+        if partial {
+            format!(" (interrupted: {asked} asked, partial)")
+        } else {
+            String::new()
+        },
         warmup,
         in_flight,
         source.describe()
@@ -283,6 +303,7 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
                 .map(|(k, v)| (k.to_string(), v))
                 .collect(),
             memory,
+            partial,
         };
         let text = serde_json::to_string_pretty(&report)?;
         output::write_files(vec![output::OutputFile {

@@ -196,6 +196,10 @@ pub struct BenchReport {
     /// Memory sampled over the timed frames (`bench --memory-samples`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub memory: Vec<MemorySample>,
+    /// A SIGINT or SIGTERM stopped the timed frames early: `frames` is how
+    /// many were timed, fewer than asked.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub partial: bool,
 }
 
 /// Host and device memory after `frame` timed frames completed (none in

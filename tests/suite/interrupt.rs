@@ -244,6 +244,56 @@ fn bench_json_killed_while_writing_leaves_nothing() {
     assert_all_or_nothing(&out, child, 15, &["b.json"]);
 }
 
+/// Issue 31: `bench` interrupted while it times frames reports the frames
+/// it timed, on stdout and in its JSON marked partial (it threw every
+/// result away before).
+#[test]
+fn bench_interrupted_reports_what_it_timed() {
+    let out = temp_dir("bench-partial").join("out");
+    let json = out.join("b.json");
+    let asked = 10_000_000;
+    let mut child = caustics()
+        .args([
+            "bench",
+            "--technique",
+            "direct",
+            "--width",
+            "8",
+            "--height",
+            "8",
+        ])
+        .args(["--frames", &asked.to_string(), "--json"])
+        .arg(&json)
+        .spawn()
+        .expect("spawn");
+    let mut stderr = BufReader::new(child.stderr.take().unwrap());
+    let mut seen = String::new();
+    loop {
+        let mut line = String::new();
+        assert!(
+            stderr.read_line(&mut line).unwrap() > 0,
+            "ended before timing: {seen}"
+        );
+        seen.push_str(&line);
+        if line.starts_with("timing ") {
+            break;
+        }
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    signal(&child, "TERM");
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut stderr, &mut rest).unwrap();
+    let o = child.wait_with_output().expect("wait");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{seen}{rest}\n{stdout}");
+    assert!(stdout.contains("partial"), "{stdout}");
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&json).expect("the JSON")).unwrap();
+    assert_eq!(report["partial"], serde_json::Value::Bool(true), "{report}");
+    let frames = report["frames"].as_u64().expect("frames");
+    assert!(frames > 0 && frames < asked, "{frames}");
+}
+
 /// The progressive reference interrupted after its first pass finishes
 /// that pass and writes the complete pair, saying how many photons it holds.
 #[test]
