@@ -478,6 +478,20 @@ fn compare_reference_must_be_finite_non_negative_exr() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `dir/scene.toml`: a camera, a point light, one diffuse material `m`
+/// (with `material`'s keys) and one object (`object`'s keys) made of it.
+fn one_object_scene(dir: &Path, material: &str, object: &str) -> PathBuf {
+    let scene = dir.join("scene.toml");
+    let text = format!(
+        "[camera]\neye = [0.0, 2.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nfov_y = 40.0\n\n\
+         [[light]]\nkind = \"point\"\nposition = [0.0, 3.0, 0.0]\nintensity = [10.0, 10.0, 10.0]\n\n\
+         [[material]]\nname = \"m\"\nkind = \"diffuse\"\n{material}\n\n\
+         [[object]]\n{object}\nmaterial = \"m\"\n"
+    );
+    std::fs::write(&scene, text).unwrap();
+    scene
+}
+
 /// Issue 31: a FIFO anywhere in a scene hung the program, `/dev/zero` was
 /// read until memory ran out. Each is now one line naming the file, at
 /// once (the child is killed after 60 s, which fails the test).
@@ -488,15 +502,11 @@ fn special_files_in_a_scene_are_refused_without_reading_them() {
     let fifo = dir.join("mesh.obj");
     let made = Command::new("mkfifo").arg(&fifo).status();
     assert!(made.is_ok_and(|s| s.success()), "mkfifo");
-    let scene = dir.join("scene.toml");
-    std::fs::write(
-        &scene,
-        "[camera]\neye = [0.0, 1.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nfov_y = 40.0\n\n\
-         [[light]]\nkind = \"point\"\nposition = [0.0, 3.0, 0.0]\nintensity = [10.0, 10.0, 10.0]\n\n\
-         [[material]]\nname = \"m\"\nkind = \"diffuse\"\nalbedo = 0.5\n\n\
-         [[object]]\nshape = \"mesh\"\npath = \"mesh.obj\"\nmaterial = \"m\"\n",
-    )
-    .unwrap();
+    let scene = one_object_scene(
+        &dir,
+        "albedo = 0.5",
+        "shape = \"mesh\"\npath = \"mesh.obj\"",
+    );
     let fifo_scene = dir.join("fifo.toml");
     assert!(Command::new("mkfifo")
         .arg(&fifo_scene)
@@ -551,15 +561,11 @@ fn an_output_never_replaces_a_scene_input() {
     let texture = dir.join("tex.png");
     caustics::output::write_png(&texture, 2, 2, &[200; 16]).unwrap();
     let before = std::fs::read(&texture).unwrap();
-    let scene = dir.join("scene.toml");
-    std::fs::write(
-        &scene,
-        "[camera]\neye = [0.0, 2.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\nfov_y = 40.0\n\n\
-         [[light]]\nkind = \"point\"\nposition = [0.0, 3.0, 0.0]\nintensity = [10.0, 10.0, 10.0]\n\n\
-         [[material]]\nname = \"m\"\nkind = \"diffuse\"\nalbedo_texture = \"tex.png\"\n\n\
-         [[object]]\nshape = \"plane\"\nsize = [4.0, 4.0]\nmaterial = \"m\"\n",
-    )
-    .unwrap();
+    let scene = one_object_scene(
+        &dir,
+        "albedo_texture = \"tex.png\"",
+        "shape = \"plane\"\nsize = [4.0, 4.0]",
+    );
     for out in [texture.clone(), dir.join("tex.exr")] {
         let o = run(
             &[

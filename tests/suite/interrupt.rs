@@ -6,7 +6,7 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, ChildStderr, Command, Stdio};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
@@ -244,6 +244,27 @@ fn bench_json_killed_while_writing_leaves_nothing() {
     assert_all_or_nothing(&out, child, 15, &["b.json"]);
 }
 
+/// Reads `child`'s stderr until a line `is_it` accepts (failing if it ends
+/// first): the reader, for the rest, and what was read.
+fn stderr_until(
+    child: &mut Child,
+    is_it: impl Fn(&str) -> bool,
+) -> (BufReader<ChildStderr>, String) {
+    let mut stderr = BufReader::new(child.stderr.take().unwrap());
+    let mut seen = String::new();
+    loop {
+        let mut line = String::new();
+        assert!(
+            stderr.read_line(&mut line).unwrap() > 0,
+            "ended first: {seen}"
+        );
+        seen.push_str(&line);
+        if is_it(&line) {
+            return (stderr, seen);
+        }
+    }
+}
+
 /// Issue 31: `bench` interrupted while it times frames reports the frames
 /// it timed, on stdout and in its JSON marked partial (it threw every
 /// result away before).
@@ -266,19 +287,7 @@ fn bench_interrupted_reports_what_it_timed() {
         .arg(&json)
         .spawn()
         .expect("spawn");
-    let mut stderr = BufReader::new(child.stderr.take().unwrap());
-    let mut seen = String::new();
-    loop {
-        let mut line = String::new();
-        assert!(
-            stderr.read_line(&mut line).unwrap() > 0,
-            "ended before timing: {seen}"
-        );
-        seen.push_str(&line);
-        if line.starts_with("timing ") {
-            break;
-        }
-    }
+    let (mut stderr, seen) = stderr_until(&mut child, |line| line.starts_with("timing "));
     std::thread::sleep(Duration::from_millis(500));
     signal(&child, "TERM");
     let mut rest = String::new();
@@ -314,19 +323,7 @@ fn reference_interrupted_writes_what_it_has() {
         .spawn()
         .expect("spawn");
     // Each pass prints a progress line when stderr is not a terminal.
-    let mut stderr = BufReader::new(child.stderr.take().unwrap());
-    let mut seen = String::new();
-    loop {
-        let mut line = String::new();
-        assert!(
-            stderr.read_line(&mut line).unwrap() > 0,
-            "ended before a pass: {seen}"
-        );
-        seen.push_str(&line);
-        if line.contains("photons, pass") {
-            break;
-        }
-    }
+    let (mut stderr, seen) = stderr_until(&mut child, |line| line.contains("photons, pass"));
     signal(&child, "INT");
     let mut rest = String::new();
     std::io::Read::read_to_string(&mut stderr, &mut rest).unwrap();
