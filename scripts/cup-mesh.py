@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes assets/meshes/cup.obj: a metal cup (Wand & Strasser 2003's
+"""Writes assets/scenes/meshes/cup.obj: a metal cup (Wand & Strasser 2003's
 self-reflecting cup), a closed solid of revolution about +y standing on
 y = 0: outer bottom disc, outer fillet and slightly flared wall, a flat rim,
 the inner wall, a rounded inner corner and the inner bottom. 8 cm across,
@@ -106,7 +106,7 @@ def main():
         n = cross(sub(verts[f[1]], verts[f[0]]), sub(verts[f[2]], verts[f[0]]))
         m = [sum(normals[v][i] for v in f) for i in range(3)]
         assert sum(n[i] * m[i] for i in range(3)) > 0.0, f
-    with open("assets/meshes/cup.obj", "w") as out:
+    with open("assets/scenes/meshes/cup.obj", "w") as out:
         out.write("# A metal cup: written by scripts/cup-mesh.py (do not edit).\n")
         out.write(f"# {len(verts)} vertices, {len(faces)} triangles, volume {volume * 1e6:.1f} cm^3.\n")
         for v in verts:
@@ -115,7 +115,7 @@ def main():
             out.write("vn %.4f %.4f %.4f\n" % n)
         for f in faces:
             out.write("f " + " ".join(f"{i + 1}//{i + 1}" for i in f) + "\n")
-    print(f"assets/meshes/cup.obj: {len(verts)} vertices, {len(faces)} triangles, {volume * 1e6:.1f} cm^3")
+    print(f"assets/scenes/meshes/cup.obj: {len(verts)} vertices, {len(faces)} triangles, {volume * 1e6:.1f} cm^3")
 
 
 if __name__ == "__main__":

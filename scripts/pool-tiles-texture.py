@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes assets/textures/pool_tiles.png, the floor texture of
+"""Writes assets/scenes/textures/pool_tiles.png, the floor texture of
 assets/scenes/pool_tiles.toml: 8 x 8 square tiles in two blues with light
 grout lines, 128 x 128 px (16 px per tile, 2 px grout), an 8-bit sRGB PNG.
 Standard library only (zlib + struct), so it runs anywhere python3 does; the
@@ -52,6 +52,6 @@ def png(width, height, pixel):
 
 
 if __name__ == "__main__":
-    out = sys.argv[1] if len(sys.argv) > 1 else "assets/textures/pool_tiles.png"
+    out = sys.argv[1] if len(sys.argv) > 1 else "assets/scenes/textures/pool_tiles.png"
     with open(out, "wb") as f:
         f.write(png(SIZE, SIZE, texel))

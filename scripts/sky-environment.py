@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes assets/environments/sky.hdr: a 256x128 equirectangular sky
+"""Writes assets/scenes/environments/sky.hdr: a 256x128 equirectangular sky
 (Radiance RGBE, flat scanlines) from the Preetham, Shirley & Smits analytic
 daylight model ("A Practical Analytic Model for Daylight", SIGGRAPH 1999:
 the Perez distribution, Eq. 3, with the turbidity fits of Appendix A.2 for
@@ -69,7 +69,7 @@ def direction(u, v):
 
 
 def main():
-    out = sys.argv[1] if len(sys.argv) > 1 else "assets/environments/sky.hdr"
+    out = sys.argv[1] if len(sys.argv) > 1 else "assets/scenes/environments/sky.hdr"
     theta_s = math.radians(90.0 - SUN_ELEVATION_DEG)
     sun = direction(math.radians(SUN_PHI_DEG) / (2 * math.pi), theta_s / math.pi)
     cy, cx, cyc = coefficients(TURBIDITY)

@@ -20,7 +20,7 @@ const SIZE: u32 = 40;
 const TURN_DEG: f32 = 70.0;
 
 /// `ring_sky.toml`'s environment line, where `rotate` goes.
-const IMAGE_LINE: &str = "path = \"../environments/sky.hdr\"\n";
+const IMAGE_LINE: &str = "path = \"environments/sky.hdr\"\n";
 
 /// ring_sky with a sun-and-sky (the sun low toward -x, as the image's)
 /// in place of the image.

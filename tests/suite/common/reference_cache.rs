@@ -389,7 +389,7 @@ fn reference_cache_key_and_entries() {
     let req = ReferenceRequest::new(&scene, 64, 1 << 20);
     let base = key("lavapipe", &req);
     let same_file = Scene::load(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/environments/../scenes/ball_lens.toml"),
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/environments/../ball_lens.toml"),
     )
     .unwrap();
     assert_eq!(

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Generates the canonical meshes of assets/meshes (run from this folder).
+"""Generates the canonical meshes of assets/scenes/meshes (run from this folder).
 
 gemstone.obj: a brilliant-cut-like gem (table, crown, girdle, pavilion),
   flat facets with one normal per face, no MTL (the scene gives the material).
