@@ -104,7 +104,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let info = techniques::find(&technique)?;
             let params = Params::resolve(&technique, info.params(), &params)?;
             check_size(&SceneArgs {
-                scene: scene.clone(),
+                file: scene.clone(),
                 width,
                 height,
                 time: 0.0,
@@ -121,7 +121,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 anyhow::bail!("--compare-test must be at least 1");
             }
             caustics::app::run(caustics::app::DemoOptions {
-                scene,
+                allowed: scene.allowed()?,
+                scene: scene.scene,
                 technique,
                 params,
                 width,

@@ -102,7 +102,7 @@ impl State {
 
     pub(super) fn reload(&mut self) {
         let path = self.renderer.scene.source.clone();
-        match Scene::load(&path) {
+        match Scene::load_allowing(&path, &self.allowed) {
             Err(e) => eprintln!("reload: {e} (keeping the old scene)"),
             Ok(scene) => {
                 let camera = OrbitCamera::from_camera(&scene.camera);

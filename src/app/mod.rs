@@ -31,7 +31,7 @@ use state::{Input, State};
 
 use crate::params::Params;
 use crate::renderer::Renderer;
-use crate::scene::Scene;
+use crate::scene::{AllowedPaths, Scene};
 use crate::vk::{Context, ContextOptions, FrameOptions, Surface};
 use anyhow::Context as _;
 use ash::vk;
@@ -53,6 +53,9 @@ const ENVIRONMENT_STEP_DEG: f32 = 15.0;
 #[derive(Clone, Debug)]
 pub struct DemoOptions {
     pub scene: PathBuf,
+    /// `--allow-paths`: folders the scene's files may be in besides its
+    /// own tree (a reload reads with the same).
+    pub allowed: AllowedPaths,
     pub technique: String,
     pub params: Params,
     pub width: u32,
@@ -91,7 +94,7 @@ fn pipeline_cache_file() -> Option<PathBuf> {
 /// Runs the demo until the window closes (or `--frames N --exit`). Fails on
 /// any error, on validation errors and on leaked Vulkan objects.
 pub fn run(options: DemoOptions) -> anyhow::Result<()> {
-    let scene = Scene::load(&options.scene)?;
+    let scene = Scene::load_allowing(&options.scene, &options.allowed)?;
     // Screenshots never replace a file the scene was read from.
     crate::output::protect_inputs(&crate::scene::input::files_read());
     if std::env::var_os("DISPLAY").is_none() && std::env::var_os("WAYLAND_DISPLAY").is_none() {
@@ -239,6 +242,7 @@ impl App {
             compare: compare::Compare::new(),
             scene_edits: 0,
             compare_script: o.compare_test,
+            allowed: o.allowed.clone(),
         };
         state.recreate(o.present_mode)?;
         println!(

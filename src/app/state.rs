@@ -72,6 +72,8 @@ pub(super) struct State {
     /// `--compare-test N`: a scripted snapshot of N reference passes that
     /// switches the three views (tests); None for interactive runs.
     pub(super) compare_script: Option<u32>,
+    /// `--allow-paths`, for reloads.
+    pub(super) allowed: crate::scene::AllowedPaths,
 }
 
 impl State {

@@ -84,7 +84,7 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
         }
         None => None,
     };
-    let scene = load_scene(&args.scene.scene, time)?;
+    let scene = load_scene(&args.scene.file, time)?;
     let exposure = scene.output.exposure;
     if args.out.exists() && !args.out.is_dir() {
         anyhow::bail!("--out {}: not a folder", args.out.display());
@@ -192,7 +192,7 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
             device: ctx.info.name.clone(),
             driver: ctx.info.driver.trim().to_string(),
             timing_source: timing_source.unwrap_or_else(|| "none (no technique ran)".into()),
-            scene: args.scene.scene.display().to_string(),
+            scene: args.scene.file.scene.display().to_string(),
             width,
             height,
             time,

@@ -10,11 +10,11 @@ pub mod render;
 use caustics::output;
 use caustics::params::Params;
 use caustics::renderer::Stage;
-use caustics::scene::{Scene, DEFAULT_SCENE};
+use caustics::scene::{AllowedPaths, Scene, DEFAULT_SCENE};
 use caustics::techniques;
 use caustics::vk::{Context, ContextOptions, FrameOptions, MAX_FRAMES_IN_FLIGHT};
 use clap::{Args, Parser, Subcommand};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 #[derive(Parser)]
@@ -41,11 +41,28 @@ pub struct DeviceArgs {
     pub validate_sync: bool,
 }
 
+/// The scene every command that loads one reads, and where its files may be.
 #[derive(Args, Clone)]
-pub struct SceneArgs {
-    /// Scene file: TOML, or a glTF 2.0 file (.gltf/.glb) as a whole scene (docs/SCENES.md).
+pub struct SceneFileArgs {
+    /// Scene file: TOML, or a glTF 2.0 file (.gltf/.glb) as a whole scene (docs/SCENES.md; the demo's R reloads it).
     #[arg(long, default_value = DEFAULT_SCENE)]
     pub scene: PathBuf,
+    /// Also read files the scene names from this folder's tree (repeatable); by default only files inside the scene file's folder tree are read (docs/SCENES.md, "Paths").
+    #[arg(long = "allow-paths", value_name = "DIR")]
+    pub allow_paths: Vec<PathBuf>,
+}
+
+impl SceneFileArgs {
+    /// The `--allow-paths` folders, each checked to be one.
+    pub fn allowed(&self) -> anyhow::Result<AllowedPaths> {
+        AllowedPaths::new(&self.allow_paths).map_err(anyhow::Error::msg)
+    }
+}
+
+#[derive(Args, Clone)]
+pub struct SceneArgs {
+    #[command(flatten)]
+    pub file: SceneFileArgs,
     #[arg(long, allow_negative_numbers = true, default_value_t = 512)]
     pub width: u32,
     #[arg(long, allow_negative_numbers = true, default_value_t = 512)]
@@ -246,9 +263,8 @@ pub struct CompareArgs {
 
 #[derive(Args)]
 pub struct DemoArgs {
-    /// Scene file: TOML, or a glTF 2.0 file (.gltf/.glb) as a whole scene (docs/SCENES.md). R reloads it.
-    #[arg(long, default_value = DEFAULT_SCENE)]
-    pub scene: PathBuf,
+    #[command(flatten)]
+    pub scene: SceneFileArgs,
     /// Technique name, or `auto` (the default: as for `render`).
     #[arg(long, default_value = "auto")]
     pub technique: String,
@@ -321,7 +337,7 @@ pub fn name_arguments(
     params: &[String],
 ) -> anyhow::Error {
     let what = match e.downcast_ref::<Stage>() {
-        Some(Stage::Scene) => format!("--scene {}", scene.scene.display()),
+        Some(Stage::Scene) => format!("--scene {}", scene.file.scene.display()),
         Some(Stage::Targets { .. }) => format!("--width {} --height {}", scene.width, scene.height),
         Some(Stage::Technique) => {
             let params: String = params.iter().map(|p| format!(" --param {p}")).collect();
@@ -345,11 +361,12 @@ pub fn check_validation(ctx: Arc<Context>) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Loads the scene and checks what it derives at `time` (transforms, light
-/// power: `Scene::check_at`) before any device work.
+/// Loads the scene (its files confined to its tree and the
+/// `--allow-paths` folders) and checks what it derives at `time`
+/// (transforms, light power: `Scene::check_at`) before any device work.
 /// Every file the scene read is then protected from the command's outputs.
-pub fn load_scene(path: &Path, time: f32) -> anyhow::Result<Scene> {
-    let scene = Scene::load(path)?;
+pub fn load_scene(file: &SceneFileArgs, time: f32) -> anyhow::Result<Scene> {
+    let scene = Scene::load_allowing(&file.scene, &file.allowed()?)?;
     scene.check_at(time).map_err(anyhow::Error::msg)?;
     caustics::output::protect_inputs(&caustics::scene::input::files_read());
     Ok(scene)
@@ -399,7 +416,7 @@ pub fn checked_technique_run(
     if frames == 0 {
         anyhow::bail!("--frames must be at least 1");
     }
-    let loaded = load_scene(&run.scene.scene, run.scene.time)?;
+    let loaded = load_scene(&run.scene.file, run.scene.time)?;
     if run.technique == "auto" {
         // Printed with the timings (`render`'s and `bench`'s first line),
         // after every check, so a failing command prints nothing.

@@ -39,7 +39,7 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
             anyhow::bail!("--radius must be a positive length in metres, got {r}");
         }
     }
-    let loaded = load_scene(&scene.scene, scene.time)?;
+    let loaded = load_scene(&scene.file, scene.time)?;
     let outputs = output::prepare(&out)?;
     let ctx = context(&device)?;
     super::check_device_limits(&ctx, &scene)?;

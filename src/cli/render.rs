@@ -228,7 +228,7 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
     println!(
         "bench {} on {} at {}x{}, {} frames{} after {} warm-up, {} in flight ({}):",
         technique,
-        scene.scene.display(),
+        scene.file.scene.display(),
         scene.width,
         scene.height,
         frames,
@@ -280,7 +280,7 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
                 device: device_name,
                 driver,
                 timing_source: source.describe().into(),
-                scene: scene.scene.display().to_string(),
+                scene: scene.file.scene.display().to_string(),
                 width: scene.width,
                 height: scene.height,
                 time: scene.time,

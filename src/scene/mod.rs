@@ -15,6 +15,7 @@ pub mod gltf;
 pub mod input;
 mod node;
 pub mod obj;
+pub mod paths;
 pub mod shapes;
 pub mod texture;
 mod types;
@@ -24,6 +25,7 @@ pub use bounds::{MAX_EMISSIVE_TRIANGLES, MAX_WORLD_EXTENT};
 pub use error::{escape_control, SceneError};
 pub use file::DEFAULT_FOV_Y_DEG;
 pub use node::{MAX_MAGNITUDE, MAX_RADIOMETRIC};
+pub use paths::AllowedPaths;
 pub use types::*;
 
 use glam::{Mat3, Mat4, Quat, Vec3};
@@ -55,12 +57,19 @@ pub fn default_scene_path() -> std::path::PathBuf {
 
 impl Scene {
     /// Reads and validates a scene file. Relative paths inside it (OBJ meshes,
-    /// density grids) resolve against the file's folder. A `.gltf` or `.glb`
+    /// density grids) resolve against the file's folder, and every file it
+    /// names must lie in that folder's tree ([`paths`]). A `.gltf` or `.glb`
     /// file is a whole scene of its own ([`gltf::scene`] with the default
     /// options: a floor, the file's camera and lights or defaults).
     /// The default scene ([`DEFAULT_SCENE`]) is found from any working
     /// directory ([`default_scene_path`]).
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        Self::load_allowing(path, &AllowedPaths::default())
+    }
+
+    /// [`Scene::load`], the files the scene names also read from the trees
+    /// of the `allowed` folders (`--allow-paths`).
+    pub fn load_allowing(path: &Path, allowed: &AllowedPaths) -> Result<Scene, SceneError> {
         let found;
         let path = if path == Path::new(DEFAULT_SCENE) {
             found = default_scene_path();
@@ -70,9 +79,13 @@ impl Scene {
         };
         let start = std::time::Instant::now();
         let scene = if gltf::is_gltf_path(path) {
-            gltf::scene(path, &gltf::GltfSceneOptions::default())?
+            let options = gltf::GltfSceneOptions {
+                allowed: allowed.clone(),
+                ..Default::default()
+            };
+            gltf::scene(path, &options)?
         } else {
-            Self::load_toml(path)?
+            Self::load_toml(path, allowed)?
         };
         // The load phase's cost (RUST_LOG=info): scripts/gltf-bench.sh reads it.
         log::info!(
@@ -84,20 +97,21 @@ impl Scene {
         Ok(scene)
     }
 
-    fn load_toml(path: &Path) -> Result<Scene, SceneError> {
+    fn load_toml(path: &Path, allowed: &AllowedPaths) -> Result<Scene, SceneError> {
         let text = input::read_text_limited(path, input::MAX_SCENE_BYTES).map_err(|why| {
             SceneError::Read {
                 path: path.to_path_buf(),
                 source: std::io::Error::other(why),
             }
         })?;
-        Self::from_str(&text, path)
+        file::parse(&text, path, allowed)
     }
 
     /// Parses scene text as if read from `source` (used in messages and to
-    /// resolve relative paths; the file itself need not exist).
+    /// resolve relative paths, confined to its folder's tree; the file
+    /// itself need not exist).
     pub fn from_str(text: &str, source: &Path) -> Result<Scene, SceneError> {
-        file::parse(text, source)
+        file::parse(text, source, &AllowedPaths::default())
     }
 
     /// Index of the material called `name`.

@@ -11,6 +11,7 @@
 //! - Materials from the MTL become scene materials named `"<obj file name>:<mtl name>"`
 //!   (see [`convert_material`]); a diffuse one's `map_Kd` is its albedo texture.
 
+use super::paths::Confinement;
 use super::types::{Material, MaterialKind, Mesh};
 use glam::{Vec2, Vec3};
 use std::collections::HashMap;
@@ -233,9 +234,12 @@ pub fn check_mtl_values(m: &tobj::Material) -> Result<(), String> {
     Ok(())
 }
 
-/// Reads an OBJ file (and the MTL files it names, relative to it).
-/// The error is a message that names the file.
-pub fn load(path: &Path) -> Result<ObjMesh, String> {
+/// Reads an OBJ file (and the MTL files it names, relative to it). The
+/// MTL files and the textures they name must lie `within` the scene's
+/// trees (a refused one is an error even when the object's `material`
+/// would ignore the MTL: it is never read). The error is a message that
+/// names the file.
+pub fn load(path: &Path, within: &Confinement) -> Result<ObjMesh, String> {
     let bytes = super::input::read_limited(path, super::input::MAX_OBJ_BYTES)
         .map_err(|e| format!("cannot open OBJ file {}: {e}", path.display()))?;
     check_relative_indices(&bytes)
@@ -243,6 +247,7 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
     let mut reader = &bytes[..];
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let mtl_errors = std::cell::RefCell::new(Vec::new());
+    let refused = std::cell::RefCell::new(None);
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: false,
@@ -250,7 +255,13 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
         ignore_lines: true,
     };
     let (models, materials) = tobj::load_obj_buf(&mut reader, &options, |mtl: &Path| {
-        let full = dir.join(mtl);
+        let full = match within.resolve(&dir, mtl) {
+            Ok(full) => full,
+            Err(why) => {
+                refused.borrow_mut().get_or_insert(why);
+                return Err(tobj::LoadError::OpenFileFailed);
+            }
+        };
         let result = super::input::read_text_limited(&full, super::input::MAX_MTL_BYTES)
             .map_err(|e| format!("cannot read it: {e}"))
             .and_then(|text| complete_colours(&text))
@@ -267,6 +278,9 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
         result.map_err(|_| tobj::LoadError::OpenFileFailed)
     })
     .map_err(|e| format!("cannot load OBJ file {}: {e}", path.display()))?;
+    if let Some(why) = refused.into_inner() {
+        return Err(format!("OBJ file {}: mtllib {why}", path.display()));
+    }
     // An MTL that failed is reported through `mtl_errors`; tobj's own error is redundant.
     let materials = materials.unwrap_or_default();
 
@@ -285,7 +299,15 @@ pub fn load(path: &Path) -> Result<ObjMesh, String> {
             .as_deref()
             .map(str::trim)
             .filter(|t| c.kind == MaterialKind::Diffuse && !t.is_empty())
-            .map(|t| dir.join(t));
+            .map(|t| within.resolve(&dir, Path::new(t)))
+            .transpose()
+            .map_err(|why| {
+                format!(
+                    "OBJ file {}: map_Kd of MTL material `{}`: {why}",
+                    path.display(),
+                    m.name
+                )
+            })?;
         // `Kd` scales `map_Kd`; without a `Kd` the texture stands alone.
         if texture.is_some() && m.diffuse.is_none() {
             c.color = Vec3::ONE;

@@ -119,15 +119,13 @@ fn direct_with_a_sphere_light_against_the_reference() {
 
 #[test]
 fn direct_with_the_sky_image_against_the_reference() {
-    // assets/environments/sky.hdr: `direct` takes the sun it finds in the
-    // image as a directional light and the rest of the image by SH.
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/environments/sky.hdr");
+    // assets/scenes/environments/sky.hdr (relative to the scene's source,
+    // `direct_lights.toml` in the working directory, the checkout): `direct`
+    // takes the sun it finds in the image as a directional light and the
+    // rest of the image by SH.
     let (energy, flip) = compare(
         "image",
-        &format!(
-            "[[light]]\nkind = \"environment\"\npath = \"{}\"\nscale = 0.005\n",
-            path.display()
-        ),
+        "[[light]]\nkind = \"environment\"\npath = \"assets/scenes/environments/sky.hdr\"\nscale = 0.005\n",
     );
     // Measured +0.0079, 0.053 (without sky occlusion +0.022, 0.057).
     assert!(energy.abs() < 0.03, "energy {energy}");

@@ -10,7 +10,8 @@
 //! (`FUZZ_CASES=5000 cargo test --release --test fuzz`). Crashes found
 //! became regular tests (`found_*` below).
 
-use caustics::scene::{gltf, obj, Scene};
+use caustics::scene::paths::Confinement;
+use caustics::scene::{gltf, obj, AllowedPaths, Scene};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 use serde_json::{json, Value};
@@ -312,6 +313,11 @@ fn mtl_line() -> impl Strategy<Value = String> {
     ]
 }
 
+/// OBJ file `path` read as a scene beside it reads it.
+fn load_obj(path: &Path) -> Result<obj::ObjMesh, String> {
+    obj::load(path, &Confinement::scene(path, &AllowedPaths::default()))
+}
+
 #[test]
 fn obj_and_mtl_never_panic_and_errors_are_one_line() {
     let dir = temp_dir("obj");
@@ -328,7 +334,7 @@ fn obj_and_mtl_never_panic_and_errors_are_one_line() {
             std::fs::write(dir.join("m.obj"), &obj_text).unwrap();
             std::fs::write(dir.join("m.mtl"), &mtl_text).unwrap();
             let what = format!("OBJ:\n{obj_text}\nMTL:\n{mtl_text}");
-            if let Err(e) = obj::load(&dir.join("m.obj")) {
+            if let Err(e) = load_obj(&dir.join("m.obj")) {
                 one_line(&what, &e)?;
             }
             let material = if own_material {
@@ -564,7 +570,7 @@ fn found_relative_index_before_the_first_vertex() {
         ("v 0 0 0\nvn 0 0 1\nf 1//-2 1//1 1//1\nv 1 0 0\n", 3, "-2"),
     ] {
         std::fs::write(&path, obj).unwrap();
-        let e = refused(obj::load(&path));
+        let e = refused(load_obj(&path));
         assert!(
             e.contains(&format!("m.obj:{line}: `"))
                 && e.contains(&format!("relative index {index} reaches before the first")),
@@ -573,7 +579,7 @@ fn found_relative_index_before_the_first_vertex() {
     }
     // In range: loads (the last three vertices).
     std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n").unwrap();
-    assert_eq!(obj::load(&path).expect("loads").mesh.indices.len(), 1);
+    assert_eq!(load_obj(&path).expect("loads").mesh.indices.len(), 1);
 }
 
 /// A TOML string holding an escaped newline (`kind = "poi\nt"`) was quoted

@@ -1190,7 +1190,9 @@ fn obj_path_is_relative_to_the_scene_file() {
             "[[object]]\nshape = \"mesh\"\npath = \"../../meshes/tri.obj\"\nmaterial = \"white\"\n",
         ),
     );
-    let s = Scene::load(&path).expect("relative to the scene file, not the cwd");
+    // The mesh is outside the scene's folder tree: allowed by its folder.
+    let allowed = AllowedPaths::new(&[dir.join("meshes")]).unwrap();
+    let s = Scene::load_allowing(&path, &allowed).expect("relative to the scene file, not the cwd");
     assert_eq!(mesh_of(&s).indices.len(), 1);
 }
 

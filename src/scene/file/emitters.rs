@@ -4,6 +4,7 @@
 
 use super::values::{direction, non_negative_rgb, positive, size2};
 use crate::scene::node::{Tbl, R};
+use crate::scene::paths::Confinement;
 use crate::scene::shapes;
 use crate::scene::types::*;
 use glam::{Mat4, Quat, Vec3};
@@ -15,7 +16,7 @@ pub const MAX_EMITTERS: usize = 64;
 /// casts shadows; its emission is sampled on the exact sphere).
 pub const EMITTER_SPHERE_SEGMENTS: u32 = 64;
 
-pub(super) fn environment(t: &Tbl, dir: &Path) -> R<Environment> {
+pub(super) fn environment(t: &Tbl, within: &Confinement) -> R<Environment> {
     t.check_keys(
         &["kind", "path", "sky", "scale", "rotate"],
         "an environment light",
@@ -34,7 +35,8 @@ pub(super) fn environment(t: &Tbl, dir: &Path) -> R<Environment> {
             ))
         }
         (Some(rel), None) => {
-            EnvironmentKind::Image(load_hdr(&dir.join(rel)).map_err(|e| t.err("path", e))?)
+            let image = within.file(rel).and_then(|file| load_hdr(&file));
+            EnvironmentKind::Image(image.map_err(|e| t.err("path", e))?)
         }
         (None, Some(sky_table)) => EnvironmentKind::Sky(sky(&sky_table, rotate_deg)?),
     };

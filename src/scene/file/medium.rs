@@ -3,11 +3,11 @@
 
 use super::values::{describe, non_negative_rgb, value_text};
 use crate::scene::node::{Node, Tbl, R};
+use crate::scene::paths::Confinement;
 use crate::scene::types::*;
 use glam::Vec3;
-use std::path::Path;
 
-pub(super) fn medium(t: &Tbl, dir: &Path) -> R<Medium> {
+pub(super) fn medium(t: &Tbl, within: &Confinement) -> R<Medium> {
     t.check_keys(
         &["sigma_s", "sigma_a", "g", "bounds", "density"],
         "[medium]",
@@ -35,7 +35,7 @@ pub(super) fn medium(t: &Tbl, dir: &Path) -> R<Medium> {
     let density = match t.get("density") {
         None => Density::Constant(1.0),
         Some(n) if matches!(n.node, Node::Table(_)) => {
-            density_table(&Tbl::of(t.src, t.field("density"), n)?, dir)?
+            density_table(&Tbl::of(t.src, t.field("density"), n)?, within)?
         }
         Some(_) => {
             let d = t.f32("density")?;
@@ -55,7 +55,7 @@ pub(super) fn medium(t: &Tbl, dir: &Path) -> R<Medium> {
     })
 }
 
-fn density_table(t: &Tbl, dir: &Path) -> R<Density> {
+fn density_table(t: &Tbl, within: &Confinement) -> R<Density> {
     if let Some(noise) = t.opt_table("noise")? {
         t.check_keys(&["noise"], "medium.density")?;
         noise.check_keys(
@@ -113,7 +113,7 @@ fn density_table(t: &Tbl, dir: &Path) -> R<Density> {
                 ))
             }
         }
-        let full = dir.join(rel);
+        let full = within.file(rel).map_err(|e| t.err("grid", e))?;
         // The grid holds exactly its texels: its size is checked before
         // anything is read, and no more than that is read.
         let count = dims.iter().map(|&d| d as u64).product::<u64>();

@@ -10,6 +10,7 @@ mod water_surface;
 
 use super::error::Source;
 use super::node::{self, Tbl, R};
+use super::paths::{AllowedPaths, Confinement};
 use super::types::*;
 use crate::shader_bindings::MAX_LIGHTS;
 use glam::Vec3;
@@ -20,8 +21,10 @@ use values::{direction, non_negative_rgb, numbers2, unit_rgb};
 /// Default vertical field of view, degrees.
 pub const DEFAULT_FOV_Y_DEG: f32 = 45.0;
 
-/// Parses and validates `text`, read from `path` (relative paths inside resolve against its folder).
-pub(crate) fn parse(text: &str, path: &Path) -> R<Scene> {
+/// Parses and validates `text`, read from `path` (relative paths inside
+/// resolve against its folder, and must stay in its tree or in an
+/// `allowed` folder's).
+pub(crate) fn parse(text: &str, path: &Path, allowed: &AllowedPaths) -> R<Scene> {
     let src = Source { path, text };
     let entries = node::parse_document(text).map_err(|e| {
         let span = e.span().unwrap_or(0..0);
@@ -41,7 +44,7 @@ pub(crate) fn parse(text: &str, path: &Path) -> R<Scene> {
         &["camera", "light", "material", "object", "medium", "output"],
         "the scene",
     )?;
-    let dir = path.parent().unwrap_or(Path::new(""));
+    let within = Confinement::scene(path, allowed);
 
     let camera = match root.opt_table("camera")? {
         Some(t) => camera(&t)?,
@@ -61,7 +64,7 @@ pub(crate) fn parse(text: &str, path: &Path) -> R<Scene> {
                 if environment.is_some() {
                     return Err(t.err("kind", "a second environment light: at most one per scene"));
                 }
-                environment = Some(emitters::environment(t, dir)?);
+                environment = Some(emitters::environment(t, &within)?);
             }
             "rect" | "sphere" => {
                 if emitter_shapes.len() == emitters::MAX_EMITTERS {
@@ -92,7 +95,7 @@ pub(crate) fn parse(text: &str, path: &Path) -> R<Scene> {
 
     let mut materials = Materials::default();
     for t in root.tables("material")? {
-        let m = material(&t, dir, &mut materials)?;
+        let m = material(&t, &within, &mut materials)?;
         let name = m.name.clone();
         if let Err(first) = materials.define(m) {
             return Err(t.err(
@@ -108,12 +111,12 @@ pub(crate) fn parse(text: &str, path: &Path) -> R<Scene> {
     }
     let mut objects = Vec::with_capacity(object_tables.len());
     for (i, t) in object_tables.iter().enumerate() {
-        objects.push(objects::object(t, i, dir, &mut materials)?);
+        objects.push(objects::object(t, i, &within, &mut materials)?);
     }
 
     let medium = root
         .opt_table("medium")?
-        .map(|t| medium::medium(&t, dir))
+        .map(|t| medium::medium(&t, &within))
         .transpose()?;
     let output = match root.opt_table("output")? {
         Some(t) => {
@@ -251,7 +254,7 @@ fn light(t: &Tbl) -> R<Light> {
     Ok(l)
 }
 
-fn material(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Material> {
+fn material(t: &Tbl, within: &Confinement, materials: &mut Materials) -> R<Material> {
     let name = t.str("name")?;
     if name.trim().is_empty() {
         return Err(t.err("name", "must not be empty"));
@@ -280,7 +283,7 @@ fn material(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Material> {
                 ],
                 "a diffuse material",
             )?;
-            m.texture = albedo_texture(t, dir, materials)?;
+            m.texture = albedo_texture(t, within, materials)?;
             // With a texture, `albedo` scales it (glTF's baseColorFactor).
             let default = if m.texture.is_some() { 1.0 } else { 0.8 };
             m.color = unit_rgb(t, "albedo", Vec3::splat(default))?;
@@ -337,10 +340,14 @@ fn material(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Material> {
     Ok(m)
 }
 
-/// A diffuse material's `albedo_texture` (a path relative to the scene file),
-/// `uv_scale` (two positive numbers, default [1, 1]) and `alpha_cutoff` (in
-/// [0, 1], default 0: opaque).
-fn albedo_texture(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Option<AlbedoTexture>> {
+/// A diffuse material's `albedo_texture` (a path relative to the scene file,
+/// inside its tree), `uv_scale` (two positive numbers, default [1, 1]) and
+/// `alpha_cutoff` (in [0, 1], default 0: opaque).
+fn albedo_texture(
+    t: &Tbl,
+    within: &Confinement,
+    materials: &mut Materials,
+) -> R<Option<AlbedoTexture>> {
     let Some(rel) = t.opt_str("albedo_texture")? else {
         for key in ["uv_scale", "alpha_cutoff"] {
             if t.has(key) {
@@ -349,8 +356,9 @@ fn albedo_texture(t: &Tbl, dir: &Path, materials: &mut Materials) -> R<Option<Al
         }
         return Ok(None);
     };
-    let index = materials
-        .texture(&dir.join(rel))
+    let index = within
+        .file(rel)
+        .and_then(|file| materials.texture(&file))
         .map_err(|e| t.err("albedo_texture", e))?;
     let uv_scale = if t.has("uv_scale") {
         numbers2(t, "uv_scale", true)?.into()

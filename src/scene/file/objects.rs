@@ -6,10 +6,10 @@ use super::values::{direction, positive, size2};
 use super::water_surface::{water_surface, WATER_KEYS};
 use crate::scene::node::Tbl;
 use crate::scene::node::R;
+use crate::scene::paths::Confinement;
 use crate::scene::types::*;
 use crate::scene::{gltf, obj, shapes};
 use glam::{Mat4, Quat, Vec2, Vec3};
-use std::path::Path;
 
 const COMMON_OBJECT_KEYS: [&str; 7] = [
     "shape",
@@ -37,7 +37,12 @@ fn segments(t: &Tbl) -> R<u32> {
 }
 
 /// Reads `[[object]]` number `index`; MTL materials it brings are added to `materials`.
-pub(super) fn object(t: &Tbl, index: usize, dir: &Path, materials: &mut Materials) -> R<Object> {
+pub(super) fn object(
+    t: &Tbl,
+    index: usize,
+    within: &Confinement,
+    materials: &mut Materials,
+) -> R<Object> {
     let shape = t.str("shape")?;
     let extra: &[&str] = match shape {
         "sphere" => &["center", "radius", "segments"],
@@ -158,8 +163,8 @@ pub(super) fn object(t: &Tbl, index: usize, dir: &Path, materials: &mut Material
                 water: Some(surface),
             });
         }
-        "gltf" => return gltf_object(t, name, dir, material, materials),
-        _ => return mesh_object(t, name, dir, material, materials),
+        "gltf" => return gltf_object(t, name, within, material, materials),
+        _ => return mesh_object(t, name, within, material, materials),
     };
     let material = material.unwrap_or_default();
     mesh.materials = vec![material; mesh.indices.len()];
@@ -198,13 +203,12 @@ fn file_object(
 fn mesh_object(
     t: &Tbl,
     name: String,
-    dir: &Path,
+    within: &Confinement,
     material: Option<u32>,
     materials: &mut Materials,
 ) -> R<Object> {
-    let rel = t.str("path")?;
-    let full = dir.join(rel);
-    let loaded = obj::load(&full).map_err(|e| t.err("path", e))?;
+    let full = within.file(t.str("path")?).map_err(|e| t.err("path", e))?;
+    let loaded = obj::load(&full, within).map_err(|e| t.err("path", e))?;
     if material.is_none() {
         if let Some((mtl, why)) = loaded.mtl_errors.first() {
             return Err(t.err(
@@ -299,12 +303,13 @@ fn import_materials(
 fn gltf_object(
     t: &Tbl,
     name: String,
-    dir: &Path,
+    within: &Confinement,
     material: Option<u32>,
     materials: &mut Materials,
 ) -> R<Object> {
-    let full = dir.join(t.str("path")?);
-    let mut loaded = gltf::load(&full).map_err(|e| t.err("path", e.to_string()))?;
+    let full = within.file(t.str("path")?).map_err(|e| t.err("path", e))?;
+    let mut loaded =
+        gltf::load_allowing(&full, within.allowed()).map_err(|e| t.err("path", e.to_string()))?;
     if material.is_none() {
         for w in &loaded.warnings {
             log::warn!("{w}");

@@ -8,7 +8,7 @@ use super::*;
 pub(super) fn read_buffers<'b>(
     document: &Document,
     blob: Option<&'b [u8]>,
-    dir: &Path,
+    within: &Confinement,
     fail: Fail,
 ) -> Result<Vec<Cow<'b, [u8]>>, GltfError> {
     let mut out = Vec::new();
@@ -22,7 +22,7 @@ pub(super) fn read_buffers<'b>(
                 )
             })?,
             ::gltf::buffer::Source::Uri(uri) => {
-                Cow::Owned(read_uri(uri, dir).map_err(|e| fail(&format!("{at}.uri"), e))?)
+                Cow::Owned(read_uri(uri, within).map_err(|e| fail(&format!("{at}.uri"), e))?)
             }
         };
         if data.len() < b.length() {
@@ -36,8 +36,8 @@ pub(super) fn read_buffers<'b>(
     Ok(out)
 }
 
-/// A URI's bytes: a base64 `data:` URI decoded, else a file (relative to `dir`).
-pub(super) fn read_uri(uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
+/// A URI's bytes: a base64 `data:` URI decoded, else a file ([`uri_file`]).
+pub(super) fn read_uri(uri: &str, within: &Confinement) -> Result<Vec<u8>, String> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let payload = rest
             .split_once(";base64,")
@@ -45,50 +45,26 @@ pub(super) fn read_uri(uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
             .ok_or("only base64 data URIs are supported")?;
         return base64_decode(payload).ok_or_else(|| "invalid base64 data".into());
     }
-    let file = uri_file(uri, dir)?;
+    let file = uri_file(uri, within)?;
     crate::scene::input::read_limited(&file, crate::scene::input::MAX_GLTF_BYTES)
         .map_err(|e| format!("cannot read {}: {e}", file.display()))
 }
 
 /// The file a non-`data:` URI names: a relative reference, percent-decoded,
-/// inside the glTF file's folder tree (issue 31: a downloaded asset must
-/// not read `/etc/passwd`). Refused: any scheme (`file:` included),
-/// absolute paths, `..` that climbs above the folder (checked after
-/// percent-decoding, so `%2e%2e/` too), and a link inside the folder that
-/// resolves outside it.
-pub(super) fn uri_file(uri: &str, dir: &Path) -> Result<PathBuf, String> {
-    use std::path::Component;
-    let refuse = |why: &str| {
-        Err(format!(
-            "URI `{uri}`: {why}; only files inside the glTF file's folder are read"
-        ))
-    };
+/// resolved by the scene's one path rule ([`Confinement::resolve`]: inside
+/// the glTF file's folder tree or an `--allow-paths` folder; issue 31: a
+/// downloaded asset must not read `/etc/passwd`). A scheme (`file:`
+/// included) is refused before that, and `..` is checked after
+/// percent-decoding, so `%2e%2e/` too.
+pub(super) fn uri_file(uri: &str, within: &Confinement) -> Result<PathBuf, String> {
     if uri.contains(':') {
-        return refuse("a scheme (file:, http:, ...) or drive");
+        return Err(format!(
+            "URI `{uri}`: a scheme (file:, http:, ...) or drive; only relative references to files are read"
+        ));
     }
-    let decoded = PathBuf::from(percent_decode(uri));
-    let mut depth = 0usize;
-    for c in decoded.components() {
-        match c {
-            Component::Normal(_) => depth += 1,
-            Component::CurDir => {}
-            Component::ParentDir if depth > 0 => depth -= 1,
-            Component::ParentDir => return refuse("it climbs above the folder"),
-            Component::RootDir | Component::Prefix(_) => return refuse("an absolute path"),
-        }
-    }
-    let file = dir.join(&decoded);
-    let folder = if dir.as_os_str().is_empty() {
-        Path::new(".")
-    } else {
-        dir
-    };
-    if let (Ok(resolved), Ok(folder)) = (file.canonicalize(), folder.canonicalize()) {
-        if !resolved.starts_with(&folder) {
-            return refuse("a link that resolves outside the folder");
-        }
-    }
-    Ok(file)
+    within
+        .file(percent_decode(uri))
+        .map_err(|e| format!("URI {e}"))
 }
 
 pub(super) fn percent_decode(s: &str) -> String {
@@ -140,14 +116,18 @@ pub(super) fn base64_decode(s: &str) -> Option<Vec<u8>> {
 }
 
 /// Every image given by a file URI must exist (images are not decoded here).
-pub(super) fn check_images(document: &Document, dir: &Path, fail: Fail) -> Result<(), GltfError> {
+pub(super) fn check_images(
+    document: &Document,
+    within: &Confinement,
+    fail: Fail,
+) -> Result<(), GltfError> {
     for image in document.images() {
         if let ::gltf::image::Source::Uri { uri, .. } = image.source() {
             if uri.starts_with("data:") {
                 continue;
             }
             let at = format!("images[{}].uri", image.index());
-            let file = uri_file(uri, dir).map_err(|e| fail(&at, e))?;
+            let file = uri_file(uri, within).map_err(|e| fail(&at, e))?;
             if !file.is_file() {
                 return Err(fail(
                     &at,

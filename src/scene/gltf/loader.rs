@@ -7,7 +7,7 @@ pub(super) struct Loader<'a> {
     pub(super) fail: Fail<'a>,
     pub(super) buffers: &'a [Cow<'a, [u8]>],
     pub(super) file_name: String,
-    pub(super) dir: &'a Path,
+    pub(super) within: Confinement<'a>,
     pub(super) asset: GltfAsset,
     /// glTF material index (None: the default material) -> asset material.
     pub(super) material_map: HashMap<Option<usize>, Option<u32>>,
@@ -394,10 +394,10 @@ impl Loader<'_> {
             ::gltf::image::Source::Uri { uri, .. } => {
                 let at = format!("images[{i}].uri");
                 if uri.starts_with("data:") {
-                    let bytes = read_uri(uri, self.dir).map_err(|e| (self.fail)(&at, e))?;
+                    let bytes = read_uri(uri, &self.within).map_err(|e| (self.fail)(&at, e))?;
                     return texture::decode(&bytes, &embedded).map_err(|e| (self.fail)(&at, e));
                 }
-                let file = uri_file(uri, self.dir).map_err(|e| (self.fail)(&at, e))?;
+                let file = uri_file(uri, &self.within).map_err(|e| (self.fail)(&at, e))?;
                 texture::load(&file).map_err(|e| (self.fail)(&at, e))
             }
         }

@@ -17,6 +17,7 @@ mod material;
 mod scene;
 
 use super::obj::{accumulate_normals, fix_zero_normals};
+use super::paths::{AllowedPaths, Confinement};
 use super::texture;
 use super::types::*;
 use crate::shader_bindings::MAX_LIGHTS;
@@ -154,10 +155,16 @@ pub fn is_gltf_path(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
 }
 
-/// Reads a glTF file (its buffers relative to it). Every image file must
-/// exist; the base colour textures of the materials the scene uses are
-/// decoded.
+/// Reads a glTF file (its buffers relative to it, inside its folder's
+/// tree). Every image file must exist; the base colour textures of the
+/// materials the scene uses are decoded.
 pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
+    load_allowing(path, &AllowedPaths::default())
+}
+
+/// [`load`], the URIs also naming files in the trees of the `allowed`
+/// folders (`--allow-paths`).
+pub fn load_allowing(path: &Path, allowed: &AllowedPaths) -> Result<GltfAsset, GltfError> {
     let fail = |at: &str, message: String| GltfError {
         file: path.to_path_buf(),
         at: at.to_owned(),
@@ -241,9 +248,9 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
         }
         other => fail("", other.to_string()),
     })?;
-    let dir = path.parent().unwrap_or(Path::new(""));
-    let buffers = read_buffers(&document, blob.as_deref(), dir, &fail)?;
-    check_images(&document, dir, &fail)?;
+    let within = Confinement::gltf(path, allowed);
+    let buffers = read_buffers(&document, blob.as_deref(), &within, &fail)?;
+    check_images(&document, &within, &fail)?;
 
     let file_name = path.file_name().map_or_else(
         || path.display().to_string(),
@@ -253,7 +260,7 @@ pub fn load(path: &Path) -> Result<GltfAsset, GltfError> {
         fail: &fail,
         buffers: &buffers,
         file_name,
-        dir,
+        within,
         asset: GltfAsset {
             mesh: Mesh::default(),
             materials: Vec::new(),

@@ -3,15 +3,20 @@
 use super::*;
 
 /// How a glTF file becomes a whole scene (`caustics render --scene model.glb`).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct GltfSceneOptions {
     /// Add a diffuse floor (albedo [`FLOOR_ALBEDO`]) under the model.
     pub floor: bool,
+    /// Folders whose files the URIs may name besides the file's own tree.
+    pub allowed: AllowedPaths,
 }
 
 impl Default for GltfSceneOptions {
     fn default() -> Self {
-        GltfSceneOptions { floor: true }
+        GltfSceneOptions {
+            floor: true,
+            allowed: AllowedPaths::default(),
+        }
     }
 }
 
@@ -30,7 +35,7 @@ pub const DEFAULT_SUN_EXPOSURE: f32 = 0.004;
 /// camera (else one framing the model), its lights (else a sun), and a
 /// floor unless `options` leaves it out. Warnings go to the log.
 pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError> {
-    let mut asset = load(path)?;
+    let mut asset = load_allowing(path, &options.allowed)?;
     if asset.lights.len() > MAX_LIGHTS as usize {
         return Err(GltfError {
             file: path.to_path_buf(),
