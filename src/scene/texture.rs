@@ -9,7 +9,8 @@
 use super::types::Texture;
 use glam::Vec3;
 use image::imageops::{self, FilterType};
-use image::{DynamicImage, Rgba32FImage};
+use image::{DynamicImage, ImageDecoder, ImageReader, Rgba32FImage};
+use std::io::{BufRead, Seek};
 use std::path::Path;
 
 /// Largest layer of the texture array (texels per side): larger files are
@@ -33,27 +34,114 @@ pub fn srgb_to_linear(c: f32) -> f32 {
 pub fn load(path: &Path) -> Result<Texture, String> {
     crate::scene::input::check_regular(path)
         .map_err(|e| format!("cannot open texture {}: {e}", path.display()))?;
-    let reader = image::ImageReader::open(path)
+    let reader = ImageReader::open(path)
         .map_err(|e| format!("cannot open texture {}: {e}", path.display()))?
         .with_guessed_format()
         .map_err(|e| format!("cannot read texture {}: {e}", path.display()))?;
-    let decoded = reader
-        .decode()
-        .map_err(|e| format!("cannot decode texture {}: {e}", path.display()))?;
-    from_image(decoded, path)
+    from_image(decode_limited(reader, path, &TEXTURE_LIMITS)?, path)
 }
 
 /// An image file's bytes held in memory (a glTF image in a buffer view or
 /// a `data:` URI), decoded as [`load`] decodes a file; `name` stands for
 /// the path in the texture and its errors.
 pub fn decode(bytes: &[u8], name: &Path) -> Result<Texture, String> {
-    let decoded = image::ImageReader::new(std::io::Cursor::new(bytes))
+    let reader = ImageReader::new(std::io::Cursor::new(bytes))
         .with_guessed_format()
-        .map_err(|e| format!("cannot read texture {}: {e}", name.display()))?
-        .decode()
-        .map_err(|e| format!("cannot decode texture {}: {e}", name.display()))?;
-    from_image(decoded, name)
+        .map_err(|e| format!("cannot read texture {}: {e}", name.display()))?;
+    from_image(decode_limited(reader, name, &TEXTURE_LIMITS)?, name)
 }
+
+/// What decoding one kind of image file may take (docs/SCENES.md,
+/// "Limits"): checked against the file's header before the decoder
+/// allocates its pixels, and given to the decoder as `image::Limits`.
+#[derive(Clone, Copy, Debug)]
+pub struct DecodeLimits {
+    /// The kind of image, in messages ("texture").
+    pub what: &'static str,
+    /// Most texels per side.
+    pub side: u32,
+    /// Most bytes of decoded pixels (the decoder's own allocation).
+    pub bytes: u64,
+}
+
+/// Albedo textures: 16384 per side, as the largest 2D image of most GPUs
+/// (larger files are box-filtered down anyway, [`MAX_DECODED_SIDE`]), and
+/// 1 GiB of decoded pixels (a 16384² RGBA8 image; an 8192² 16-bit RGBA or
+/// a 4096 x 8192 float RGBA one).
+pub const TEXTURE_LIMITS: DecodeLimits = DecodeLimits {
+    what: "texture",
+    side: 16384,
+    bytes: 1 << 30,
+};
+
+/// Environment images: 8192 per side and 512 MiB of decoded pixels, an 8K
+/// equirectangular image (8192 x 4096) of float RGBA. Larger ones are
+/// refused rather than downsampled: a sun a few texels wide would lose its
+/// peak, and with it the caustics it casts.
+pub const ENVIRONMENT_LIMITS: DecodeLimits = DecodeLimits {
+    what: "environment image",
+    side: 8192,
+    bytes: 512 << 20,
+};
+
+/// Decodes `reader`'s image within `limits`: its header's size is checked
+/// first (a small file may declare a huge image), the message naming the
+/// file, its size and the limit; then the decoder runs under the same
+/// limits as `image::Limits`.
+pub fn decode_limited<R: BufRead + Seek>(
+    mut reader: ImageReader<R>,
+    name: &Path,
+    limits: &DecodeLimits,
+) -> Result<DynamicImage, String> {
+    let what = limits.what;
+    let cannot = |e: image::ImageError| format!("cannot decode {what} {}: {e}", name.display());
+    let mut header = image::Limits::default();
+    header.max_alloc = Some(limits.bytes);
+    reader.limits(header);
+    let mut decoder = reader.into_decoder().map_err(cannot)?;
+    let (width, height) = decoder.dimensions();
+    if width.max(height) > limits.side {
+        return Err(format!(
+            "{what} {} is {width}x{height}, larger than {} texels per side, the most a {what} may have (docs/SCENES.md, \"Limits\")",
+            name.display(),
+            limits.side
+        ));
+    }
+    let bytes = decoder.total_bytes();
+    if bytes > limits.bytes {
+        return Err(format!(
+            "{what} {} is {width}x{height} of {:?}: decoded it takes {} MiB, more than {} MiB, the most a {what} may take (docs/SCENES.md, \"Limits\")",
+            name.display(),
+            decoder.color_type(),
+            bytes.div_ceil(1 << 20),
+            limits.bytes >> 20
+        ));
+    }
+    let mut full = image::Limits::default();
+    full.max_image_width = Some(limits.side);
+    full.max_image_height = Some(limits.side);
+    full.max_alloc = Some(limits.bytes);
+    decoder.set_limits(full).map_err(cannot)?;
+    DynamicImage::from_decoder(decoder).map_err(cannot)
+}
+
+/// A vector of `len` elements reserved up front: memory that cannot be
+/// had is an error naming `what` and the size, not an abort.
+pub fn reserved<T>(len: usize, what: impl FnOnce() -> String) -> Result<Vec<T>, String> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(len).map_err(|_| {
+        format!(
+            "{}: cannot allocate {} MiB",
+            what(),
+            (len * std::mem::size_of::<T>()).div_ceil(1 << 20)
+        )
+    })?;
+    Ok(v)
+}
+
+/// Rows converted to floats at a time, so that no full-size float copy of
+/// the decoded image is made besides the texture's own texels.
+const STRIP_ROWS: u32 = 64;
 
 /// Largest side a decoded texture keeps before its float copies are made
 /// (4 x MAX_LAYER_SIZE, so the layer's own filtering still has 4 texels per
@@ -116,23 +204,23 @@ fn from_image(decoded: DynamicImage, path: &Path) -> Result<Texture, String> {
         decoded,
         DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
     );
-    let rgba = decoded.into_rgba32f();
-    let texels: Vec<[f32; 3]> = rgba
-        .pixels()
-        .map(|p| {
+    // At most MAX_DECODED_SIDE² texels: 12 bytes each, 4 more with alpha
+    // (256 MiB at the most), reserved before any is converted.
+    let count = width as usize * height as usize;
+    let size = || format!("texture {} ({width}x{height})", path.display());
+    let mut texels: Vec<[f32; 3]> = reserved(count, size)?;
+    let mut alpha: Vec<f32> = reserved(if has_alpha { count } else { 0 }, size)?;
+    for top in (0..height).step_by(STRIP_ROWS as usize) {
+        let rows = STRIP_ROWS.min(height - top);
+        let strip = decoded.crop_imm(0, top, width, rows).into_rgba32f();
+        for p in strip.pixels() {
             let rgb = [p.0[0], p.0[1], p.0[2]];
-            if linear {
-                rgb
-            } else {
-                rgb.map(srgb_to_linear)
+            texels.push(if linear { rgb } else { rgb.map(srgb_to_linear) });
+            if has_alpha {
+                alpha.push(p.0[3]);
             }
-        })
-        .collect();
-    let mut alpha: Vec<f32> = if has_alpha {
-        rgba.pixels().map(|p| p.0[3]).collect()
-    } else {
-        Vec::new()
-    };
+        }
+    }
     if let Some(i) = alpha.iter().position(|a| !(0.0..=1.0).contains(a)) {
         return Err(format!(
             "texture {}: texel {i} has alpha {}, outside [0, 1]",
@@ -194,26 +282,30 @@ pub fn layer_size(textures: &[Texture]) -> u32 {
 /// coverage whose neighbours have some takes their coverage-weighted
 /// colour ([`dilate_into_transparent`]), so the shader's bilinear taps
 /// across the edge blend no colour of the cut-away texels into what stays.
+///
+/// One RGBA float copy of the texture is alive at a time besides the chain
+/// (16 bytes a texel: 256 MiB for the largest, [`MAX_DECODED_SIDE`]²).
 pub fn mip_chain(texture: &Texture, size: u32) -> Vec<Vec<[f32; 4]>> {
     let has_alpha = !texture.alpha.is_empty();
-    let straight: Vec<[f32; 4]> = texture
-        .texels
-        .iter()
-        .enumerate()
-        .map(|(i, t)| {
-            [
+    // The texture at `size` x `size`, its colour premultiplied by alpha or not.
+    let level0_of = |premultiplied: bool| -> Vec<[f32; 4]> {
+        let texels = texture.texels.iter().enumerate().map(|(i, t)| {
+            let t = [
                 t[0],
                 t[1],
                 t[2],
                 texture.alpha.get(i).copied().unwrap_or(1.0),
-            ]
-        })
-        .collect();
-    let resize = |texels: Vec<[f32; 4]>| -> Vec<[f32; 4]> {
+            ];
+            if premultiplied {
+                premultiply(t)
+            } else {
+                t
+            }
+        });
         if (texture.width, texture.height) == (size, size) {
-            return texels;
+            return texels.collect();
         }
-        let flat: Vec<f32> = texels.into_iter().flatten().collect();
+        let flat: Vec<f32> = texels.flatten().collect();
         let image = Rgba32FImage::from_raw(texture.width, texture.height, flat)
             .expect("texel count matches the size");
         imageops::resize(&image, size, size, FilterType::Triangle)
@@ -222,9 +314,9 @@ pub fn mip_chain(texture: &Texture, size: u32) -> Vec<Vec<[f32; 4]>> {
             .collect()
     };
     let side = size as usize;
-    let mut level0 = resize(straight.clone());
+    let mut level0 = level0_of(false);
     if has_alpha {
-        let weighted = resize(straight.iter().map(|&t| premultiply(t)).collect());
+        let weighted = level0_of(true);
         for (t, w) in level0.iter_mut().zip(&weighted) {
             *t = unpremultiply(*w, *t);
         }

@@ -5,9 +5,10 @@
 use super::values::{direction, non_negative_rgb, positive, size2};
 use crate::scene::node::{Tbl, R};
 use crate::scene::paths::Confinement;
-use crate::scene::shapes;
 use crate::scene::types::*;
+use crate::scene::{shapes, texture};
 use glam::{Mat4, Quat, Vec3};
+use image::DynamicImage;
 use std::path::Path;
 
 /// Most area lights a scene may hold.
@@ -76,8 +77,9 @@ fn sky(t: &Tbl, rotate_deg: f32) -> R<Sky> {
 }
 
 /// An equirectangular HDR image (Radiance RGBE `.hdr` or OpenEXR) as linear
-/// radiance. Other formats, undecodable or truncated files and negative or
-/// non-finite texels are refused; the message names the file.
+/// radiance. Other formats, images over [`texture::ENVIRONMENT_LIMITS`],
+/// undecodable or truncated files and negative or non-finite texels are
+/// refused; the message names the file.
 pub fn load_hdr(path: &Path) -> Result<Texture, String> {
     crate::scene::input::check_regular(path)
         .map_err(|e| format!("cannot open environment image {}: {e}", path.display()))?;
@@ -95,9 +97,7 @@ pub fn load_hdr(path: &Path) -> Result<Texture, String> {
             ))
         }
     }
-    let decoded = reader
-        .decode()
-        .map_err(|e| format!("cannot decode environment image {}: {e}", path.display()))?;
+    let decoded = texture::decode_limited(reader, path, &texture::ENVIRONMENT_LIMITS)?;
     let (width, height) = (decoded.width(), decoded.height());
     if width < 2 || height < 1 {
         return Err(format!(
@@ -105,7 +105,13 @@ pub fn load_hdr(path: &Path) -> Result<Texture, String> {
             path.display()
         ));
     }
-    let texels: Vec<[f32; 3]> = decoded.into_rgb32f().pixels().map(|p| p.0).collect();
+    let mut texels: Vec<[f32; 3]> = texture::reserved(width as usize * height as usize, || {
+        format!("environment image {} ({width}x{height})", path.display())
+    })?;
+    match decoded {
+        DynamicImage::ImageRgb32F(image) => texels.extend(image.pixels().map(|p| p.0)),
+        other => texels.extend(other.into_rgb32f().pixels().map(|p| p.0)),
+    }
     // The radiometric bound of every scene value (docs/SCENES.md, Bounds):
     // above it the table's sums and the photons' flux leave the f32 range
     // and the render would fail at its end with a NaN naming no file.
