@@ -587,3 +587,68 @@ fn an_output_never_replaces_a_scene_input() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 31: a scene's mesh outside its folder was read. Now it is one
+/// line naming the scene file, the field and the rule; `--allow-paths`
+/// with the mesh's folder renders it, and a missing `--allow-paths`
+/// folder is one line too.
+#[test]
+fn allow_paths_opens_a_folder_outside_the_scene_tree() {
+    let dir = out_dir("allow-paths");
+    let meshes = dir.join("meshes");
+    std::fs::create_dir_all(&meshes).unwrap();
+    std::fs::write(
+        meshes.join("tri.obj"),
+        "v -1 0 -1\nv 1 0 -1\nv 0 0 1\nf 1 3 2\n",
+    )
+    .unwrap();
+    let scene_dir = dir.join("scene");
+    std::fs::create_dir_all(&scene_dir).unwrap();
+    let scene = one_object_scene(
+        &scene_dir,
+        "albedo = 0.5",
+        "shape = \"mesh\"\npath = \"../meshes/tri.obj\"",
+    );
+    let out = dir.join("x.png");
+    let (scene_arg, out_arg) = (scene.to_str().unwrap(), out.to_str().unwrap());
+    let run_with = |allow: &[&str]| {
+        let mut args = vec![
+            "render",
+            "--scene",
+            scene_arg,
+            "--technique",
+            "direct",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--out",
+            out_arg,
+        ];
+        args.extend(allow.iter().copied());
+        run(&args, &[])
+    };
+    let o = run_with(&[]);
+    one_line_error(
+        &o,
+        &[
+            scene.to_str().unwrap(),
+            "object[0].path",
+            "it climbs above the folder",
+            "--allow-paths",
+        ],
+    );
+    assert!(!out.exists());
+    let o = run_with(&["--allow-paths", meshes.to_str().unwrap()]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(out.exists());
+    let missing = dir.join("missing");
+    let o = run_with(&["--allow-paths", missing.to_str().unwrap()]);
+    one_line_error(&o, &["--allow-paths", "missing"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1325,3 +1325,261 @@ fn animation_moves_objects_with_time() {
     // The static object does not move.
     assert_eq!(s.object_transform(0, 0.0), s.object_transform(0, 3.0));
 }
+
+// ------------------------------------------- issue 31: confined paths, limits
+
+/// `dir/outside/`: a valid file of every kind a scene names (a triangle
+/// OBJ, an MTL, an 8-bit PNG, the canonical sky, a 2³ density grid, a glTF
+/// with its buffer beside it), and `dir/scene/` for scenes naming them.
+fn outside_files(dir: &Path) -> PathBuf {
+    let outside = dir.join("outside");
+    write(
+        &outside.join("tri.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    );
+    write(&outside.join("x.mtl"), "newmtl m\nKd 0.5 0.5 0.5\n");
+    caustics::output::write_png(&outside.join("t.png"), 2, 2, &[128; 16]).unwrap();
+    std::fs::copy(
+        manifest("assets/scenes/environments/sky.hdr"),
+        outside.join("sky.hdr"),
+    )
+    .unwrap();
+    write(&outside.join("g.raw"), [0u8; 8 * 4]);
+    let positions: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    write(&outside.join("m.bin"), &positions);
+    write(
+        &outside.join("m.gltf"),
+        r#"{"asset": {"version": "2.0"}, "buffers": [{"uri": "m.bin", "byteLength": 36}],
+            "bufferViews": [{"buffer": 0, "byteLength": 36}],
+            "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                           "min": [0, 0, 0], "max": [1, 1, 0]}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+            "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]}"#,
+    );
+    std::fs::create_dir_all(dir.join("scene")).unwrap();
+    outside
+}
+
+/// (field, the scene's lines naming a file outside its tree, the rule's
+/// words) for every kind of file a TOML scene names. `outside` is the
+/// folder of [`outside_files`], `scene_dir` the scene's.
+fn escaping_references(
+    outside: &Path,
+    scene_dir: &Path,
+) -> Vec<(&'static str, String, &'static str)> {
+    let mesh = |path: &str| {
+        format!("[[object]]\nshape = \"mesh\"\npath = \"{path}\"\nmaterial = \"white\"\n")
+    };
+    // A link inside the scene's folder to the OBJ outside it.
+    let link = scene_dir.join("link.obj");
+    let _ = std::fs::remove_file(&link);
+    std::os::unix::fs::symlink(outside.join("tri.obj"), &link).unwrap();
+    // An OBJ inside whose MTL is outside.
+    write(
+        &scene_dir.join("inside.obj"),
+        "mtllib ../outside/x.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n",
+    );
+    let absolute = outside.join("tri.obj");
+    vec![
+        ("object[1].path", mesh("../outside/tri.obj"), "climbs above the folder"),
+        ("object[1].path", mesh(absolute.to_str().unwrap()), "an absolute path"),
+        ("object[1].path", mesh("link.obj"), "a link that resolves outside"),
+        (
+            "object[1].path",
+            "[[object]]\nshape = \"mesh\"\npath = \"inside.obj\"\n".into(),
+            "mtllib `../outside/x.mtl`: it climbs above",
+        ),
+        (
+            "material[1].albedo_texture",
+            "[[material]]\nname = \"t\"\nkind = \"diffuse\"\nalbedo_texture = \"../outside/t.png\"\n".into(),
+            "climbs above the folder",
+        ),
+        (
+            "light[1].path",
+            "[[light]]\nkind = \"environment\"\npath = \"../outside/sky.hdr\"\n".into(),
+            "climbs above the folder",
+        ),
+        (
+            "medium.density.grid",
+            "[medium]\nsigma_s = 0.1\nbounds = { min = [-1.0, -1.0, -1.0], max = [1.0, 1.0, 1.0] }\n\
+             density = { grid = \"../outside/g.raw\", dims = [2, 2, 2] }\n"
+                .into(),
+            "climbs above the folder",
+        ),
+        (
+            "object[1].path",
+            "[[object]]\nshape = \"gltf\"\npath = \"../outside/m.gltf\"\n".into(),
+            "climbs above the folder",
+        ),
+    ]
+}
+
+/// Issue 31: a TOML scene read any file its paths named (`../`, absolute
+/// paths, links out of its folder, an OBJ's `mtllib`). Each is now refused,
+/// naming the scene file, the line, the field and the rule, before the
+/// file is read.
+#[test]
+fn files_outside_the_scene_folder_tree_are_refused() {
+    let dir = temp_dir("confined");
+    let outside = outside_files(&dir);
+    let scene_dir = dir.join("scene");
+    for (field, lines, rule) in escaping_references(&outside, &scene_dir) {
+        let path = scene_dir.join("s.toml");
+        let text = base(&lines);
+        write(&path, &text);
+        let e = Scene::load(&path)
+            .err()
+            .unwrap_or_else(|| panic!("accepted a file outside the tree:\n{lines}"))
+            .to_string();
+        // The line of the value that names the file.
+        let key = field.rsplit('.').next().unwrap();
+        let at = format!(
+            "{}:{}:",
+            path.display(),
+            line_of(&text, &format!("{key} = "))
+        );
+        assert!(e.starts_with(&at), "{at} in {e}");
+        assert!(e.contains(&format!(": {field}: ")), "{field} in {e}");
+        assert!(
+            e.contains(rule) && e.contains("scene file's folder") && e.contains("--allow-paths"),
+            "{rule} in {e}"
+        );
+        assert!(!e.contains('\n'), "{e}");
+    }
+}
+
+/// The same files load when their folder is allowed (`--allow-paths`,
+/// `Scene::load_allowing`), and a glTF file's URIs are widened the same way.
+#[test]
+fn allowed_folders_open_the_same_files() {
+    let dir = temp_dir("allowed");
+    let outside = outside_files(&dir);
+    let scene_dir = dir.join("scene");
+    let allowed = AllowedPaths::new(&[outside.clone()]).unwrap();
+    for (field, lines, _) in escaping_references(&outside, &scene_dir) {
+        let path = scene_dir.join("s.toml");
+        write(&path, base(&lines));
+        if let Err(e) = Scene::load_allowing(&path, &allowed) {
+            panic!("{field}: refused with its folder allowed: {e}");
+        }
+    }
+    // A glTF scene whose buffer is in an allowed folder.
+    write(
+        &scene_dir.join("up.gltf"),
+        std::fs::read_to_string(outside.join("m.gltf"))
+            .unwrap()
+            .replace("\"m.bin\"", "\"../outside/m.bin\""),
+    );
+    let e = Scene::load(&scene_dir.join("up.gltf"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("buffers[0].uri") && e.contains("climbs above"),
+        "{e}"
+    );
+    Scene::load_allowing(&scene_dir.join("up.gltf"), &allowed).expect("allowed buffer");
+    let e = AllowedPaths::new(&[dir.join("missing")]).unwrap_err();
+    assert!(
+        e.starts_with("--allow-paths ") && e.contains("missing"),
+        "{e}"
+    );
+}
+
+/// A PNG of `width` x `height` RGB8 (colour type 2) or RGBA16 (colour
+/// type 6, depth 16) that holds only its header and an empty IDAT: a few
+/// dozen bytes that declare a huge image.
+fn png_header(width: u32, height: u32, depth: u8, colour: u8) -> Vec<u8> {
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut crc = !0u32;
+        for &b in bytes {
+            crc ^= b as u32;
+            for _ in 0..8 {
+                crc = if crc & 1 != 0 {
+                    (crc >> 1) ^ 0xEDB8_8320
+                } else {
+                    crc >> 1
+                };
+            }
+        }
+        !crc
+    }
+    let chunk = |kind: &[u8], data: &[u8]| {
+        let mut c = (data.len() as u32).to_be_bytes().to_vec();
+        let body = [kind, data].concat();
+        c.extend(&body);
+        c.extend(crc32(&body).to_be_bytes());
+        c
+    };
+    let mut ihdr = width.to_be_bytes().to_vec();
+    ihdr.extend(height.to_be_bytes());
+    ihdr.extend([depth, colour, 0, 0, 0]);
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    png.extend(chunk(b"IHDR", &ihdr));
+    png.extend(chunk(
+        b"IDAT",
+        &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01],
+    ));
+    png.extend(chunk(b"IEND", &[]));
+    png
+}
+
+/// Issue 31: small files that declare huge images were decoded with the
+/// decoder's default limits only (or none: the HDR reader), the message
+/// naming neither the size nor a limit. Now the header is checked against
+/// the documented limits (docs/SCENES.md, "Limits") before anything is
+/// allocated: one line naming the file, its size and the limit.
+#[test]
+fn images_over_the_decoder_limits_are_refused_naming_size_and_limit() {
+    let dir = temp_dir("decoder-limits");
+    let cases = [
+        // Over 16384 per side.
+        (
+            "wide.png",
+            png_header(20000, 16, 8, 2),
+            "20000x16",
+            "16384 texels per side",
+        ),
+        // Within the sides, 2 GiB of 16-bit RGBA: over 1024 MiB.
+        (
+            "deep.png",
+            png_header(16384, 16384, 16, 6),
+            "16384x16384",
+            "1024 MiB",
+        ),
+    ];
+    for (name, bytes, size, limit) in &cases {
+        write(&dir.join(name), bytes);
+        let text = base(&format!(
+            "[[material]]\nname = \"t\"\nkind = \"diffuse\"\nalbedo_texture = \"{name}\"\n"
+        ));
+        let path = dir.join("s.toml");
+        write(&path, &text);
+        let e = Scene::load(&path).unwrap_err().to_string();
+        assert!(e.contains(": material[1].albedo_texture: "), "{e}");
+        assert!(
+            e.contains(name) && e.contains(size) && e.contains(limit),
+            "{e}"
+        );
+    }
+    // A Radiance header declaring 18000 x 9000 texels and no data.
+    write(
+        &dir.join("huge.hdr"),
+        "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 9000 +X 18000\n",
+    );
+    let path = dir.join("env.toml");
+    write(
+        &path,
+        base("[[light]]\nkind = \"environment\"\npath = \"huge.hdr\"\n"),
+    );
+    let e = Scene::load(&path).unwrap_err().to_string();
+    assert!(
+        e.contains(": light[1].path: ")
+            && e.contains("environment image")
+            && e.contains("18000x9000")
+            && e.contains("8192 texels per side"),
+        "{e}"
+    );
+}
