@@ -11,7 +11,11 @@ Runs `caustics` on several hundred hostile inputs and checks, for each:
   symlink points to is unchanged;
 - inputs are never overwritten (an output naming the scene's texture);
 - nothing outside the scene's folder is read through a glTF URI (the
-  canary file outside the folder is never named in a success).
+  canary file outside the folder is never named in a success);
+- nothing outside a TOML scene's folder tree is read through any path it
+  names (mesh, mtllib, map_Kd, albedo_texture, environment, density grid,
+  glTF object) unless --allow-paths names the folder: without the flag
+  each is refused by the path rule, with it each renders.
 
     cargo build --release
     scripts/hostile-corpus.py [--binary target/release/caustics] [--limit N]
@@ -20,14 +24,17 @@ Prints one line per failed case and a summary; exits 1 if any case failed.
 The cases: every number of three canonical scenes replaced by hostile
 values (NaN, infinities, huge, negative, zero, wrong types), fields
 removed, special files as the scene, a mesh, a glTF buffer and the output,
-glTF URIs that leave the folder, and outputs that name inputs.
+glTF URIs that leave the folder, TOML paths that leave the scene's tree
+(with and without --allow-paths), and outputs that name inputs.
 """
 import argparse
+import base64
 import json
 import os
 import re
 import shutil
 import stat
+import struct
 import subprocess
 import sys
 import tempfile
@@ -135,7 +142,7 @@ def main():
     os.makedirs(scenes_dir)
     # The canonical scenes' meshes and textures, beside copies of the scenes.
     for sub in ["meshes", "textures", "environments"]:
-        shutil.copytree(os.path.join(repo, "assets", sub), os.path.join(root, sub))
+        shutil.copytree(os.path.join(repo, "assets", "scenes", sub), os.path.join(scenes_dir, sub))
 
     # 1. Scene values.
     for scene in ["ball_lens", "ring_sky", "volume_box"]:
@@ -151,16 +158,25 @@ def main():
     os.mkfifo(fifo)
     for p in [fifo, "/dev/zero", root, "/dev/null"]:
         c.case(f"--scene {p}", ["render", "--scene", p, "--out", out] + small, root, out)
-    mesh_scene = os.path.join(scenes_dir, "mesh_fifo.toml")
-    with open(mesh_scene, "w") as f:
-        f.write(open(os.path.join(repo, "assets", "scenes", "cup.toml")).read().replace("../meshes/cup.obj", "../fifo"))
-    c.case("OBJ path is a FIFO", ["render", "--scene", mesh_scene, "--out", out] + small, root, out)
-    for p in ["/dev/zero", fifo, root]:
+    # Special files inside the scene's tree (read only if the path rule
+    # lets them through), and outside it (refused by the rule first).
+    inner_fifo = os.path.join(scenes_dir, "fifo.obj")
+    os.mkfifo(inner_fifo)
+    inner_dir = os.path.join(scenes_dir, "folder")
+    os.makedirs(inner_dir)
+    cup = open(os.path.join(repo, "assets", "scenes", "cup.toml")).read()
+    for p in ["fifo.obj", "../fifo", "folder"]:
+        mesh_scene = os.path.join(scenes_dir, "mesh_fifo.toml")
+        with open(mesh_scene, "w") as f:
+            f.write(cup.replace("meshes/cup.obj", p))
+        c.case(f"OBJ path {p}", ["render", "--scene", mesh_scene, "--out", out] + small, root, out)
+    smoke = open(os.path.join(repo, "assets", "scenes", "smoke.toml")).read()
+    for p, allow in [("/dev/zero", []), (fifo, []), (root, []), ("fifo.obj", []), ("folder", []),
+                     ("/dev/zero", ["--allow-paths", "/dev"]), (fifo, ["--allow-paths", root])]:
         s = os.path.join(scenes_dir, "grid.toml")
-        smoke = open(os.path.join(repo, "assets", "scenes", "smoke.toml")).read()
         with open(s, "w") as f:
             f.write(re.sub(r"(?m)^density = .*$", 'density = { grid = "' + p + '", dims = [4, 4, 4] }', smoke))
-        c.case(f"density grid {p}", ["render", "--scene", s, "--out", out] + small, root, out)
+        c.case(f"density grid {p} {' '.join(allow)}", ["render", "--scene", s, "--out", out] + small + allow, root, out)
 
     # 3. glTF URIs that leave the folder (a canary outside it).
     gltf_dir = os.path.join(root, "gltf")
@@ -190,7 +206,86 @@ def main():
             json.dump(doc, f)
         c.case(f"glTF accessor count {count}", ["render", "--scene", path, "--out", out] + small, root, out)
 
-    # 4. Special files and inputs as outputs.
+    # 4. TOML paths that leave the scene's tree: valid files outside it,
+    # named by every kind of reference in every spelling. Without
+    # --allow-paths each must be refused by the path rule (the message
+    # names it); with the folder allowed, the real files render.
+    outside = os.path.join(root, "outside")
+    os.makedirs(outside)
+    shutil.copy(os.path.join(scenes_dir, "meshes", "cup.obj"), os.path.join(outside, "cup.obj"))
+    shutil.copy(os.path.join(scenes_dir, "textures", "pool_tiles.png"), os.path.join(outside, "tiles.png"))
+    shutil.copy(os.path.join(scenes_dir, "environments", "sky.hdr"), os.path.join(outside, "sky.hdr"))
+    with open(os.path.join(outside, "x.mtl"), "w") as f:
+        f.write("newmtl m\nKd 0.5 0.5 0.5\n")
+    with open(os.path.join(outside, "grid.raw"), "wb") as f:
+        f.write(b"\0" * 4 * 64)
+    # Its buffer inline: a link to the file resolves its URIs beside the link.
+    triangle = base64.b64encode(struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 0, 1)).decode()
+    gltf_doc = {"asset": {"version": "2.0"},
+                "buffers": [{"uri": "data:application/octet-stream;base64," + triangle, "byteLength": 36}],
+                "bufferViews": [{"buffer": 0, "byteLength": 36}],
+                "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                               "min": [0, 0, 0], "max": [1, 0, 1]}],
+                "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+                "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]}
+    with open(os.path.join(outside, "m.gltf"), "w") as f:
+        json.dump(gltf_doc, f)
+    tree = os.path.join(root, "tree")
+    os.makedirs(os.path.join(tree, "sub"))
+    os.symlink(outside, os.path.join(tree, "linked_dir"))
+    head = ('[camera]\neye = [0.0, 2.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\n\n'
+            '[[light]]\nkind = "point"\nposition = [0.0, 3.0, 0.0]\nintensity = 10.0\n\n'
+            '[[material]]\nname = "white"\nkind = "diffuse"\nalbedo = 0.5\n\n'
+            '[[object]]\nshape = "plane"\nsize = [4.0, 4.0]\nmaterial = "white"\n\n')
+    kinds = {
+        "cup.obj": lambda p: f'[[object]]\nshape = "mesh"\npath = "{p}"\nmaterial = "white"\n',
+        "tiles.png": lambda p: f'[[material]]\nname = "t"\nkind = "diffuse"\nalbedo_texture = "{p}"\n',
+        "sky.hdr": lambda p: f'[[light]]\nkind = "environment"\npath = "{p}"\nscale = 0.001\n',
+        "grid.raw": lambda p: ('[medium]\nsigma_s = 0.1\nbounds = { min = [-1.0, 0.0, -1.0], max = [1.0, 1.0, 1.0] }\n'
+                               f'density = {{ grid = "{p}", dims = [4, 4, 4] }}\n'),
+        "m.gltf": lambda p: f'[[object]]\nshape = "gltf"\npath = "{p}"\n',
+        # An OBJ inside the tree whose mtllib, or whose MTL's map_Kd, leaves it.
+        "x.mtl": lambda p: '[[object]]\nshape = "mesh"\npath = "inner.obj"\n',
+        "tiles.png (map_Kd)": lambda p: '[[object]]\nshape = "mesh"\npath = "inner_kd.obj"\n',
+    }
+    tri = "v 0 0 0\nv 1 0 0\nv 0 0 1\nvt 0 0\nvt 1 0\nvt 0 1\n"
+    spellings = {  # name -> (reference to outside/F from tree/, a real file there)
+        "parent": (lambda f: "../outside/" + f, True),
+        "absolute": (lambda f: os.path.join(outside, f), True),
+        "climb from sub": (lambda f: "sub/../../outside/" + f, True),
+        "dot parent": (lambda f: "./../outside/" + f, True),
+        "linked folder": (lambda f: "linked_dir/" + f, True),
+        "linked file": (lambda f: "link_" + f.replace(" (map_Kd)", ""), True),
+        "encoded": (lambda f: "%2e%2e/outside/" + f, False),
+    }
+    for kind, snippet in kinds.items():
+        name = kind.replace(" (map_Kd)", "")
+        link = os.path.join(tree, "link_" + name)
+        if not os.path.lexists(link):
+            os.symlink(os.path.join(outside, name), link)
+        for spelling, (ref, real) in spellings.items():
+            p = ref(name)
+            with open(os.path.join(tree, "inner.obj"), "w") as f:
+                f.write(f"mtllib {p}\n{tri}usemtl m\nf 1/1 2/2 3/3\n")
+            with open(os.path.join(tree, "inner.mtl"), "w") as f:
+                f.write(f"newmtl m\nKd 1 1 1\nmap_Kd {p}\n")
+            with open(os.path.join(tree, "inner_kd.obj"), "w") as f:
+                f.write(f"mtllib inner.mtl\n{tri}usemtl m\nf 1/1 2/2 3/3\n")
+            s = os.path.join(tree, "s.toml")
+            with open(s, "w") as f:
+                f.write(head + snippet(p))
+            args = ["render", "--scene", s, "--technique", "direct", "--out", out] + small
+            # A real file outside must be refused by the path rule itself;
+            # a name that does not exist (`%2e%2e` is no escape in a path) just fails.
+            c.case(f"TOML {kind} {spelling}", args, root, out,
+                   lambda code, so, se, real=real: "read outside the scene's tree" if code == 0
+                   else f"refused, but not by the path rule: {se.strip()}" if real and "--allow-paths" not in se
+                   else None)
+            if real:
+                c.case(f"TOML {kind} {spelling} --allow-paths", args + ["--allow-paths", outside], root, out,
+                       lambda code, so, se: None if code == 0 else "refused with its folder allowed")
+
+    # 5. Special files and inputs as outputs.
     ball = os.path.join(repo, "assets", "scenes", "ball_lens.toml")
     target = os.path.join(root, "target.txt")
     with open(target, "w") as f:
@@ -217,7 +312,7 @@ def main():
         c.case(f"special {kind} as bench --json", ["bench", "--scene", ball, "--frames", "1", "--json", p] + small,
                root, out, lambda code, so, se, p=p, kind=kind: None if kinds[kind](p) else f"{p} replaced")
     tiles = os.path.join(repo, "assets", "scenes", "pool_tiles.toml")
-    tex = os.path.join(root, "scenes", "..", "textures", "pool_tiles.png")
+    tex = os.path.join(scenes_dir, "textures", "pool_tiles.png")
     copy = os.path.join(scenes_dir, "tiles.toml")
     with open(copy, "w") as f:
         f.write(open(tiles).read())
