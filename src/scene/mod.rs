@@ -6,6 +6,8 @@
 //! - `shapes.rs`: procedural tessellation; `obj.rs`: OBJ/MTL through tobj;
 //!   `gltf/`: glTF 2.0 files (objects, or a whole scene of one file).
 //! - `water.rs`: water surfaces (Gerstner waves), re-tessellated per time.
+//! - `paths.rs`: where the files a scene names may be (its folder's tree,
+//!   `--allow-paths`); `input.rs`: how they are read (regular files, size limits).
 //! - this file: loading, animation and world-space queries.
 
 mod bounds;

@@ -1458,7 +1458,7 @@ fn allowed_folders_open_the_same_files() {
     let dir = temp_dir("allowed");
     let outside = outside_files(&dir);
     let scene_dir = dir.join("scene");
-    let allowed = AllowedPaths::new(&[outside.clone()]).unwrap();
+    let allowed = AllowedPaths::new(std::slice::from_ref(&outside)).unwrap();
     for (field, lines, _) in escaping_references(&outside, &scene_dir) {
         let path = scene_dir.join("s.toml");
         write(&path, base(&lines));
