@@ -328,14 +328,16 @@ fn a_lost_device_or_its_memory_running_out_is_one_line_and_no_output() {
 fn a_closed_stdout_pipe_is_no_panic() {
     use std::os::unix::process::ExitStatusExt as _;
     use std::process::Stdio;
-    let mut child = Command::new(env!("CARGO_BIN_EXE_caustics"))
+    // The read end is closed before the child starts: closing it after
+    // spawn raced the child's first write, which a pipe's buffer accepts.
+    let (reader, writer) = std::io::pipe().expect("pipe");
+    drop(reader);
+    let o = Command::new(env!("CARGO_BIN_EXE_caustics"))
         .args(["render", "--technique", "list"])
-        .stdout(Stdio::piped())
+        .stdout(writer)
         .stderr(Stdio::piped())
-        .spawn()
+        .output()
         .expect("run caustics");
-    drop(child.stdout.take()); // the reader is gone before the first line
-    let o = child.wait_with_output().expect("wait");
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert_eq!(
