@@ -1481,6 +1481,22 @@ fn allowed_folders_open_the_same_files() {
         "{e}"
     );
     Scene::load_allowing(&scene_dir.join("up.gltf"), &allowed).expect("allowed buffer");
+    // An absolute URI is refused even when it names a file inside the tree
+    // or an allowed folder (issue 31: glTF URIs are relative references).
+    let absolute = std::path::absolute(outside.join("m.bin")).unwrap();
+    write(
+        &scene_dir.join("abs.gltf"),
+        std::fs::read_to_string(outside.join("m.gltf"))
+            .unwrap()
+            .replace("\"m.bin\"", &format!("\"{}\"", absolute.display())),
+    );
+    let e = Scene::load_allowing(&scene_dir.join("abs.gltf"), &allowed)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("buffers[0].uri") && e.contains("an absolute path"),
+        "{e}"
+    );
     let e = AllowedPaths::new(&[dir.join("missing")]).unwrap_err();
     assert!(
         e.starts_with("--allow-paths ") && e.contains("missing"),
@@ -1579,6 +1595,21 @@ fn images_over_the_decoder_limits_are_refused_naming_size_and_limit() {
         e.contains(": light[1].path: ")
             && e.contains("environment image")
             && e.contains("18000x9000")
+            && e.contains("8192 texels per side"),
+        "{e}"
+    );
+    // A float EXR environment one texel wider than the limit.
+    image::Rgb32FImage::new(8193, 2)
+        .save(dir.join("wide.exr"))
+        .expect("write the EXR");
+    write(
+        &path,
+        base("[[light]]\nkind = \"environment\"\npath = \"wide.exr\"\n"),
+    );
+    let e = Scene::load(&path).unwrap_err().to_string();
+    assert!(
+        e.contains(": light[1].path: ")
+            && e.contains("8193x2")
             && e.contains("8192 texels per side"),
         "{e}"
     );

@@ -54,17 +54,22 @@ pub(super) fn read_uri(uri: &str, within: &Confinement) -> Result<Vec<u8>, Strin
 /// resolved by the scene's one path rule ([`Confinement::resolve`]: inside
 /// the glTF file's folder tree or an `--allow-paths` folder; issue 31: a
 /// downloaded asset must not read `/etc/passwd`). A scheme (`file:`
-/// included) is refused before that, and `..` is checked after
-/// percent-decoding, so `%2e%2e/` too.
+/// included) and an absolute path (`/...`, even one inside the tree: an
+/// asset that names one is not portable) are refused before that, and `..`
+/// is checked after percent-decoding, so `%2e%2e/` too.
 pub(super) fn uri_file(uri: &str, within: &Confinement) -> Result<PathBuf, String> {
     if uri.contains(':') {
         return Err(format!(
             "URI `{uri}`: a scheme (file:, http:, ...) or drive; only relative references to files are read"
         ));
     }
-    within
-        .file(percent_decode(uri))
-        .map_err(|e| format!("URI {e}"))
+    let decoded = percent_decode(uri);
+    if decoded.starts_with(['/', '\\']) {
+        return Err(format!(
+            "URI `{uri}`: an absolute path; only references relative to the glTF file are read"
+        ));
+    }
+    within.file(decoded).map_err(|e| format!("URI {e}"))
 }
 
 pub(super) fn percent_decode(s: &str) -> String {
