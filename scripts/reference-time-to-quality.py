@@ -6,7 +6,7 @@ converged image of the same scene, per scene, for one or more builds of it
 
     cargo build --release
     scripts/reference-time-to-quality.py [--size 128] [--scenes ball_lens,...]
-        [--binary LABEL=PATH ...] [--converged-seconds 240]
+        [--binary 'LABEL=PATH [OPTIONS]' ...] [--converged-seconds 240]
 
 For each scene: a converged image, traced once by the first binary for
 --converged-seconds with its own seed and kept under
@@ -145,14 +145,16 @@ def main():
     p = argparse.ArgumentParser()
     p.add_argument("--size", type=int, default=128)
     p.add_argument("--scenes", default=",".join(SCENES))
-    p.add_argument("--binary", action="append", default=[], help="LABEL=PATH (repeatable)")
+    p.add_argument("--binary", action="append", default=[],
+                   help="'LABEL=PATH [OPTIONS]' (repeatable): OPTIONS go to that binary's runs only")
     p.add_argument("--converged-seconds", type=float, default=240)
     p.add_argument("--cap", type=float, default=256, help="longest rung (s)")
     p.add_argument("--first", type=float, default=1, help="first rung (s; with small --pass-photons below 1)")
     p.add_argument("--mitsuba", action="store_true", help="also Mitsuba 3 (scripts/mitsuba_scenes.py)")
     p.add_argument("--extra", default="", help="more `caustics reference` options for every run")
     a = p.parse_args()
-    binaries = [b.split("=", 1) for b in a.binary] or [["ours", "target/release/caustics"]]
+    binaries = [(label, *rest.split()) for label, rest in (b.split("=", 1) for b in a.binary)]
+    binaries = binaries or [("ours", "target/release/caustics")]
     os.makedirs(CACHE, exist_ok=True)
     results = []
     for scene in a.scenes.split(","):
@@ -161,11 +163,11 @@ def main():
         path = f"{CACHE}/{scene}-{a.size}-converged.exr"
         if not os.path.exists(path):
             print(f"{scene}: converging with {binaries[0][1]} for {a.converged_seconds} s", flush=True)
-            ours(binaries[0][1], scene, a.size, a.converged_seconds, 1000, path, extra)
+            ours(binaries[0][1], scene, a.size, a.converged_seconds, 1000, path, extra + list(binaries[0][2:]))
         converged = read_exr(path)
-        for label, binary in binaries:
-            def measure(seconds, binary=binary):
-                t, photons, image = ours(binary, scene, a.size, seconds, 7, f"/tmp/ttq-{label}.exr", extra)
+        for label, binary, *options in binaries:
+            def measure(seconds, binary=binary, options=options):
+                t, photons, image = ours(binary, scene, a.size, seconds, 7, f"/tmp/ttq-{label}.exr", extra + options)
                 return t, f"{photons / 1e6:.1f} M photons", image
             rungs = ladder(f"{scene} {label}", measure, converged, scale, a.first, a.cap)
             results.append((scene, label, rungs))
