@@ -4,7 +4,7 @@
 //! stand-ins of small area lights. `glsl/common/emitters.glsl` evaluates the
 //! same formulas on the GPU.
 
-use crate::gpu::LUMINANCE;
+use crate::radiometry::LUMINANCE;
 use crate::scene::{
     Emitter, EmitterShape, Environment, EnvironmentKind, Light, LightKind, Scene, Sky,
 };

@@ -290,9 +290,6 @@ impl GpuMaterial {
     }
 }
 
-/// Luminance weights used to turn rgb power into one number for light selection.
-pub const LUMINANCE: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);
-
 impl GpuLight {
     /// `scene_radius` is the radius of the scene's bounding sphere: a directional
     /// light's photons leave a disk of that radius, so its power is E * pi * R^2.
@@ -317,7 +314,7 @@ impl GpuLight {
             direction: v4(l.direction.normalize_or_zero(), cos_outer),
             intensity: v4(l.intensity, cos_inner),
             power: [
-                crate::radiometry::light_power(l, scene_radius).dot(LUMINANCE),
+                crate::radiometry::light_power(l, scene_radius).dot(crate::radiometry::LUMINANCE),
                 0.0,
                 0.0,
                 0.0,
@@ -344,14 +341,17 @@ impl GpuEmitter {
                     position: v4(p0, f32::from_bits(b::EMITTER_TRIANGLE)),
                     normal: v4(p1 - p0, area),
                     tangent: v4(p2 - p0, 0.0),
-                    radiance: v4(l, (l * std::f32::consts::PI * area).dot(LUMINANCE)),
+                    radiance: v4(
+                        l,
+                        (l * std::f32::consts::PI * area).dot(crate::radiometry::LUMINANCE),
+                    ),
                 })
             })
             .collect()
     }
 
     pub fn new(e: &Emitter) -> Self {
-        let power = crate::environment::emitter_power(e).dot(LUMINANCE);
+        let power = crate::environment::emitter_power(e).dot(crate::radiometry::LUMINANCE);
         let radiance = v4(e.radiance, power);
         match e.shape {
             EmitterShape::Rect {

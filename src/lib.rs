@@ -4,7 +4,6 @@
 pub mod app;
 pub mod bvh;
 pub mod cache_dir;
-pub mod cascades;
 pub mod compare;
 pub mod environment;
 pub mod frame;

@@ -6,6 +6,16 @@ use crate::shader_bindings as b;
 use glam::Vec3;
 use std::f32::consts::PI;
 
+/// Rec. 709 luminance weights of linear rgb (`luminance()` in
+/// glsl/common/optics.glsl): one number for an rgb power or radiance
+/// (light selection, energy criteria, denoising weights).
+pub const LUMINANCE: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);
+
+/// The luminance of linear rgb `c`.
+pub fn luminance(c: Vec3) -> f32 {
+    c.dot(LUMINANCE)
+}
+
 /// Spot-light angular falloff: 1 inside `cos_inner`, 0 outside `cos_outer`,
 /// smoothstep in cos(theta) between (glsl/common/lights.glsl: spot_falloff).
 /// `cos_inner` > 1 marks the cosine profile of a rect light's stand-in

@@ -8,7 +8,8 @@
 //! changes (`EnvironmentGpu::update`, the demo's live rotation).
 
 use crate::environment;
-use crate::gpu::{GpuEnvironment, LUMINANCE};
+use crate::gpu::GpuEnvironment;
+use crate::radiometry::LUMINANCE;
 use crate::scene::{Environment, EnvironmentKind};
 use crate::vk::{Buffer, BufferUsage, Context, Image, ImageDesc, Sampler, VkResult};
 use ash::vk;

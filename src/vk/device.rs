@@ -2,7 +2,7 @@
 //! (`RequiredFeature`), what `caustics info` shows of each (`DeviceInfo`),
 //! and the choice of one (`--device` by index or name).
 
-use super::context::{create_instance, load_entry, Validation};
+use super::instance::{create_instance, load_entry, Validation};
 use super::{VkError, VkResult};
 use ash::vk;
 use std::ffi::CStr;

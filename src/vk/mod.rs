@@ -19,6 +19,7 @@ mod fault;
 mod frame;
 mod host_memory;
 mod image;
+mod instance;
 mod limits;
 mod pass;
 mod pipeline;
@@ -43,9 +44,11 @@ pub use limits::{bytes, host_rss, trim_host_heap, MemoryHeaps, MemoryReport};
 pub use pass::{step, Pass, Resource, Sync};
 pub use pipeline::{
     begin_rendering, begin_rendering_with_depth, end_rendering, groups_8x8, ComputePipeline,
-    GraphicsPipeline, GraphicsPipelineDesc,
+    GraphicsPipeline,
 };
-pub use pipeline_store::{CacheLoad, PipelineCounts, PipelineStore, Specialization};
+pub use pipeline_store::{
+    CacheLoad, GraphicsPipelineDesc, PipelineCounts, PipelineStore, Specialization,
+};
 pub use profiler::Profiler;
 pub use resources::{Buffer, BufferUsage};
 pub use swapchain::{Acquired, Surface, Swapchain};

@@ -2,7 +2,7 @@
 //! from `descriptors.rs`.
 
 use super::pipeline_create::{create_graphics, create_with_stages, pipeline_key};
-use super::pipeline_store::{SharedPipeline, Specialization, Stages};
+use super::pipeline_store::{GraphicsPipelineDesc, SharedPipeline, Specialization, Stages};
 use super::{Buffer, Context, DescriptorSet, DescriptorSetLayout, VkResult};
 use ash::vk;
 use std::sync::Arc;
@@ -144,45 +144,6 @@ impl ComputePipeline {
         bind_sets(ctx, cmd, vk::PipelineBindPoint::COMPUTE, self.layout, sets);
         push(ctx, cmd, self.layout, push_data);
         unsafe { ctx.device.cmd_dispatch_indirect(cmd, args.raw, offset) };
-    }
-}
-
-/// How a graphics pipeline is built. Geometry comes from storage buffers
-/// (vertex pulling), so there is no vertex input state.
-#[derive(Clone, Debug, PartialEq, Eq, Hash)]
-pub struct GraphicsPipelineDesc<'a> {
-    pub vertex: &'a str,
-    pub geometry: Option<&'a str>,
-    pub fragment: &'a str,
-    pub color_formats: Vec<vk::Format>,
-    pub depth_format: Option<vk::Format>,
-    pub depth_test: bool,
-    pub depth_write: bool,
-    /// Additive blending (one + one) on every colour attachment.
-    pub additive: bool,
-    pub cull: vk::CullModeFlags,
-    pub topology: vk::PrimitiveTopology,
-    pub push_size: u32,
-    /// Specialisation constants, the same for every stage.
-    pub specialization: Specialization,
-}
-
-impl<'a> GraphicsPipelineDesc<'a> {
-    pub fn new(vertex: &'a str, fragment: &'a str) -> Self {
-        Self {
-            vertex,
-            geometry: None,
-            fragment,
-            color_formats: Vec::new(),
-            depth_format: None,
-            depth_test: false,
-            depth_write: false,
-            additive: false,
-            cull: vk::CullModeFlags::NONE,
-            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-            push_size: 0,
-            specialization: Specialization::new(),
-        }
     }
 }
 

@@ -3,8 +3,7 @@
 //! `PipelineStore` shares them by. `pipeline.rs`'s `ComputePipeline` and
 //! `GraphicsPipeline` call these through the store.
 
-use super::pipeline::GraphicsPipelineDesc;
-use super::pipeline_store::{PipelineKey, Specialization, Stages};
+use super::pipeline_store::{GraphicsPipelineDesc, PipelineKey, Specialization, Stages};
 use super::DescriptorSetLayout;
 use super::{Context, VkResult};
 use crate::shaders;

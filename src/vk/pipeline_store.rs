@@ -30,7 +30,6 @@
 //! it at start (`load`, `save`), after checking its header against this
 //! device.
 
-use super::pipeline::GraphicsPipelineDesc;
 use super::VkResult;
 use ash::vk;
 use std::collections::{HashMap, VecDeque};
@@ -378,5 +377,44 @@ fn keep(kept: &mut VecDeque<Arc<SharedPipeline>>, shared: &Arc<SharedPipeline>) 
     kept.push_back(shared.clone());
     if kept.len() > KEPT {
         kept.pop_front();
+    }
+}
+
+/// How a graphics pipeline is built. Geometry comes from storage buffers
+/// (vertex pulling), so there is no vertex input state.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct GraphicsPipelineDesc<'a> {
+    pub vertex: &'a str,
+    pub geometry: Option<&'a str>,
+    pub fragment: &'a str,
+    pub color_formats: Vec<vk::Format>,
+    pub depth_format: Option<vk::Format>,
+    pub depth_test: bool,
+    pub depth_write: bool,
+    /// Additive blending (one + one) on every colour attachment.
+    pub additive: bool,
+    pub cull: vk::CullModeFlags,
+    pub topology: vk::PrimitiveTopology,
+    pub push_size: u32,
+    /// Specialisation constants, the same for every stage.
+    pub specialization: Specialization,
+}
+
+impl<'a> GraphicsPipelineDesc<'a> {
+    pub fn new(vertex: &'a str, fragment: &'a str) -> Self {
+        Self {
+            vertex,
+            geometry: None,
+            fragment,
+            color_formats: Vec::new(),
+            depth_format: None,
+            depth_test: false,
+            depth_write: false,
+            additive: false,
+            cull: vk::CullModeFlags::NONE,
+            topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            push_size: 0,
+            specialization: Specialization::new(),
+        }
     }
 }

@@ -213,7 +213,7 @@ fn total(img: &[f32], mask: impl Fn(u32, u32) -> bool) -> f64 {
     for y in 0..SIZE {
         for x in 0..SIZE {
             if mask(x, y) {
-                s += caustics::techniques::water_photons::denoise::luminance(px(img, x, y)) as f64;
+                s += caustics::radiometry::luminance(px(img, x, y)) as f64;
             }
         }
     }
@@ -225,7 +225,7 @@ fn mse(img: &[f32]) -> f64 {
     let mut s = 0.0;
     for y in 0..SIZE {
         for x in 0..SIZE {
-            let lum = caustics::techniques::water_photons::denoise::luminance;
+            let lum = caustics::radiometry::luminance;
             let e = (lum(px(img, x, y)) - lum(smooth_mean(x, y))) as f64;
             s += e * e;
         }
@@ -283,7 +283,7 @@ fn constant_input_stays_constant() {
 }
 
 fn common_lum(c: Vec3) -> f32 {
-    caustics::techniques::water_photons::denoise::luminance(c)
+    caustics::radiometry::luminance(c)
 }
 
 /// Zero stays exactly zero; huge isolated photons next to depth edges and

@@ -33,12 +33,12 @@
 
 use crate::common;
 
-use caustics::cascades::CascadeLayout;
 use caustics::frame::{FrameTargets, SceneGpu};
 use caustics::gpu::GpuTriangle;
 use caustics::params::{ParamSet, Params};
 use caustics::scene::{MaterialKind, Scene, Water, Wave};
 use caustics::shader_bindings as b;
+use caustics::techniques::water_photons::cascades::CascadeLayout;
 use caustics::techniques::water_photons::{
     GpuWaterPhoton, WaterPhotons, WaterPhotonsParams, GUARD_PHOTONS, GUARD_WORD,
 };

@@ -14,6 +14,7 @@ use crate::passes::light_views::photon_view;
 use crate::passes::light_views::{LightView, LightViewConsumer};
 use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::passes::surface_frame::SurfaceFrame;
+use crate::radiometry::luminance;
 use crate::scene::{Density, Light, LightKind, Scene};
 use crate::vk::{
     begin_rendering, end_rendering, groups_8x8, step, Access, BindingKind, Buffer, BufferUsage,
@@ -263,10 +264,6 @@ pub struct BeamTracer {
     caustic_pipeline: GraphicsPipeline,
     sets: BeamSets,
     _layouts: BeamLayouts,
-}
-
-fn luminance(c: glam::Vec3) -> f32 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
 }
 
 /// The energy criterion's reference per light: the flux of its whole view

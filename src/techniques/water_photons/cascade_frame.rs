@@ -2,7 +2,7 @@
 //! followed as the camera moves, and the water's bounds and wave data the
 //! shaders need.
 
-use crate::cascades::{light_position, CascadeLayout, LightRange};
+use super::cascades::{light_position, CascadeLayout, LightRange};
 use crate::scene::Water;
 use glam::{Mat4, Vec3};
 

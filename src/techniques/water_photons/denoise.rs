@@ -46,6 +46,7 @@
 //! pixels and narrow at bright ones adds energy around isolated photons).
 
 use super::bindings;
+use crate::radiometry::luminance;
 use crate::scene::{Camera, Light, LightKind, Scene};
 use crate::vk::{
     copy_image, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
@@ -132,11 +133,6 @@ struct Push {
     mode: [u32; 4],
 }
 const _: () = assert!(std::mem::size_of::<Push>() == 48);
-
-/// Rec. 709 luminance of linear rgb, as `luminance()` in glsl/common/optics.glsl.
-pub fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
-}
 
 /// Eq. 25: the luminance threshold C_scene (W/m²) from L_min (see the module doc).
 pub fn c_scene(l_min: Vec3) -> f32 {

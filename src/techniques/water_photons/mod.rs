@@ -6,7 +6,7 @@
 //!    the cascaded caustic maps: N cascades of ccm_0² texels, scale s, one
 //!    orthographic projection each (Eq. 2) from one light view (Eq. 1,
 //!    centred on the camera's position, followed frame by frame), layer c of a 2D
-//!    array holding world position and normal (src/cascades.rs).
+//!    array holding world position and normal (cascades.rs).
 //! 2. "photon trace" (`trace`, glsl/water_photons/trace.comp): Algorithm 1
 //!    maps each thread to (texel, cascade); Algorithm 3 traces a shadow ray,
 //!    then the reflected and refracted rays through the BVH; a diffuse hit
@@ -68,7 +68,7 @@
 //! cascade c − 1 and cascade c's ring as well, since the ring's texels line
 //! up with the finer cascade's border when Eq. 6 is integral (a tent kernel
 //! sums to one only within one lattice: ±25% bands at the seams for s = 2).
-//! Where Eq. 6 is rounded (src/cascades.rs), the ring's inner edge is off
+//! Where Eq. 6 is rounded (cascades.rs), the ring's inner edge is off
 //! the finer cascade's border by |ΔX − ccm_0 (1 − 1/s)/2| < 1/2 texel of
 //! cascade c: a band of that width along the seam is covered twice (ΔX
 //! rounded up) or not at all (rounded down), E doubled or zero there; the
@@ -140,6 +140,7 @@
 
 pub mod bindings;
 mod cascade_frame;
+pub mod cascades;
 mod ccm;
 pub mod denoise;
 mod params;
@@ -157,7 +158,6 @@ pub use trace::{GpuWaterPhoton, PhotonCounts, Trace, GUARD_PHOTONS, GUARD_WORD};
 pub use view::WaterView;
 
 use super::{Technique, TechniqueBuild};
-use crate::cascades::{inner_cascade_size, CascadeLayout};
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::gpu::GpuFrame;
 use crate::params::{ParamSet, Params};
@@ -168,6 +168,7 @@ use crate::scene::{Light, LightKind, Scene, Water};
 use crate::shader_bindings as b;
 use crate::vk::{Buffer, BufferUsage, Context, FrameRecorder, Specialization, VkResult};
 use anyhow::Context as _;
+use cascades::{inner_cascade_size, CascadeLayout};
 use glam::{Mat4, Vec3};
 use std::mem::size_of;
 use std::sync::Arc;

@@ -10,8 +10,8 @@
 //! and [`PhotonCounts`]).
 
 use super::bindings;
+use super::cascades::CascadeLayout;
 use super::WpParamsBuffer;
-use crate::cascades::CascadeLayout;
 use crate::frame::SceneGpu;
 use crate::vk::{
     step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,

@@ -1,9 +1,7 @@
 //! Cascaded caustic maps (CCMs): their layout on the CPU, after Kougianos &
 //! Moustakas 2021, "Large-scale ray traced water caustics in real-time using
-//! cascaded caustic maps", §3.1 and Appendix A. A building block of the
-//! `water_photons` technique (src/techniques/water_photons/), kept apart
-//! from it because it is plain arithmetic that the shaders mirror and the
-//! tests check.
+//! cascaded caustic maps", §3.1 and Appendix A: plain arithmetic, in a
+//! module of its own because the shaders mirror it and the tests check it.
 //!
 //! N cascades share one light view (Eq. 1) and one texture resolution
 //! ccm_0 (Eq. 3); cascade c's orthographic projection covers s^c times the
