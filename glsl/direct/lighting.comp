@@ -19,6 +19,7 @@
 #include "medium.glsl"
 #include "emitters.glsl"
 #include "bvh.glsl"
+#include "traced_direct.glsl"
 #include "sh.glsl"
 
 #define SHADOW_SET 1
@@ -41,12 +42,6 @@ layout(push_constant) uniform Push {
 
 // A_l L_lm of the environment's table (environment_sh.comp).
 layout(set = 1, binding = DIRECT_BINDING_ENVIRONMENT_SH, std430) readonly buffer ShBlock { vec4 sh[9]; };
-
-// Offsets a shadow ray's origin off the surface, scaled with |x| to
-// survive float rounding.
-vec3 shadow_origin(vec3 x, vec3 n) {
-    return x + n * (1e-4 * (1.0 + max(abs(x.x), max(abs(x.y), abs(x.z)))));
-}
 
 // The fraction of the environment's table that x (normal n) sees, weighted
 // as its irradiance weighs it: over K = sky_rays cosine-weighted directions
@@ -82,9 +77,8 @@ float sky_visibility(vec3 x, vec3 n, ivec2 p) {
 // Irradiance at x (normal n, facing the camera) from the environment and the
 // area lights (docs/ARCHITECTURE.md, "Environment and area lights in
 // direct"): the environment's table by its order-2 spherical-harmonic
-// irradiance times its visibility (sky_visibility); the environment's sun (a sky's, or the one found in
-// an image) as a directional light with a BVH shadow ray toward its centre; each area light's exact unoccluded
-// irradiance (emitters.glsl) times one BVH shadow ray toward its centre.
+// irradiance times its visibility (sky_visibility); the environment's sun
+// and each area light by BVH shadow rays (glsl/common/traced_direct.glsl).
 vec3 extended_irradiance(vec3 x, vec3 n, ivec2 p) {
     vec3 e = vec3(0.0);
     if (environment_present()) {
@@ -93,23 +87,8 @@ vec3 extended_irradiance(vec3 x, vec3 n, ivec2 p) {
         vec3 sky = vec3(0.0);
         for (int k = 0; k < 9; ++k) sky += sh[k].rgb * y[k];
         e += max(sky, vec3(0.0)) * sky_visibility(x, n, p);
-        vec3 to_sun;
-        vec3 sun = environment_sun_irradiance(to_sun);
-        float cos_sun = dot(n, to_sun);
-        if (cos_sun > 0.0 && any(greaterThan(sun, vec3(0.0)))
-                && !trace_any(shadow_origin(x, n), to_sun, 0.0, 1e30)) {
-            e += sun * cos_sun * medium_transmittance_steps(x, to_sun, light_travel(1e30, x), pc.medium_steps);
-        }
     }
-    for (uint i = 0u; i < frame.components.y; ++i) {
-        vec3 to_light;
-        float reach;
-        vec3 ei = emitter_irradiance(i, x, n, to_light, reach);
-        if (all(equal(ei, vec3(0.0)))) continue;
-        if (trace_any(shadow_origin(x, n), to_light, 0.0, reach)) continue;
-        e += ei * medium_transmittance_steps(x, to_light, reach, pc.medium_steps);
-    }
-    return e;
+    return e + sun_and_area_irradiance(x, n, pc.medium_steps);
 }
 
 void main() {

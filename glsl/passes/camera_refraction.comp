@@ -26,14 +26,20 @@
 // opaque frame holds L(x) as radiance of the surface (albedo/pi E), the
 // medium around the receiver being the refractor's.
 // Mirror at p1: L = reflectance * L(p1, R).
-// L(o, d): the image-space search of the opaque frame (below); a ray that
-// leaves the view or the scene's bounding sphere reads the environment
-// (glsl/common/emitters.glsl, the emitted component): exact for a ray that
-// leaves the bounding sphere, an approximation for one that leaves the view
-// (an off-screen surface may lie ahead; the search cannot see it).
+// L(o, d): the image-space search of the opaque frame (below), the fast
+// path; where it finds nothing (the ray leaves the view, or passes only
+// behind nearer objects) the ray is traced through the scene's BVH instead
+// (`traced_radiance`, a hybrid as later work after Wyman's does), and one
+// that leaves the scene reads the environment (glsl/common/emitters.glsl,
+// the emitted component).
 #include "scene.glsl"
 #include "optics.glsl"
 #include "emitters.glsl"
+#include "bvh.glsl"
+#include "lights.glsl"
+#include "random.glsl"
+#include "medium.glsl"
+#include "traced_direct.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -127,14 +133,73 @@ float frustum_exit(vec3 o, vec3 d) {
     return t * (1.0 - 1e-4);
 }
 
+// Midpoint steps of the fallback's transmittance in an inhomogeneous medium
+// (exact for constant density), as `direct`'s default.
+const uint FALLBACK_MEDIUM_STEPS = 16u;
+// Specular surfaces a traced fallback ray passes through at most before
+// it gives up (the opaque frame holds no specular surface, so neither
+// does what stands in for it).
+const uint FALLBACK_SPECULAR_SKIPS = 4u;
+
+// What the opaque frame would hold for a surface it does not show: the ray
+// (o, d) traced through the BVH, past specular surfaces, to its first
+// diffuse surface x, and there (as glsl/direct/lighting.comp shades, with
+// BVH shadow rays where it uses shadow maps) the direct light of the
+// scene's punctual lights, of the environment's sun and of each area light
+// (glsl/common/traced_direct.glsl), attenuated by the medium along the
+// light's leg and from x back to o; an area light's front face gives its
+// radiance. Not
+// there: the environment table's sky light on x and the surface caustics
+// at x, which live only in screen-space images (so an off-screen surface
+// lacks them). A ray that escapes reads the environment. `t_hit`: the
+// distance to x, -1 when it escapes.
+vec3 traced_radiance(vec3 o, vec3 d, out float t_hit) {
+    t_hit = -1.0;
+    float t_min = 0.0;
+    for (uint k = 0u; k <= FALLBACK_SPECULAR_SKIPS; ++k) {
+        Hit hit;
+        if (!trace_closest(o, d, t_min, 1e30, hit)) break;
+        uint m = hit_material(hit);
+        if (material_kind(m) != MATERIAL_DIFFUSE) {
+            t_min = hit.t + 1e-4 * (1.0 + hit.t);
+            continue;
+        }
+        t_hit = hit.t;
+        vec3 x = o + hit.t * d;
+        vec3 ng = hit_geometric_normal(hit);
+        bool front = dot(d, ng) < 0.0;
+        vec3 n_side = front ? ng : -ng;
+        vec3 ns = hit_normal(hit);
+        vec3 n = dot(ns, n_side) > 0.0 ? ns : -ns;
+        vec3 so = shadow_origin(x, n_side);
+        vec3 e = vec3(0.0);
+        for (uint l = 0u; l < frame.counts.x; ++l) {
+            vec3 to_light;
+            float dist;
+            vec3 el = light_irradiance(l, x, n, to_light, dist);
+            if (all(equal(el, vec3(0.0)))) continue;
+            if (trace_any(so, to_light, 0.0, dist > 1e29 ? 1e30 : dist * (1.0 - 1e-4))) continue;
+            e += el * medium_transmittance_steps(x, to_light, light_travel(dist, x), FALLBACK_MEDIUM_STEPS);
+        }
+        e += sun_and_area_irradiance(x, n, FALLBACK_MEDIUM_STEPS);
+        vec3 emission = front ? materials[m].emission.rgb : vec3(0.0);
+        vec3 l = component_weight(COMPONENT_DIRECT) * hit_albedo(hit) / PI * e
+            + component_weight(COMPONENT_EMITTED) * emission;
+        return l * medium_transmittance_steps(x, -d, hit.t, FALLBACK_MEDIUM_STEPS);
+    }
+    return component_weight(COMPONENT_EMITTED) * environment_radiance(d);
+}
+
 // Image-space search of the opaque frame along (o, d) (Wyman 2006 cites
 // linear [Wyman05b] and binary [Policarpo05] searches; we do both): linear
 // steps over the part of the ray inside both the view frustum and the
 // scene's bounding sphere until the ray passes behind the opaque depth,
 // then bisection between the last two steps. A crossing whose refined gap
 // exceeds one step plus the surface's depth change across a pixel is the
-// ray passing behind a nearer object, not meeting it: the march goes on. Past the frustum nothing can be found (the
-// frustum is convex, the ray never comes back): environment.
+// ray passing behind a nearer object, not meeting it: the march goes on.
+// Past the frustum the search can find nothing (the frustum is convex, the
+// ray never comes back): there, and where the march ends without a hit,
+// the ray is traced (`traced_radiance`).
 vec3 search_opaque_hit(vec3 o, vec3 d, out float t_hit) {
     t_hit = -1.0;
     vec3 oc = o - frame.scene_sphere.xyz;
@@ -142,14 +207,14 @@ vec3 search_opaque_hit(vec3 o, vec3 d, out float t_hit) {
     float disc = b * b - (dot(oc, oc) - frame.scene_sphere.w * frame.scene_sphere.w);
     if (disc <= 0.0) return component_weight(COMPONENT_EMITTED) * environment_radiance(d);
     float t_max = min(-b + sqrt(disc), frustum_exit(o, d));
-    if (t_max <= 0.0) return component_weight(COMPONENT_EMITTED) * environment_radiance(d);
+    if (t_max <= 0.0) return traced_radiance(o, d, t_hit);
     float step = t_max / float(max(pc.search_steps, 1u));
     float t_prev = 0.0;
     for (uint i = 1u; i <= pc.search_steps; ++i) {
         float t = step * float(i);
         ivec2 q;
         float gap, z;
-        if (!project(o + t * d, q, z)) return component_weight(COMPONENT_EMITTED) * environment_radiance(d);
+        if (!project(o + t * d, q, z)) return traced_radiance(o, d, t_hit);
         if (behind_opaque(o + t * d, q, gap)) {
             float lo = t_prev, hi = t;
             for (int k = 0; k < BISECTIONS; ++k) {
@@ -166,7 +231,7 @@ vec3 search_opaque_hit(vec3 o, vec3 d, out float t_hit) {
         }
         t_prev = t;
     }
-    return component_weight(COMPONENT_EMITTED) * environment_radiance(d);
+    return traced_radiance(o, d, t_hit);
 }
 
 vec3 search_opaque(vec3 o, vec3 d) {

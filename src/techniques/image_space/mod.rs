@@ -34,13 +34,14 @@
 //! time changed; other frames reuse the last caustic map.
 //!
 //! Limits: two interfaces only (light inside the glass is never reflected
-//! again; the remedies stand in for TIR); rays that leave the view or the
-//! scene's bounding sphere read the environment, which is black (scene
-//! files have no background; the reference also gives escaping rays 0);
-//! the search only finds what the camera sees (no surface hidden behind
-//! another or off screen), and a crossing deeper than one search step (plus
-//! a pixel's depth footprint) is taken for a ray passing behind a nearer
-//! object; glass seen through
+//! again; the remedies stand in for TIR); the search only finds what the
+//! camera sees, and a crossing deeper than one search step (plus a pixel's
+//! depth footprint) is taken for a ray passing behind a nearer object;
+//! where it finds nothing (a ray that leaves the view, or passes only
+//! behind nearer objects) the ray is traced through the BVH instead and
+//! the surface it meets shaded with its direct light, without the sky
+//! light of an environment table or the surface caustics (screen-space
+//! images: an off-screen surface lacks them); glass seen through
 //! glass (nested or overlapping refractors) is not refracted twice: the
 //! opaque frame has no specular surfaces. Open sheets (water: a dielectric
 //! with no back surface, i.e. an empty back-face texel and d_N = 0) are one
