@@ -281,6 +281,15 @@ impl SceneGpu {
         &self.bvh
     }
 
+    /// Whether this frame draws component `c` (`components` has its bit).
+    /// A technique skips the passes whose only output is a component not
+    /// drawn: the shaders would multiply it by `component_weight` = 0, so
+    /// the image is the same, and a component's frame (the demo's C key,
+    /// `render --component`, `compare`) costs only what it draws.
+    pub fn draws(&self, c: Component) -> bool {
+        self.components & c.mask() != 0
+    }
+
     /// Refits the BVH to the triangles at `time` (animated scenes) and
     /// writes both through this frame's upload ring: earlier frames in
     /// flight still read the old geometry, which the frame's copy replaces

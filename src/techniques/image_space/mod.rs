@@ -159,13 +159,17 @@ impl Technique for ImageSpace {
         targets: &FrameTargets,
     ) -> VkResult<()> {
         self.surface.record_opaque(rec, scene)?;
-        if self.caustics.needs_update(scene) {
-            self.caustics.begin(rec, scene, &self.light_views)?;
-            self.light_views
-                .record(rec, scene, &mut [&mut self.caustics]);
+        // The caustic map's passes only add surface caustics
+        // (`SceneGpu::draws`); a skipped map is not marked current.
+        if scene.draws(Component::SurfaceCaustics) {
+            if self.caustics.needs_update(scene) {
+                self.caustics.begin(rec, scene, &self.light_views)?;
+                self.light_views
+                    .record(rec, scene, &mut [&mut self.caustics]);
+            }
+            self.caustics
+                .apply(rec, scene, self.surface.gbuffer(), self.surface.opaque());
         }
-        self.caustics
-            .apply(rec, scene, self.surface.gbuffer(), self.surface.opaque());
         self.surface.record_refraction(rec, scene, targets);
         Ok(())
     }

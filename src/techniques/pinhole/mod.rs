@@ -549,7 +549,11 @@ impl Technique for Pinhole {
         targets: &FrameTargets,
     ) -> VkResult<()> {
         self.surface.record_opaque(rec, scene)?;
-        self.record_caustics(rec, scene);
+        // Every caustic pass only adds surface caustics
+        // (`SceneGpu::draws`).
+        if scene.draws(Component::SurfaceCaustics) {
+            self.record_caustics(rec, scene);
+        }
         self.surface.record_refraction(rec, scene, targets);
         Ok(())
     }

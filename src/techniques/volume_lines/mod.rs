@@ -95,7 +95,7 @@ use crate::frame::{FrameTargets, SceneGpu};
 use crate::params::{ParamSet, Params};
 use crate::passes::airlight::{Airlight, AirlightParams};
 use crate::passes::caustic_map::{CausticMap, ImageSpaceParams};
-use crate::passes::light_views::LightViews;
+use crate::passes::light_views::{LightViewConsumer, LightViews};
 use crate::passes::surface_frame::SurfaceFrame;
 use crate::radiometry::Component;
 use crate::scene::{Light, Scene};
@@ -271,29 +271,42 @@ impl Technique for VolumeLines {
         targets: &FrameTargets,
     ) -> crate::vk::VkResult<()> {
         self.surface.record_opaque(rec, scene)?;
-        self.rays.begin(rec, scene, &self.surface, targets);
-        // One loop over the lights for the caustic map's photons and B's
-        // rays when they share a resolution (one light view each).
-        let caustics = self.caustics.needs_update(scene);
+        // The caustic map only adds surface caustics and B's rays only
+        // volume caustics: each runs only when its component is drawn
+        // (`SceneGpu::draws`; a skipped map is not marked current).
+        let surface = scene.draws(Component::SurfaceCaustics);
+        let rays = scene.draws(Component::VolumeCaustics);
+        if rays {
+            self.rays.begin(rec, scene, &self.surface, targets);
+        }
+        let caustics = surface && self.caustics.needs_update(scene);
         if caustics {
             let views = self.caustic_views.as_ref().unwrap_or(&self.light_views);
             self.caustics.begin(rec, scene, views)?;
         }
-        match (&self.caustic_views, caustics) {
-            (None, true) => {
-                self.light_views
-                    .record(rec, scene, &mut [&mut self.caustics, &mut self.rays])
+        // One loop over the lights for the caustic map's photons and B's
+        // rays when they share a resolution (one light view each).
+        let mut consumers: Vec<&mut dyn LightViewConsumer> = Vec::with_capacity(2);
+        if caustics {
+            match &self.caustic_views {
+                Some(views) => views.record(rec, scene, &mut [&mut self.caustics]),
+                None => consumers.push(&mut self.caustics),
             }
-            (Some(views), true) => {
-                views.record(rec, scene, &mut [&mut self.caustics]);
-                self.light_views.record(rec, scene, &mut [&mut self.rays]);
-            }
-            (_, false) => self.light_views.record(rec, scene, &mut [&mut self.rays]),
         }
-        self.caustics
-            .apply(rec, scene, self.surface.gbuffer(), self.surface.opaque());
+        if rays {
+            consumers.push(&mut self.rays);
+        }
+        if !consumers.is_empty() {
+            self.light_views.record(rec, scene, &mut consumers);
+        }
+        if surface {
+            self.caustics
+                .apply(rec, scene, self.surface.gbuffer(), self.surface.opaque());
+        }
         self.surface.record_refraction(rec, scene, targets);
-        self.rays.composite(rec, scene, targets);
+        if rays {
+            self.rays.composite(rec, scene, targets);
+        }
         // A: single scattering straight from the lights, shadowed by every
         // object (the shadow maps C recorded this frame).
         self.airlight
