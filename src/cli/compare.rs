@@ -1,9 +1,9 @@
 //! `caustics compare`: every applicable technique against the ground truth
 //! in one command (docs/REPORTS.md). The reference is traced (two equal
 //! half-runs, whose difference is its own noise), taken from the cache, or
-//! read from `--reference`; each technique renders its full frame and each
-//! of its components, timed over `--frames`; the metrics are the tests'
-//! (`caustics::compare::metrics`). Each file is written as soon as it is
+//! read from `--reference`; each technique renders each of its components
+//! (which warm it up) and then its full frame, timed over `--frames`; the
+//! metrics are the tests' (`caustics::compare::metrics`). Each file is written as soon as it is
 //! made, to a temporary renamed into place with all the others at the end
 //! (`output::Batch`; removed on SIGINT/SIGTERM or an error), report.json
 //! last, so a failed or interrupted run leaves none of its files. What
@@ -418,28 +418,11 @@ fn run_technique(
         .map_err(|e| super::name_arguments(e, &args.scene, name, &[]))?;
     r.set_frame_options(FrameOptions::default())?;
     *timing_source = Some(r.frames.source.describe().to_string());
-    // Warm-up (pipeline compilation), then the timed frames, all at the
-    // comparison's time so the last one is the image compared.
-    r.render_frame(time)?;
-    let start = Instant::now();
-    for _ in 0..args.frames {
-        r.submit_frame(time)?;
-    }
-    let done = r.finish()?;
-    let timing = Timing {
-        frames: args.frames,
-        frame_ms: start.elapsed().as_secs_f64() * 1e3 / args.frames as f64,
-        passes_ms: pass_stats(&done),
-    };
-    let image = r.radiance()?;
-    let (full, map) = metrics::compare(&image, &reference.all, width, height, exposure);
-    staging.write_pair(name, width, height, &image, exposure)?;
-    staging.write_map(&format!("{name}_flip"), &map)?;
-    let thumbnails = [
-        thumbnail_of(&image, width, height, exposure),
-        sheet::thumbnail(map.magma_rgb8(), width, height),
-    ];
-    drop((image, map));
+    // Each component's frame first, all at the comparison's time. Together
+    // they run every pass once (a technique skips in a component's frame
+    // only the passes of the components it does not draw,
+    // `SceneGpu::draws`), so they are the warm-up (pipeline compilation)
+    // the timed frames need; a separate warm-up frame only without them.
     let mut components = Vec::new();
     for &c in info.components {
         r.scene_gpu.components = c.mask();
@@ -462,6 +445,30 @@ fn run_technique(
             metrics: m,
         });
     }
+    r.scene_gpu.components = Component::All.mask();
+    if info.components.is_empty() {
+        r.render_frame(time)?;
+    }
+    // The timed frames; the last one is the image compared.
+    let start = Instant::now();
+    for _ in 0..args.frames {
+        r.submit_frame(time)?;
+    }
+    let done = r.finish()?;
+    let timing = Timing {
+        frames: args.frames,
+        frame_ms: start.elapsed().as_secs_f64() * 1e3 / args.frames as f64,
+        passes_ms: pass_stats(&done),
+    };
+    let image = r.radiance()?;
+    let (full, map) = metrics::compare(&image, &reference.all, width, height, exposure);
+    staging.write_pair(name, width, height, &image, exposure)?;
+    staging.write_map(&format!("{name}_flip"), &map)?;
+    let thumbnails = [
+        thumbnail_of(&image, width, height, exposure),
+        sheet::thumbnail(map.magma_rgb8(), width, height),
+    ];
+    drop((image, map));
     drop(r);
     let result = TechniqueResult {
         technique: name.into(),
