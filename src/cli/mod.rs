@@ -248,8 +248,8 @@ pub struct CompareArgs {
     /// Diffuse bounces in the reference (0: the single-bounce components the techniques render).
     #[arg(long, default_value_t = 0)]
     pub diffuse_bounces: u32,
-    /// Frames timed per technique, after one warm-up frame.
-    #[arg(long, default_value_t = 5)]
+    /// Full frames timed per technique, after its component frames (which warm it up).
+    #[arg(long, default_value_t = 3)]
     pub frames: u32,
     /// Trace the reference even when the cache (`references` in $CAUSTICS_CACHE_DIR, else $XDG_CACHE_HOME/caustics) holds it, and do not store it.
     #[arg(long)]
