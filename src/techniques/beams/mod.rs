@@ -172,6 +172,10 @@ pub struct Beams {
     /// Airlight with volumetric shadows from the surface frame's shadow maps.
     pub airlight: Airlight,
     last_counts: Option<BeamCounts>,
+    /// Per frame slot: whether its latest frame traced beams (a frame that
+    /// draws neither caustic component does not, `SceneGpu::draws`, and
+    /// copies no counters).
+    traced: Vec<bool>,
 }
 
 impl TechniqueBuild for Beams {
@@ -261,12 +265,14 @@ impl TechniqueBuild for Beams {
             tracer,
             airlight,
             last_counts: None,
+            traced: Vec::new(),
         })
     }
 }
 
 impl Beams {
-    /// The counters of the last completed frame.
+    /// The counters of the last completed frame (None when it traced no
+    /// beams).
     pub fn counts(&self) -> Option<BeamCounts> {
         self.last_counts
     }
@@ -290,12 +296,25 @@ impl Technique for Beams {
         scene: &SceneGpu,
         targets: &FrameTargets,
     ) -> crate::vk::VkResult<()> {
+        // The beams only add surface and volume caustics: a frame that
+        // draws neither skips them (`SceneGpu::draws`).
+        let traced =
+            scene.draws(Component::SurfaceCaustics) || scene.draws(Component::VolumeCaustics);
+        let slot = rec.slot();
+        if self.traced.len() <= slot {
+            self.traced.resize(slot + 1, false);
+        }
+        self.traced[slot] = traced;
         self.surface.record_opaque(rec, scene)?;
-        self.tracer.begin(rec, scene, &self.surface, targets);
-        self.light_views.record(rec, scene, &mut [&mut self.tracer]);
-        self.tracer.apply(rec, scene, &self.surface);
+        if traced {
+            self.tracer.begin(rec, scene, &self.surface, targets);
+            self.light_views.record(rec, scene, &mut [&mut self.tracer]);
+            self.tracer.apply(rec, scene, &self.surface);
+        }
         self.surface.record_refraction(rec, scene, targets);
-        self.tracer.composite(rec, scene, targets);
+        if traced {
+            self.tracer.composite(rec, scene, targets);
+        }
         self.airlight
             .record(rec, scene, self.surface.shadows(), &targets.radiance);
         Ok(())
@@ -311,6 +330,10 @@ impl Technique for Beams {
     }
 
     fn after_frame(&mut self, slot: usize) -> crate::vk::VkResult<()> {
+        if !self.traced.get(slot).copied().unwrap_or(false) {
+            self.last_counts = None;
+            return Ok(());
+        }
         let counts = self.tracer.counts(slot)?;
         if counts.beam_overflow > 0 || counts.triangle_overflow > 0 {
             log::warn!(
