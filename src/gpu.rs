@@ -164,7 +164,8 @@ pub struct GpuFrame {
     /// x lights, y triangles, z materials, w frame index.
     pub counts: [u32; 4],
     /// x: the path-type components techniques draw, a bit mask
-    /// (1 << COMPONENT_*; `Component::mask`); y: area lights; zw reserved.
+    /// (1 << COMPONENT_*; `Component::mask`); y: area lights; z: still
+    /// frames accumulated before this one (`SceneGpu::still_frames`); w reserved.
     pub components: [u32; 4],
 }
 

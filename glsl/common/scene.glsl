@@ -86,7 +86,7 @@ layout(set = SCENE_SET, binding = BINDING_FRAME, std140) uniform FrameBlock {
     vec4 viewport;     // width, height, aspect, time
     vec4 scene_sphere; // centre, radius
     uvec4 counts;      // lights, triangles, materials, frame index
-    uvec4 components;  // x: bit mask of the components drawn (1 << COMPONENT_*); y: area lights
+    uvec4 components;  // x: bit mask of the components drawn (1 << COMPONENT_*); y: area lights; z: still frames before this one
 } frame;
 
 // 1.0 when the path-type component `c` (COMPONENT_*) is drawn this frame,

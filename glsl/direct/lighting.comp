@@ -51,14 +51,16 @@ layout(set = 1, binding = DIRECT_BINDING_ENVIRONMENT_SH, std430) readonly buffer
 // directions are a stratified (Hammersley-like: k + 1/2 over K in one
 // dimension, a golden-ratio sequence in the other) set, rotated per pixel
 // by a random offset (Cranley-Patterson), so the noise is a fixed pattern,
-// not flicker. The cosine-weighted estimate of E = int L v cos dw is
+// not flicker, in motion; each frame of a still view (frame.components.z,
+// passes/accumulate.comp) draws new offsets, which the accumulation
+// averages. The cosine-weighted estimate of E = int L v cos dw is
 // pi/K sum_k L_k v_k; dividing by the same estimate without v leaves the
 // occluded fraction, which scales the noise-free SH irradiance. Exact
 // unoccluded (V = 1) and for a sky of constant radiance as K grows; 1
 // without rays or for a black table.
 float sky_visibility(vec3 x, vec3 n, ivec2 p) {
     if (pc.sky_rays == 0u) return 1.0;
-    uint rng = rng_seed(uint(p.y) * 65536u + uint(p.x), 0x5bd1e995u);
+    uint rng = rng_seed(uint(p.y) * 65536u + uint(p.x), 0x5bd1e995u ^ (frame.components.z * 0x9e3779b9u));
     vec2 shift = vec2(rng_next(rng), rng_next(rng));
     vec3 o = shadow_origin(x, n);
     float seen = 0.0, total = 0.0;

@@ -213,6 +213,8 @@ impl App {
             frames_in_flight: o.frames_in_flight,
             ..FrameOptions::default()
         })?;
+        // A still view converges; moving the camera starts over.
+        renderer.set_accumulation(true)?;
         let now = Instant::now();
         let mut state = State {
             finished: ImageSemaphores::new(&ctx, 0)?,

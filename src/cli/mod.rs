@@ -137,7 +137,9 @@ pub struct TechniqueArgs {
 pub struct RenderArgs {
     #[command(flatten)]
     pub run: TechniqueArgs,
-    /// Frames to render (time advances 1/60 s per frame); timings are averaged over them.
+    /// Frames to render (time advances 1/60 s per frame); timings are
+    /// averaged over them. In a scene without animation the frames show one
+    /// still view and accumulate: the image written is their mean.
     #[arg(long, allow_negative_numbers = true, default_value_t = 1)]
     pub frames: u32,
     /// Path-type component to draw: one the technique renders (`--technique list`) or all.

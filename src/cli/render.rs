@@ -107,6 +107,9 @@ fn start(
     )
     .map_err(|e| super::name_arguments(e, s, &run.technique, &run.params))?;
     renderer.set_frame_options(options)?;
+    // Frames of a still view accumulate (`render --frames N` writes their
+    // mean; an animated scene's frames, at different times, do not).
+    renderer.set_accumulation(true)?;
     Ok((ctx, renderer))
 }
 

@@ -60,6 +60,11 @@ pub struct SceneGpu {
     /// The path-type components techniques draw (`Component::mask` bits),
     /// written into the frame constants; all of them unless a caller narrows it.
     pub components: u32,
+    /// Frames of the same still view accumulated before this one
+    /// (`Renderer::set_accumulation`; 0 in motion or without accumulation):
+    /// the frame constants' `components.z`, which stochastic passes mix
+    /// into their seeds so that each still frame draws new samples.
+    pub still_frames: u32,
     /// Per uploaded triangle, the d_N of its three vertices (kept across
     /// refits, see `update_geometry`).
     normal_thickness: Vec<[f32; 3]>,
@@ -261,6 +266,7 @@ impl SceneGpu {
             stats,
             sphere,
             components: Component::All.mask(),
+            still_frames: 0,
             geometry_time: time,
             normal_thickness,
             bvh,
@@ -404,7 +410,7 @@ impl SceneGpu {
                 scene.materials.len() as u32,
                 frame_index,
             ],
-            components: [self.components, self.emitter_count, 0, 0],
+            components: [self.components, self.emitter_count, self.still_frames, 0],
         };
         self.frame_constants.set(data);
         data

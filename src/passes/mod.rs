@@ -2,6 +2,7 @@
 //! through `FrameRecorder::pass`. Passes know no technique: they import
 //! `frame`, `params`, the scene and the backend, and each other.
 
+pub mod accumulate;
 pub mod airlight;
 pub mod camera_refraction;
 pub mod caustic_map;

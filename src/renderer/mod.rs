@@ -7,6 +7,7 @@
 
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::params::{Apply, Params};
+use crate::passes::accumulate::Accumulate;
 use crate::passes::tonemap::Tonemap;
 use crate::scene::Scene;
 use crate::techniques::{self, Technique};
@@ -61,6 +62,22 @@ pub struct Renderer {
     technique_generation: u64,
     /// The generation that recorded each slot's latest frame.
     slot_generation: Vec<u64>,
+    /// Still-view accumulation, when on (`set_accumulation`).
+    accumulate: Option<Accumulate>,
+    /// The view the accumulated frames show and how many there are; None
+    /// after anything changed that the next frame must not be averaged
+    /// across (every mutator calls `restart_accumulation`).
+    still: Option<(StillView, u32)>,
+}
+
+/// What a frame shows that callers may change between frames through the
+/// renderer's public fields: the camera, the components drawn and, in an
+/// animated scene, the time. Everything else goes through a method.
+#[derive(Clone, Copy, PartialEq)]
+struct StillView {
+    camera: crate::scene::Camera,
+    components: u32,
+    animated_time: Option<u32>,
 }
 
 impl Renderer {
@@ -91,7 +108,48 @@ impl Renderer {
             completed: Vec::new(),
             technique_generation: 0,
             slot_generation: Vec::new(),
+            accumulate: None,
+            still: None,
         })
+    }
+
+    /// Still-view accumulation on or off (off by default). On, each frame
+    /// of a view that has not changed since the last one is averaged with
+    /// the frames before it (passes/accumulate.rs), and its stochastic
+    /// passes draw new samples (`SceneGpu::still_frames`); a changed camera,
+    /// time (in an animated scene), component, parameter, light, scene or
+    /// size starts over. The demo, `bench` and `render --frames N` turn it on.
+    pub fn set_accumulation(&mut self, on: bool) -> VkResult<()> {
+        self.restart_accumulation();
+        if !on {
+            if let Some(old) = self.accumulate.take() {
+                self.frames.defer_release(old);
+            }
+        } else if self.accumulate.is_none() {
+            self.accumulate = Some(Accumulate::new(&self.ctx, &self.targets.radiance)?);
+        }
+        Ok(())
+    }
+
+    /// The next frame starts a new accumulation.
+    fn restart_accumulation(&mut self) {
+        self.still = None;
+    }
+
+    /// Still frames accumulated before the next one at `time` (0: a new
+    /// view), and the view it shows.
+    fn still_frames(&mut self, time: f32) -> u32 {
+        let view = StillView {
+            camera: self.scene.camera,
+            components: self.scene_gpu.components,
+            animated_time: self.scene.is_animated().then(|| time.to_bits()),
+        };
+        let frames = match self.still {
+            Some((still, n)) if still == view && self.accumulate.is_some() => n,
+            _ => 0,
+        };
+        self.still = Some((view, frames.saturating_add(1)));
+        frames
     }
 
     /// Frames in flight and timing mode (waits for the frames in flight first).
@@ -121,6 +179,13 @@ impl Renderer {
             width,
             height,
         )?;
+        let accumulate = match self.accumulate {
+            Some(_) => Some(Accumulate::new(&self.ctx, &targets.radiance)?),
+            None => None,
+        };
+        if let Some(old) = std::mem::replace(&mut self.accumulate, accumulate) {
+            self.frames.defer_release(old);
+        }
         self.replace_technique(technique);
         let old_tonemap = std::mem::replace(&mut self.tonemap, tonemap);
         self.frames.defer_release(old_tonemap);
@@ -163,6 +228,7 @@ impl Renderer {
         let old = std::mem::replace(&mut self.technique, technique);
         self.frames.defer_release(old);
         self.technique_generation += 1;
+        self.restart_accumulation();
     }
 
     /// Frames have completed: hands each one's read-backs to the technique
@@ -206,6 +272,7 @@ impl Renderer {
         });
         if live && self.technique.update_live(params)? {
             self.params = params.clone();
+            self.restart_accumulation();
             return Ok(false);
         }
         self.set_technique(self.technique.name(), params)?;
@@ -241,6 +308,7 @@ impl Renderer {
     /// the lights buffer this rewrites); a user's edit, not every frame.
     pub fn lights_changed(&mut self, time: f32) -> anyhow::Result<()> {
         self.finish()?;
+        self.restart_accumulation();
         if self.technique.set_lights(&self.scene.lights) {
             self.scene_gpu.update_lights(&self.scene)?;
             Ok(())
@@ -270,6 +338,7 @@ impl Renderer {
             anyhow::bail!("the scene has no environment to rotate");
         };
         self.finish()?;
+        self.restart_accumulation();
         self.scene.set_environment_rotation(rotate_deg);
         self.scene_gpu.update_environment(&self.scene)?;
         if !self.technique.environment_changed() {
@@ -300,6 +369,7 @@ impl Renderer {
     /// it, after the frames in flight that read it.
     pub fn medium_changed(&mut self) -> VkResult<()> {
         self.finish()?;
+        self.restart_accumulation();
         self.scene_gpu.update_medium(&self.scene)
     }
 
@@ -313,6 +383,8 @@ impl Renderer {
         time: f32,
         present: impl FnOnce(&mut FrameRecorder, &Image) -> Result<FrameSync, E>,
     ) -> Result<(), E> {
+        let still_frames = self.still_frames(time);
+        self.scene_gpu.still_frames = still_frames;
         let (mut rec, done) = self.frames.begin_frame()?;
         let slot = rec.slot();
         // Their fences have signalled: their read-backs are current.
@@ -338,6 +410,9 @@ impl Renderer {
             .technique
             .record(&mut rec, &self.scene_gpu, &self.targets)
             .map(|()| {
+                if let Some(accumulate) = &self.accumulate {
+                    accumulate.record(&mut rec, &self.targets.radiance, still_frames);
+                }
                 self.tonemap
                     .record(&mut rec, &self.targets.radiance, self.scene.output.exposure)
             });

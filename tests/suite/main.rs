@@ -11,6 +11,7 @@
 
 mod common;
 
+mod accumulation;
 mod airlight;
 mod beams;
 mod bvh_gpu;
