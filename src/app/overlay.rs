@@ -108,6 +108,7 @@ mod enabled {
     use super::*;
     use crate::params::Apply;
     use crate::techniques::TECHNIQUES;
+    use crate::vk::CommandPool;
     use egui_ash_renderer::{DynamicRendering, Options, RenderMode, Renderer};
 
     pub struct Overlay {
@@ -116,7 +117,7 @@ mod enabled {
         winit: egui_winit::State,
         renderer: Renderer<egui_ash_renderer::allocator::DefaultAllocator>,
         /// For egui-ash-renderer's blocking texture uploads.
-        pool: vk::CommandPool,
+        pool: CommandPool,
         visible: bool,
         primitives: Vec<egui::ClippedPrimitive>,
         pixels_per_point: f32,
@@ -136,14 +137,7 @@ mod enabled {
             format: vk::Format,
             frames_in_flight: usize,
         ) -> anyhow::Result<Self> {
-            let pool = unsafe {
-                ctx.device.create_command_pool(
-                    &vk::CommandPoolCreateInfo::default()
-                        .queue_family_index(ctx.queue_family)
-                        .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER),
-                    None,
-                )
-            }?;
+            let pool = CommandPool::new(ctx)?;
             let renderer = Renderer::with_default_allocator(
                 &ctx.instance,
                 ctx.physical_device,
@@ -160,13 +154,7 @@ mod enabled {
                     ..Default::default()
                 },
             );
-            let renderer = match renderer {
-                Ok(r) => r,
-                Err(e) => {
-                    unsafe { ctx.device.destroy_command_pool(pool, None) };
-                    anyhow::bail!("egui renderer: {e}");
-                }
-            };
+            let renderer = renderer.map_err(|e| anyhow::anyhow!("egui renderer: {e}"))?;
             let egui = egui::Context::default();
             let winit = egui_winit::State::new(
                 egui.clone(),
@@ -267,7 +255,7 @@ mod enabled {
             for (id, deltas) in &output.textures_delta.set {
                 for delta in deltas {
                     self.renderer
-                        .set_texture(self.ctx.queue, self.pool, *id, delta)?;
+                        .set_texture(self.ctx.queue, self.pool.raw, *id, delta)?;
                 }
             }
             self.to_free
@@ -621,12 +609,5 @@ mod enabled {
             points,
             egui::Stroke::new(1.5, egui::Color32::LIGHT_GREEN),
         ));
-    }
-
-    impl Drop for Overlay {
-        fn drop(&mut self) {
-            // The demo waited for the device before dropping the state.
-            unsafe { self.ctx.device.destroy_command_pool(self.pool, None) };
-        }
     }
 }

@@ -584,7 +584,7 @@ impl LightViewConsumer for CausticMap {
                         bytemuck::bytes_of(&push),
                         extent,
                     );
-                    unsafe { ctx.device.cmd_draw(cmd, count, 1, 0, 0) };
+                    crate::vk::draw(&ctx, cmd, count);
                     end_rendering(&ctx, cmd);
                 }
             });

@@ -145,7 +145,7 @@ impl GBuffer {
                         bytemuck::bytes_of(&opaque_only),
                         extent,
                     );
-                    unsafe { ctx.device.cmd_draw(cmd, 3 * scene.triangle_count, 1, 0, 0) };
+                    crate::vk::draw(&ctx, cmd, 3 * scene.triangle_count);
                 }
                 end_rendering(&ctx, cmd);
             });

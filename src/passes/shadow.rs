@@ -313,7 +313,7 @@ impl ShadowMaps {
                                 bytemuck::bytes_of(&push),
                                 extent,
                             );
-                            unsafe { ctx.device.cmd_draw(cmd, 3 * scene.triangle_count, 1, 0, 0) };
+                            crate::vk::draw(&ctx, cmd, 3 * scene.triangle_count);
                         }
                         end_rendering(&ctx, cmd);
                     }

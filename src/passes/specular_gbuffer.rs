@@ -200,7 +200,7 @@ impl SpecularGBuffer {
                 };
                 self.pipeline
                     .bind(cmd, &[&scene.set], bytemuck::bytes_of(&push), extent);
-                unsafe { ctx.device.cmd_draw(cmd, 3 * scene.triangle_count, 1, 0, 0) };
+                crate::vk::draw(ctx, cmd, 3 * scene.triangle_count);
             }
             end_rendering(ctx, cmd);
         }

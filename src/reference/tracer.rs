@@ -389,11 +389,7 @@ fn fill(ctx: &Context, cmd: ash::vk::CommandBuffer, buffers: &[&Buffer], value: 
     }
     fills.emit();
     for b in buffers {
-        // SAFETY: the buffer is alive and its barrier above orders the fill.
-        unsafe {
-            ctx.device
-                .cmd_fill_buffer(cmd, b.raw, 0, ash::vk::WHOLE_SIZE, value)
-        };
+        crate::vk::fill_buffer(ctx, cmd, b, value);
     }
 }
 

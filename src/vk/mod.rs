@@ -12,6 +12,7 @@
 //! and are destroyed when the last holder (or the store's short keep list)
 //! lets go.
 
+mod commands;
 mod context;
 mod descriptors;
 mod device;
@@ -21,6 +22,7 @@ mod host_memory;
 mod image;
 mod instance;
 mod limits;
+mod objects;
 mod pass;
 mod pipeline;
 mod pipeline_create;
@@ -31,6 +33,9 @@ mod ring;
 mod swapchain;
 mod sync;
 
+pub use commands::{
+    clear_color_image, copy_buffer, draw, draw_indirect, fill_buffer, update_buffer,
+};
 pub use context::{Context, ContextOptions, ValidationCounts};
 pub use descriptors::{BindingKind, DescriptorSet, DescriptorSetLayout, Sampler};
 pub use device::{DeviceInfo, RequiredFeature};
@@ -41,6 +46,7 @@ pub use frame::{
 pub use host_memory::{rust_heap, vulkan_host_memory, CountingAllocator, HostCount};
 pub use image::{Image, ImageDesc};
 pub use limits::{bytes, host_rss, trim_host_heap, MemoryHeaps, MemoryReport};
+pub use objects::{CommandPool, Semaphores};
 pub use pass::{step, Pass, Resource, Sync};
 pub use pipeline::{
     begin_rendering, begin_rendering_with_depth, end_rendering, groups_8x8, ComputePipeline,

@@ -624,10 +624,7 @@ impl BeamTracer {
             .overwrite(&self.surface, Access::ColorAttachment)
             .write(&self.counters, Access::TransferWrite)
             .record(|cmd| {
-                unsafe {
-                    ctx.device
-                        .cmd_fill_buffer(cmd, self.counters.raw, 0, vk::WHOLE_SIZE, 0)
-                };
+                crate::vk::fill_buffer(&ctx, cmd, &self.counters, 0);
                 begin_rendering(
                     &ctx,
                     cmd,
@@ -763,11 +760,7 @@ impl BeamTracer {
                 let groups = groups_8x8(targets.width, targets.height);
                 self.composite_pipeline
                     .dispatch(cmd, &[&scene.set, set], &[], groups);
-                let region = vk::BufferCopy::default().size(self.counters.size);
-                unsafe {
-                    ctx.device
-                        .cmd_copy_buffer(cmd, self.counters.raw, readback.raw, &[region])
-                };
+                crate::vk::copy_buffer(&ctx, cmd, &self.counters, readback, self.counters.size);
                 step(&ctx, cmd).read(readback, Access::HostRead).emit();
             });
     }
@@ -809,20 +802,10 @@ impl LightViewConsumer for BeamTracer {
                 args[0] = first.div_ceil(bb::BEAMS_REFINE_GROUP);
                 args[1] = 1;
                 args[2] = 1;
-                unsafe {
-                    ctx.device.cmd_update_buffer(
-                        cmd,
-                        self.counters.raw,
-                        0,
-                        bytemuck::cast_slice(&light_words),
-                    );
-                    ctx.device.cmd_update_buffer(
-                        cmd,
-                        self.indirect.raw,
-                        0,
-                        bytemuck::cast_slice(&args),
-                    );
-                }
+                let words = bytemuck::cast_slice(&light_words);
+                crate::vk::update_buffer(&ctx, cmd, &self.counters, 0, words);
+                let words = bytemuck::cast_slice(&args);
+                crate::vk::update_buffer(&ctx, cmd, &self.indirect, 0, words);
             });
         for level in 0..=self.refine.grid[1] {
             push.grid[0] = level;
@@ -920,15 +903,8 @@ impl BeamTracer {
                     bytemuck::bytes_of(&self.volume_push),
                     extent,
                 );
-                unsafe {
-                    ctx.device.cmd_draw_indirect(
-                        cmd,
-                        self.indirect.raw,
-                        4 * bb::BEAMS_INDIRECT_DRAW as u64,
-                        1,
-                        0,
-                    )
-                };
+                let offset = 4 * bb::BEAMS_INDIRECT_DRAW as u64;
+                crate::vk::draw_indirect(&ctx, cmd, &self.indirect, offset);
                 end_rendering(&ctx, cmd);
             });
     }

@@ -406,7 +406,7 @@ impl LightViewConsumer for VolumeRays {
                     bytemuck::bytes_of(&self.line_push),
                     extent,
                 );
-                unsafe { ctx.device.cmd_draw(cmd, self.draw_count, 1, 0, 0) };
+                crate::vk::draw(&ctx, cmd, self.draw_count);
                 end_rendering(&ctx, cmd);
             });
     }

@@ -125,7 +125,7 @@ impl Ccm {
                     self.pipeline
                         .bind(cmd, &[&self.set], bytemuck::bytes_of(&push), extent);
                     let vertices = 6 * self.grid[0] * self.grid[1];
-                    unsafe { ctx.device.cmd_draw(cmd, vertices, 1, 0, 0) };
+                    crate::vk::draw(&ctx, cmd, vertices);
                     end_rendering(&ctx, cmd);
                 }
             });

@@ -128,7 +128,7 @@ impl Splat {
                 );
                 self.pipeline
                     .bind(cmd, &[&scene.set, &self.set], &[], extent);
-                unsafe { ctx.device.cmd_draw_indirect(cmd, draw.raw, 0, 1, 0) };
+                crate::vk::draw_indirect(&ctx, cmd, draw, 0);
                 end_rendering(&ctx, cmd);
             });
     }

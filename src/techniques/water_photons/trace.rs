@@ -214,24 +214,8 @@ impl Trace {
                 let none = vk::ClearColorValue {
                     uint32: [u32::MAX; 4],
                 };
-                let all_layers = vk::ImageSubresourceRange {
-                    aspect_mask: vk::ImageAspectFlags::COLOR,
-                    base_mip_level: 0,
-                    level_count: 1,
-                    base_array_layer: 0,
-                    layer_count: vk::REMAINING_ARRAY_LAYERS,
-                };
-                unsafe {
-                    ctx.device
-                        .cmd_update_buffer(cmd, self.draw.raw, 0, bytemuck::bytes_of(&reset));
-                    ctx.device.cmd_clear_color_image(
-                        cmd,
-                        self.slots.raw,
-                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                        &none,
-                        &[all_layers],
-                    );
-                };
+                crate::vk::update_buffer(&ctx, cmd, &self.draw, 0, bytemuck::bytes_of(&reset));
+                crate::vk::clear_color_image(&ctx, cmd, &self.slots, none);
             });
         // The reset before the atomics; the CCM attachments before the
         // storage-image reads; the photons after last frame's vertex reads;
@@ -281,11 +265,7 @@ impl Trace {
                     .read(&self.draw, Access::TransferRead)
                     .write(readback, Access::TransferWrite)
                     .emit();
-                let region = vk::BufferCopy::default().size(self.draw.size);
-                unsafe {
-                    ctx.device
-                        .cmd_copy_buffer(cmd, self.draw.raw, readback.raw, &[region])
-                };
+                crate::vk::copy_buffer(&ctx, cmd, &self.draw, readback, self.draw.size);
                 step(&ctx, cmd).read(readback, Access::HostRead).emit();
             });
     }
