@@ -8,6 +8,7 @@ pub mod camera_refraction;
 pub mod caustic_map;
 pub mod direct_light;
 pub mod gbuffer;
+mod image_compute;
 pub mod light_views;
 pub mod shadow;
 pub mod specular_gbuffer;
