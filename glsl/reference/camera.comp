@@ -12,10 +12,11 @@
 //     follows adds every photon landing within r of it on the side the
 //     camera sees, except photons straight from the light (those are the
 //     direct light above): L S+ D S+ E, L D+ D S+ E, L V D S+ E (trace.comp).
-// Emitters (L S* E, the emitted component): a camera path that escapes adds
-// the environment's radiance, one that meets an area light's front face
-// adds its radiance, whether directly (depth 0: the background, a lamp) or
-// after specular bounces (in a mirror, through glass and water).
+// Emitters (L S* E, the emitted component): EMISSION_GRID^2 camera chains
+// of their own a pixel and pass (`chain_emission`) add the environment's
+// radiance where they escape and an area light's where they meet its front
+// face, whether directly (the background, a lamp) or after specular bounces
+// (in a mirror, through glass and water).
 // How the path space splits: the direct light of the point, spot,
 // directional, rect and triangle lights is this pass's, by shadow rays,
 // which converge far sooner than photons: at every pixel's diffuse point,
@@ -170,6 +171,98 @@ vec3 airlight(vec3 o, vec3 d, float t_end, inout uint rng) {
     return sum;
 }
 
+// Radiance emitted toward a camera path of state `s` at its next hit: the
+// environment where it escapes (from outside glass), an area light's front
+// face; 0 elsewhere.
+vec3 emitted_radiance(SpecularState s, bool found, Hit hit) {
+    if (!found) return environment_present() && !s.inside ? environment_radiance(s.dir) : vec3(0.0);
+    Material m = materials[hit_material(hit)];
+    bool emitter = floatBitsToUint(m.color.w) == MATERIAL_DIFFUSE && any(greaterThan(m.emission.rgb, vec3(0.0)));
+    return emitter && dot(s.dir, hit_geometric_normal(hit)) < 0.0 ? m.emission.rgb : vec3(0.0);
+}
+
+// The attenuation of the segment from s.origin along s.dir to the next hit
+// (`found`) or out of the scene: absorption inside glass, the medium outside.
+vec3 segment_attenuation(SpecularState s, bool found, float t, inout uint rng) {
+    if (s.inside) return found ? exp(-s.inside_absorption * t) : vec3(0.0);
+    float travel = found ? t : 2.0 * frame.scene_sphere.w + length(s.origin - frame.scene_sphere.xyz);
+    return mean_transmittance(s.origin, s.dir, travel, rng);
+}
+
+// The emitted component (L S* E): the emitters a camera ray meets directly
+// (the background, a lamp) or through its specular chain (in a mirror,
+// through glass and water). A `mixed` material's mirror part always
+// continues the chain, weighted by its reflectance (its diffuse part emits
+// nothing further here). At a Fresnel choice the branch not taken is traced
+// one hit further and its emission counted with the weight of not taking
+// it, the branch taken counting its next hit's with the weight of taking
+// it: the expectation is the plain choice's, f E_r + (1 - f) E_t, while a
+// lamp or the sky reflected in glass (F = 4%: one sample in 25 at 25 times
+// the reflection's radiance) no longer comes as fireflies (on `medium_box`
+// its lamp's reflection in the sphere held the noise above 70%).
+vec3 chain_emission(SpecularState s, inout uint rng) {
+    vec3 sum = vec3(0.0);
+    float share = 1.0; // of the emission met at the next hit
+    for (uint depth = 0u; depth < pc.max_depth; ++depth) {
+        Hit hit;
+        bool found = trace_closest(s.origin, s.dir, 0.0, 1e30, hit);
+        Material m;
+        bool diffuse = false, continues = false;
+        if (found) {
+            m = materials[hit_material(hit)];
+            diffuse = floatBitsToUint(m.color.w) == MATERIAL_DIFFUSE;
+            continues = !(diffuse && all(equal(m.specular.rgb, vec3(0.0))));
+        }
+        vec3 radiance = emitted_radiance(s, found, hit);
+        bool emits = any(greaterThan(radiance, vec3(0.0)));
+        if (!emits && !continues) break; // no attenuation to compute
+        vec3 tr = segment_attenuation(s, found, found ? hit.t : 0.0, rng);
+        sum += share * s.weight * tr * radiance;
+        if (!continues) break;
+        s.weight *= tr;
+        vec3 x = s.origin + hit.t * s.dir;
+        vec3 ng = hit_geometric_normal(hit);
+        bool front = dot(s.dir, ng) < 0.0;
+        if (diffuse) {
+            mirror_bounce(s, x, ng, hit_normal(hit), front, m.specular.rgb);
+            share = 1.0;
+            continue;
+        }
+        SpecularState reflected = s;
+        SpecularState other = s;
+        float p_reflect = specular_bounce(reflected, x, ng, hit_normal(hit), front, m, -1.0, true);
+        specular_bounce(other, x, ng, hit_normal(hit), front, m, 2.0, true);
+        share = p_reflect;
+        if (rng_next(rng) < p_reflect) {
+            s = reflected;
+        } else {
+            s = other;
+            other = reflected;
+            share = 1.0 - p_reflect;
+        }
+        if (share < 1.0) {
+            Hit other_hit;
+            bool other_found = trace_closest(other.origin, other.dir, 0.0, 1e30, other_hit);
+            vec3 other_radiance = emitted_radiance(other, other_found, other_hit);
+            if (any(greaterThan(other_radiance, vec3(0.0)))) {
+                vec3 other_tr = segment_attenuation(other, other_found, other_found ? other_hit.t : 0.0, rng);
+                sum += (1.0 - share) * other.weight * other_tr * other_radiance;
+            }
+        }
+        if (luminance(s.weight) <= 0.0) break;
+    }
+    return sum;
+}
+
+// Camera rays a pixel traces a pass for the emitted component alone, one
+// per cell of an EMISSION_GRID^2 stratification of the pixel: an emitter's
+// edge seen directly or through glass (the lamp reflected in
+// `medium_box`'s sphere, 40 times the image's mean radiance, and its tiny
+// image refracted through the sphere, 900 times) is pixel coverage noise,
+// which one random sample a pass left at 15% of the image's noise after 5
+// minutes; a chain is one ray per bounce, cheap beside a pass's photons.
+const uint EMISSION_GRID = 4u;
+
 void main() {
     uvec2 p = gl_GlobalInvocationID.xy;
     if (p.x >= image_width() || p.y >= image_height()) return;
@@ -182,29 +275,24 @@ void main() {
     vp.normal = vec4(0.0);
     vp.weight = vec4(0.0);
 
+    vec3 emitted = vec3(0.0);
+    // Without area lights or an environment nothing is seen emitting.
+    uint emission_samples = frame.components.y > 0u || environment_present() ? EMISSION_GRID * EMISSION_GRID : 0u;
+    for (uint k = 0u; k < emission_samples; ++k) {
+        vec2 cell = vec2(k % EMISSION_GRID, k / EMISSION_GRID);
+        vec2 jitter = (cell + vec2(rng_next(rng), rng_next(rng))) / float(EMISSION_GRID);
+        emitted += chain_emission(camera_ray_through(p, jitter), rng);
+    }
+    if (emission_samples > 0u) add_pass(index, COMPONENT_EMITTED, emitted / float(emission_samples));
     for (uint depth = 0u; depth < pc.max_depth; ++depth) {
         Hit hit;
         bool found = trace_closest(s.origin, s.dir, 0.0, 1e30, hit);
         if (depth == 0u) add_pass(index, COMPONENT_AIRLIGHT, airlight(s.origin, s.dir, found ? hit.t : 1e30, rng));
-        if (!found) {
-            // Escaped: the environment, seen directly or through the chain
-            // (L S* E, the emitted component).
-            if (environment_present() && !s.inside) {
-                float travel = 2.0 * frame.scene_sphere.w + length(s.origin - frame.scene_sphere.xyz);
-                vec3 tr = medium_transmittance(s.origin, s.dir, travel, rng);
-                add_pass(index, COMPONENT_EMITTED, s.weight * tr * environment_radiance(s.dir));
-            }
-            break;
-        }
+        if (!found) break;
         Material m = materials[hit_material(hit)];
         bool diffuse = floatBitsToUint(m.color.w) == MATERIAL_DIFFUSE;
         vec3 ng = hit_geometric_normal(hit);
         bool front = dot(s.dir, ng) < 0.0;
-        // An area light's front face, seen directly or through the chain.
-        if (diffuse && front && any(greaterThan(m.emission.rgb, vec3(0.0)))) {
-            vec3 tr = s.inside ? exp(-s.inside_absorption * hit.t) : medium_transmittance(s.origin, s.dir, hit.t, rng);
-            add_pass(index, COMPONENT_EMITTED, s.weight * tr * m.emission.rgb);
-        }
         // A `mixed` material: a diffuse one with a mirror part.
         vec3 mirror = diffuse ? m.specular.rgb : vec3(0.0);
         bool mixed = any(greaterThan(mirror, vec3(0.0)));

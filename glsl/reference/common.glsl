@@ -78,6 +78,7 @@ uint image_pixels() { return image_width() * image_height(); }
 
 // Adds the radiance estimate `value` to pixel `index` of this pass's image `component`.
 void add_pass(uint index, uint component, vec3 value) {
+    if (all(equal(value, vec3(0.0)))) return; // no atomics for nothing
     uint base = (component * image_pixels() + index) * 3u;
     atomicAdd(pass_accum[base + 0u], value.r);
     atomicAdd(pass_accum[base + 1u], value.g);
@@ -132,11 +133,14 @@ void mirror_bounce(inout SpecularState s, vec3 x, vec3 ng, vec3 ns, bool front, 
 // light's direction of travel (radiance / n^2 is invariant): a camera ray
 // entering water from the air sees L_water / n^2. Photons carry flux, which
 // no such factor touches.
-void specular_bounce(inout SpecularState s, vec3 x, vec3 ng, vec3 ns, bool front, Material m, float u, bool carries_radiance) {
+// Returns the probability of the reflected branch (1 at a mirror and under
+// total internal reflection): u < it reflects, so u = -1 forces reflection
+// and u = 2 the other branch, with the weights a random choice gives.
+float specular_bounce(inout SpecularState s, vec3 x, vec3 ng, vec3 ns, bool front, Material m, float u, bool carries_radiance) {
     uint kind = floatBitsToUint(m.color.w);
     if (kind == MATERIAL_MIRROR) {
         mirror_bounce(s, x, ng, ns, front, m.color.rgb);
-        return;
+        return 1.0;
     }
     vec3 ng_in = front ? ng : -ng;                   // facing the arriving ray
     vec3 ns_in = dot(ns, ng_in) > 0.0 ? ns : -ns;
@@ -145,14 +149,15 @@ void specular_bounce(inout SpecularState s, vec3 x, vec3 ng, vec3 ns, bool front
         // probability R_sheet (about the shading normal, as a mirror), else
         // through undeflected; in and out of one medium, so no (n_t/n_i)^2.
         vec3 n = ns_in;
-        if (u < thin_sheet_reflectance(dot(s.dir, n), m.absorption_ior.w)) {
+        float r_sheet = thin_sheet_reflectance(dot(s.dir, n), m.absorption_ior.w);
+        if (u < r_sheet) {
             vec3 r = reflect(s.dir, n);
             s.dir = dot(r, ng_in) > 0.0 ? r : reflect(s.dir, ng_in);
             s.origin = offset_origin(x, ng_in);
         } else {
             s.origin = offset_origin(x, -ng_in);
         }
-        return;
+        return r_sheet;
     }
     float ior = m.absorption_ior.w;
     float eta = front ? 1.0 / ior : ior;
@@ -178,6 +183,7 @@ void specular_bounce(inout SpecularState s, vec3 x, vec3 ng, vec3 ns, bool front
         s.dir = dot(r, ng_in) > 0.0 ? r : reflect(s.dir, ng_in);
         s.origin = offset_origin(x, ng_in);
     }
+    return f;
 }
 
 // A point y uniform over area light `em` (pdf 1 / area) and the normal n
@@ -218,8 +224,7 @@ bool emitter_sampled_by_camera(Emitter em) {
 }
 
 // A camera ray through a uniformly jittered point of pixel p (weight 1).
-SpecularState camera_ray(uvec2 p, inout uint rng) {
-    vec2 jitter = vec2(rng_next(rng), rng_next(rng));
+SpecularState camera_ray_through(uvec2 p, vec2 jitter) {
     vec2 ndc = (vec2(p) + jitter) / frame.viewport.xy * 2.0 - 1.0;
     vec4 far = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
     SpecularState s;
@@ -229,6 +234,11 @@ SpecularState camera_ray(uvec2 p, inout uint rng) {
     s.inside = false;
     s.inside_absorption = vec3(0.0);
     return s;
+}
+
+// The camera ray through a uniform random point of pixel p.
+SpecularState camera_ray(uvec2 p, inout uint rng) {
+    return camera_ray_through(p, vec2(rng_next(rng), rng_next(rng)));
 }
 
 #endif

@@ -335,7 +335,13 @@ void main() {
                         uint tag = tag_for(specular, scattered_or_bounced, true);
                         // Straight from a sampled light: airlight, which
                         // camera.comp samples along the camera rays.
-                        if (!straight_from_sampled_light) connect_medium(x, s.dir, s.weight * sigma_s / majorant, g, tag, rng);
+                        // Multiple scattering (tag `other`) seen directly is
+                        // camera_volume.comp's gather when the volume photon
+                        // map is on (finite variance near the eye).
+                        bool gathered_on_first_segment = pc.volume_capacity != 0u && tag == COMPONENT_OTHER;
+                        if (!straight_from_sampled_light && !gathered_on_first_segment) {
+                            connect_medium(x, s.dir, s.weight * sigma_s / majorant, g, tag, rng);
+                        }
                         if (pc.volume_capacity != 0u) store_volume_photon(x, s.dir, s.weight * sigma_s / majorant, tag);
                     }
                     float p_scatter = (sigma_s.r + sigma_s.g + sigma_s.b) / (3.0 * majorant);
