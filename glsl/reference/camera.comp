@@ -182,11 +182,12 @@ vec3 emitted_radiance(SpecularState s, bool found, Hit hit) {
 }
 
 // The attenuation of the segment from s.origin along s.dir to the next hit
-// (`found`) or out of the scene: absorption inside glass, the medium outside.
+// (`found`) or out of the scene: absorption inside glass, the medium outside
+// (one ratio-tracking run: the EMISSION_GRID^2 chains already average).
 vec3 segment_attenuation(SpecularState s, bool found, float t, inout uint rng) {
     if (s.inside) return found ? exp(-s.inside_absorption * t) : vec3(0.0);
     float travel = found ? t : 2.0 * frame.scene_sphere.w + length(s.origin - frame.scene_sphere.xyz);
-    return mean_transmittance(s.origin, s.dir, travel, rng);
+    return medium_transmittance(s.origin, s.dir, travel, rng);
 }
 
 // The emitted component (L S* E): the emitters a camera ray meets directly
