@@ -74,7 +74,8 @@ fn run(ctx: &Arc<Context>, from_constants: bool, binds: u32) -> anyhow::Result<(
         &[&layout],
         0,
     )?;
-    let dispatch = || ctx.submit_and_wait(|cmd| pipeline.dispatch(cmd, &[&set], &[], [1, 1, 1]));
+    let dispatch =
+        || ctx.submit_commands_and_wait(|c| c.dispatch(&pipeline, &[&set], &[], [1, 1, 1]));
     for _ in 0..10 {
         dispatch()?;
     }

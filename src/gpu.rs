@@ -93,7 +93,7 @@ pub struct GpuEmitter {
 }
 
 /// The environment light's constants, the head of the BINDING_ENVIRONMENT_DATA
-/// buffer (its sampling tables follow, `environment::sampling_tables`).
+/// buffer (its sampling tables follow, `emitters::sampling_tables`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuEnvironment {
@@ -107,7 +107,7 @@ pub struct GpuEnvironment {
     /// x width, y height of the table; z = table power (luminance, W:
     /// π R² ∫ L dω); w unused.
     pub table: [f32; 4],
-    /// The sun found in an image's table (`environment::extract_sun`), for
+    /// The sun found in an image's table (`emitters::extract_sun`), for
     /// `direct` only: xyz its peak texel's direction (world), w the cosine
     /// of the search cone (2: none).
     pub image_sun_peak: [f32; 4],
@@ -352,7 +352,7 @@ impl GpuEmitter {
     }
 
     pub fn new(e: &Emitter) -> Self {
-        let power = crate::environment::emitter_power(e).dot(crate::radiometry::LUMINANCE);
+        let power = crate::emitters::emitter_power(e).dot(crate::radiometry::LUMINANCE);
         let radiance = v4(e.radiance, power);
         match e.shape {
             EmitterShape::Rect {

@@ -5,7 +5,7 @@ pub mod app;
 pub mod bvh;
 pub mod cache_dir;
 pub mod compare;
-pub mod environment;
+pub mod emitters;
 pub mod frame;
 pub mod gpu;
 pub mod output;

@@ -19,7 +19,7 @@ pub fn luminance(c: Vec3) -> f32 {
 /// Spot-light angular falloff: 1 inside `cos_inner`, 0 outside `cos_outer`,
 /// smoothstep in cos(theta) between (glsl/common/lights.glsl: spot_falloff).
 /// `cos_inner` > 1 marks the cosine profile of a rect light's stand-in
-/// (`environment::LAMBERTIAN_FALLOFF`): max(cos θ, 0).
+/// (`frame::LAMBERTIAN_FALLOFF`): max(cos θ, 0).
 pub fn spot_falloff(cos_theta: f32, cos_outer: f32, cos_inner: f32) -> f32 {
     if cos_inner > 1.5 {
         return cos_theta.max(0.0);

@@ -13,7 +13,7 @@
 pub use super::compare::{CompareStatus, View};
 use crate::params::Params;
 use crate::radiometry::Component;
-use crate::vk::{Context, PassTiming};
+use crate::vk::{Context, PassTiming, Rendering};
 use ash::vk;
 use std::sync::Arc;
 use winit::event::WindowEvent;
@@ -95,7 +95,7 @@ impl Overlay {
     pub fn prepare(&mut self, _window: &Window, _data: &UiData) -> anyhow::Result<Vec<Action>> {
         Ok(Vec::new())
     }
-    pub fn record(&mut self, _cmd: vk::CommandBuffer, _extent: vk::Extent2D) -> anyhow::Result<()> {
+    pub fn record(&mut self, _draws: &mut Rendering, _extent: vk::Extent2D) -> anyhow::Result<()> {
         Ok(())
     }
 }
@@ -266,15 +266,17 @@ mod enabled {
             Ok(actions)
         }
 
-        /// Draws the prepared UI; the caller has the target image in
-        /// COLOR_ATTACHMENT_OPTIMAL inside `begin_rendering`.
+        /// Draws the prepared UI in the caller's rendering scope over the
+        /// target image (egui's renderer records its own draws).
         pub fn record(
             &mut self,
-            cmd: vk::CommandBuffer,
+            draws: &mut Rendering,
             extent: vk::Extent2D,
         ) -> anyhow::Result<()> {
-            self.renderer
-                .cmd_draw(cmd, extent, self.pixels_per_point, &self.primitives)?;
+            draws.third_party(|cmd| {
+                self.renderer
+                    .cmd_draw(cmd, extent, self.pixels_per_point, &self.primitives)
+            })?;
             Ok(())
         }
     }

@@ -6,10 +6,7 @@ use super::compare::{Compare, View, ViewKey};
 use super::overlay::{Action, MediumValues, Overlay, UiData};
 use super::slots::ImageSemaphores;
 use crate::renderer::Renderer;
-use crate::vk::{
-    begin_rendering, end_rendering, step, Access, Acquired, Context, FrameSync, PassTiming,
-    Surface, Swapchain,
-};
+use crate::vk::{Access, Acquired, Context, FrameSync, PassTiming, Surface, Swapchain};
 use ash::vk;
 use std::collections::{HashSet, VecDeque};
 use std::sync::Arc;
@@ -299,21 +296,26 @@ impl State {
                         return Ok(FrameSync::default());
                     }
                 };
-                let cmd = rec.cmd();
                 // The tonemap's compute writes -> transfer read. The next frame's
                 // tonemap pass orders its write after this read through the
                 // display image's tracked state (write-after-read).
-                step(&ctx, cmd).read(display, Access::TransferRead).emit();
                 let draw_overlay = overlay.visible();
-                swapchain.blit_to_image(cmd, index, display, draw_overlay);
-                if draw_overlay {
-                    let view = swapchain.images[index as usize].view;
-                    begin_rendering(&ctx, cmd, swapchain.extent, &[(view, None)], None);
-                    let drawn = overlay.record(cmd, swapchain.extent);
-                    end_rendering(&ctx, cmd);
-                    swapchain.attachment_to_present(cmd, index);
-                    drawn?;
-                }
+                let extent = swapchain.extent;
+                rec.pass("present")
+                    .untimed()
+                    .read(display, Access::TransferRead)
+                    .record(|c| {
+                        swapchain.blit_to_image(c, index, display, draw_overlay);
+                        if !draw_overlay {
+                            return Ok(());
+                        }
+                        let view = swapchain.images[index as usize].view;
+                        let drawn =
+                            c.render(extent, &[(view, None)], None, |r| overlay.record(r, extent));
+                        swapchain.attachment_to_present(c, index);
+                        drawn
+                    })
+                    .transpose()?;
                 presented = Some(index);
                 Ok(FrameSync {
                     waits: vec![(acquired, vk::PipelineStageFlags2::ALL_TRANSFER)],

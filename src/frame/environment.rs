@@ -1,13 +1,13 @@
 //! The environment light on the GPU (set 0): its equirectangular radiance
 //! table as an RGBA32F image with a bilinear sampler (BINDING_ENVIRONMENT),
 //! and its constants followed by the luminance sampling tables
-//! (BINDING_ENVIRONMENT_DATA; `environment::sampling_tables`). A scene
+//! (BINDING_ENVIRONMENT_DATA; `emitters::sampling_tables`). A scene
 //! without an environment binds a 2x1 black table and `params.x` = 0.
 //! Both are written at `SceneGpu::new` (a blocking upload before any frame
 //! reads them); the constants again when the environment's `rotate`
 //! changes (`EnvironmentGpu::update`, the demo's live rotation).
 
-use crate::environment;
+use crate::emitters;
 use crate::gpu::GpuEnvironment;
 use crate::radiometry::LUMINANCE;
 use crate::scene::{Environment, EnvironmentKind};
@@ -28,7 +28,7 @@ impl EnvironmentGpu {
     /// `scene_radius`: the bounding sphere's radius R; the environment's
     /// photons leave a disc of that radius, so its power is π R² ∫ L dω.
     pub fn new(ctx: &Arc<Context>, env: Option<&Environment>, scene_radius: f32) -> VkResult<Self> {
-        let (w, h, texels) = env.map_or((2, 1, vec![[0.0; 3]; 2]), environment::table);
+        let (w, h, texels) = env.map_or((2, 1, vec![[0.0; 3]; 2]), emitters::table);
         let (constants, bytes) = data(env, scene_radius, w, h, &texels);
         let data = Buffer::with_data::<u8>(ctx, "environment data", &bytes, BufferUsage::Storage)?;
         let rgba: Vec<f32> = texels
@@ -61,7 +61,7 @@ impl EnvironmentGpu {
     /// is in its own frame, a sky's gradient depends on elevation alone.
     /// The caller has waited for every frame that read the old data.
     pub fn update(&mut self, env: Option<&Environment>, scene_radius: f32) -> VkResult<()> {
-        let (w, h, texels) = env.map_or((2, 1, vec![[0.0; 3]; 2]), environment::table);
+        let (w, h, texels) = env.map_or((2, 1, vec![[0.0; 3]; 2]), emitters::table);
         let (constants, bytes) = data(env, scene_radius, w, h, &texels);
         self.data.upload(&bytes)?;
         self.constants = constants;
@@ -78,7 +78,7 @@ fn data(
     h: u32,
     texels: &[[f32; 3]],
 ) -> (GpuEnvironment, Vec<u8>) {
-    let (cdf, integral) = environment::sampling_tables(w, h, texels);
+    let (cdf, integral) = emitters::sampling_tables(w, h, texels);
     let disc = PI * scene_radius * scene_radius;
     let mut constants = GpuEnvironment {
         params: [0.0, 0.0, 1.0, 0.0],
@@ -94,8 +94,8 @@ fn data(
         constants.params = [1.0, 0.0, c, s];
         constants.table[2] = integral * disc;
         if let EnvironmentKind::Image(_) = &env.kind {
-            if let Some(sun) = environment::extract_sun(w, h, texels) {
-                let rot = environment::rotation(env);
+            if let Some(sun) = emitters::extract_sun(w, h, texels) {
+                let rot = emitters::rotation(env);
                 let (p, d) = (rot * sun.peak, rot * sun.direction);
                 constants.image_sun_peak = [p.x, p.y, p.z, sun.cos_search];
                 constants.image_sun_direction = [d.x, d.y, d.z, sun.threshold];
@@ -106,7 +106,7 @@ fn data(
             let l = sky.sun_radiance * env.scale;
             let d = sky.sun_direction;
             constants.sun = [d.x, d.y, d.z, sky.sun_radius_deg.to_radians().cos()];
-            let power = l.dot(LUMINANCE) * environment::sun_solid_angle(sky) * disc;
+            let power = l.dot(LUMINANCE) * emitters::sun_solid_angle(sky) * disc;
             constants.sun_radiance = [l.x, l.y, l.z, power];
         }
     }

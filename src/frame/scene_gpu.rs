@@ -165,9 +165,9 @@ impl SceneGpu {
         let sphere = scene.bounding_sphere(time);
         let materials: Vec<GpuMaterial> = scene.materials.iter().map(GpuMaterial::new).collect();
         // The scene's lights, then the stand-ins of its sun and rect lights
-        // (`environment::caustic_lights`): the reference and `direct` use
+        // (`frame::caustic_lights`): the reference and `direct` use
         // only the first `frame.counts.x`, the caustic techniques all.
-        let mut lights: Vec<GpuLight> = crate::environment::caustic_lights(scene)
+        let mut lights: Vec<GpuLight> = crate::frame::caustic_lights(scene)
             .iter()
             .map(|l| GpuLight::new(l, sphere.1))
             .collect();
@@ -335,7 +335,7 @@ impl SceneGpu {
     /// Re-uploads moved lights (same count). The caller has waited for every
     /// frame that read the old ones.
     pub fn update_lights(&self, scene: &Scene) -> VkResult<()> {
-        let lights: Vec<GpuLight> = crate::environment::caustic_lights(scene)
+        let lights: Vec<GpuLight> = crate::frame::caustic_lights(scene)
             .iter()
             .map(|l| GpuLight::new(l, self.sphere.1))
             .collect();

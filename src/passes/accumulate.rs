@@ -38,11 +38,14 @@ impl Accumulate {
         rec.pass("accumulate")
             .storage_image(set, 0, radiance, Access::ComputeWrite)
             .storage_image(set, 1, &self.history, Access::ComputeWrite)
-            .record(|cmd| {
+            .record(|c| {
                 let groups = groups_8x8(radiance.desc.width, radiance.desc.height);
-                self.pass
-                    .pipeline
-                    .dispatch(cmd, &[set], bytemuck::bytes_of(&frames), groups);
+                c.dispatch(
+                    &self.pass.pipeline,
+                    &[set],
+                    bytemuck::bytes_of(&frames),
+                    groups,
+                );
             });
     }
 }

@@ -12,7 +12,7 @@
 //! caster, glass included), transmittance exact for constant density and by
 //! `medium_steps` midpoint steps otherwise. This is exactly what the
 //! reference's `airlight` component (L V paths) converges to. The lights
-//! are the GPU light buffer's (`environment::caustic_lights`): the scene's
+//! are the GPU light buffer's (`frame::caustic_lights`): the scene's
 //! own, with the technique's shadow maps, then the point stand-ins of small
 //! rect lights (a spot at the centre with the cosine profile
 //! I = L A max(cos θ, 0), so their airlight agrees with the surface light
@@ -20,7 +20,7 @@
 //! an environment's sun (a directional light of its irradiance), each
 //! shadowed by one BVH ray per sample (they have no shadow map). The
 //! stand-in differs from the rect's own airlight by O((s/d)²) at distance d
-//! (`environment::STAND_IN_MAX_SIZE_RATIO`). An environment's sky (beyond
+//! (`frame::STAND_IN_MAX_SIZE_RATIO`). An environment's sky (beyond
 //! its sun) and sphere lights scatter no airlight here. The camera ray
 //! ends at the first surface of any kind (one BVH ray per pixel): the
 //! reference has no L V path seen through glass, and a technique's
@@ -111,7 +111,7 @@ impl Airlight {
         Ok(Self {
             push: AirlightPush {
                 light_count: scene.lights.len().min(b::MAX_LIGHTS as usize) as u32,
-                lit_count: crate::environment::caustic_lights(scene).len() as u32,
+                lit_count: crate::frame::caustic_lights(scene).len() as u32,
                 steps: params.airlight_steps,
                 medium_steps,
                 jitter: params.airlight_jitter,
@@ -157,10 +157,10 @@ impl Airlight {
                 out,
                 Access::ComputeWrite,
             )
-            .record(|cmd| {
+            .record(|c| {
                 let groups = groups_8x8(width, height);
-                self.pipeline.dispatch(
-                    cmd,
+                c.dispatch(
+                    &self.pipeline,
                     &[&scene.set, &self.set],
                     bytemuck::bytes_of(&self.push),
                     groups,

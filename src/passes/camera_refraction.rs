@@ -147,10 +147,10 @@ impl CameraRefraction {
             &targets.radiance,
             Access::ComputeWrite,
         )
-        .record(|cmd| {
+        .record(|c| {
             let groups = groups_8x8(targets.width, targets.height);
-            self.pipeline.dispatch(
-                cmd,
+            c.dispatch(
+                &self.pipeline,
                 &[&scene.set, set],
                 bytemuck::bytes_of(&self.push),
                 groups,

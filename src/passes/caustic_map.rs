@@ -76,9 +76,9 @@ use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::scene::{Light, LightKind};
 use crate::shader_bindings as b;
 use crate::vk::{
-    begin_rendering, end_rendering, groups_8x8, Access, BindingKind, Buffer, BufferUsage,
-    ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
-    GraphicsPipelineDesc, Image, ImageDesc, Sampler, Specialization, VkResult,
+    groups_8x8, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
+    Sampler, Specialization, VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -426,14 +426,12 @@ impl CausticMap {
         rec.upload(&self.views, bytemuck::cast_slice(&views));
         self.frame_views = views;
         self.geometry_time = Some(scene.geometry_time);
-        let ctx = rec.ctx().clone();
         rec.pass("caustic map clear")
             .overwrite(&self.map, Access::ColorAttachment)
-            .record(|cmd| {
+            .record(|c| {
                 let extent = self.map.extent();
                 for &view in &self.map.layer_views {
-                    begin_rendering(&ctx, cmd, extent, &[(view, Some([0.0; 4]))], None);
-                    end_rendering(&ctx, cmd);
+                    c.render(extent, &[(view, Some([0.0; 4]))], None, |_| {});
                 }
             });
         Ok(())
@@ -486,10 +484,10 @@ impl CausticMap {
                 radiance,
                 Access::ComputeWrite,
             )
-            .record(|cmd| {
+            .record(|c| {
                 let groups = groups_8x8(extent.width, extent.height);
-                self.apply.dispatch(
-                    cmd,
+                c.dispatch(
+                    &self.apply,
                     &[&scene.set, &self.apply_set],
                     bytemuck::bytes_of(&push),
                     groups,
@@ -514,7 +512,6 @@ impl LightViewConsumer for CausticMap {
         view: &LightView,
         light_view: &SpecularGBuffer,
     ) {
-        let ctx = rec.ctx().clone();
         let push = self.photon_push(view);
         let v = self.frame_views[l];
         // Write-after-read against the previous light's splat (or last
@@ -542,10 +539,10 @@ impl LightViewConsumer for CausticMap {
                     b::CAUSTIC_BINDING_BACK_NORMAL,
                 ],
             )
-            .record(|cmd| {
+            .record(|c| {
                 let groups = groups_8x8(self.photon_size, self.photon_size);
-                self.photon_pipeline.dispatch(
-                    cmd,
+                c.dispatch(
+                    &self.photon_pipeline,
                     &[&scene.set, &self.set],
                     bytemuck::bytes_of(&push),
                     groups,
@@ -560,32 +557,23 @@ impl LightViewConsumer for CausticMap {
                 &self.photons,
                 Access::VertexRead,
             )
-            .record(|cmd| {
+            .record(|c| {
                 let extent = self.map.extent();
                 let count = 2 * self.photon_size * self.photon_size;
                 for face in 0..v.info[1] {
                     let layer = (v.info[2] + face) as usize;
-                    begin_rendering(
-                        &ctx,
-                        cmd,
-                        extent,
-                        &[(self.map.layer_views[layer], None)],
-                        None,
-                    );
                     let push = SplatPush {
                         light: l as u32,
                         view: face,
                         size: self.map_size,
                         splat_size: self.splat_size,
                     };
-                    self.splat_pipeline.bind(
-                        cmd,
-                        &[&scene.set, &self.set],
-                        bytemuck::bytes_of(&push),
-                        extent,
-                    );
-                    crate::vk::draw(&ctx, cmd, count);
-                    end_rendering(&ctx, cmd);
+                    let colors = [(self.map.layer_views[layer], None)];
+                    c.render(extent, &colors, None, |r| {
+                        let sets = [&scene.set, &self.set];
+                        r.bind(&self.splat_pipeline, &sets, bytemuck::bytes_of(&push));
+                        r.draw(count);
+                    });
                 }
             });
     }

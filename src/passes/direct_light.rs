@@ -223,10 +223,7 @@ impl DirectLight {
                     &self.sh,
                     Access::ComputeWrite,
                 )
-                .record(|cmd| {
-                    self.environment_sh
-                        .dispatch(cmd, &[&scene.set, set], &[], [1, 1, 1])
-                });
+                .record(|c| c.dispatch(&self.environment_sh, &[&scene.set, set], &[], [1, 1, 1]));
             self.sh_done = true;
         }
         // The G-buffer's and shadow maps' attachment writes must be
@@ -253,10 +250,14 @@ impl DirectLight {
                 &targets.radiance,
                 Access::ComputeWrite,
             )
-            .record(|cmd| {
+            .record(|c| {
                 let groups = groups_8x8(targets.width, targets.height);
-                self.lighting
-                    .dispatch(cmd, &[&scene.set, set], bytemuck::bytes_of(&push), groups);
+                c.dispatch(
+                    &self.lighting,
+                    &[&scene.set, set],
+                    bytemuck::bytes_of(&push),
+                    groups,
+                );
             });
         Ok(())
     }

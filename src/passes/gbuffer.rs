@@ -19,8 +19,8 @@
 
 use crate::frame::SceneGpu;
 use crate::vk::{
-    begin_rendering, end_rendering, Access, Context, DescriptorSetLayout, FrameRecorder,
-    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, VkResult,
+    Access, Context, DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc,
+    Image, ImageDesc, VkResult,
 };
 use ash::vk;
 use std::sync::Arc;
@@ -112,7 +112,6 @@ impl GBuffer {
     /// Records the pass "gbuffer". Afterwards the targets' last access is
     /// `ColorAttachment`/`DepthAttachment`; readers declare theirs with `barrier`.
     pub fn record(&self, rec: &mut FrameRecorder, scene: &SceneGpu) {
-        let ctx = rec.ctx().clone();
         // Every target is cleared and redrawn, so earlier contents are
         // discarded; the barrier still waits for last frame's readers
         // (write-after-read). The triangle buffer is read by the vertex
@@ -124,30 +123,23 @@ impl GBuffer {
             .overwrite(&self.depth, Access::DepthAttachment)
             .read(&scene.triangles, Access::VertexRead)
             .read(&scene.triangle_uvs, Access::VertexRead)
-            .record(|cmd| {
-                let extent = self.extent();
-                begin_rendering(
-                    &ctx,
-                    cmd,
-                    extent,
-                    &[
-                        (self.position.view, Some([0.0; 4])),
-                        (self.normal.view, Some([0.0; 4])),
-                        (self.albedo.view, Some([0.0; 4])),
-                    ],
-                    Some(self.depth.view),
-                );
-                if scene.triangle_count > 0 {
-                    let opaque_only = u32::from(self.contents == GBufferContents::Opaque);
-                    self.pipeline.bind(
-                        cmd,
-                        &[&scene.set],
-                        bytemuck::bytes_of(&opaque_only),
-                        extent,
-                    );
-                    crate::vk::draw(&ctx, cmd, 3 * scene.triangle_count);
-                }
-                end_rendering(&ctx, cmd);
+            .record(|c| {
+                let colors = [
+                    (self.position.view, Some([0.0; 4])),
+                    (self.normal.view, Some([0.0; 4])),
+                    (self.albedo.view, Some([0.0; 4])),
+                ];
+                c.render(self.extent(), &colors, Some((self.depth.view, true)), |r| {
+                    if scene.triangle_count > 0 {
+                        let opaque_only = u32::from(self.contents == GBufferContents::Opaque);
+                        r.bind(
+                            &self.pipeline,
+                            &[&scene.set],
+                            bytemuck::bytes_of(&opaque_only),
+                        );
+                        r.draw(3 * scene.triangle_count);
+                    }
+                });
             });
     }
 }

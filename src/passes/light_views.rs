@@ -177,8 +177,8 @@ impl LightViews {
             gbuffer: SpecularGBuffer::new(ctx, &scene_gpu.layout, size, size)?,
             size,
             // With the stand-ins of the environment's sun and the rect
-            // lights (`environment::caustic_lights`, the GPU light buffer's order).
-            lights: crate::environment::caustic_lights(scene),
+            // lights (`frame::caustic_lights`, the GPU light buffer's order).
+            lights: crate::frame::caustic_lights(scene),
             specular: specular_bounds(scene),
         })
     }

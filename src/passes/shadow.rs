@@ -23,9 +23,8 @@ use crate::frame::SceneGpu;
 use crate::scene::{Light, LightKind};
 use crate::shader_bindings as b;
 use crate::vk::{
-    begin_rendering, end_rendering, step, Access, Buffer, BufferUsage, Context,
-    DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
-    VkResult,
+    Access, Buffer, BufferUsage, Context, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
+    GraphicsPipelineDesc, Image, ImageDesc, VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -275,47 +274,34 @@ impl ShadowMaps {
         let views = self.views(scene.sphere);
         // Through the frame's upload ring: earlier frames may still read the buffer.
         rec.upload(&self.lights, bytemuck::cast_slice(&views));
-        let ctx = rec.ctx().clone();
         // Every used layer is cleared and redrawn: discard the contents,
         // but wait for last frame's readers (write-after-read). The
-        // triangle buffer is pulled by the vertex shader.
+        // triangle buffer is pulled by the vertex shader. One depth image
+        // serves every view: each view's clear and tests wait for the
+        // previous view's depth writes (write-after-write), as the
+        // declaration holds again before each rendering scope.
         rec.pass("shadow maps")
             .overwrite(&self.map, Access::ColorAttachment)
+            .overwrite(&self.depth, Access::DepthAttachment)
             .read(&scene.triangles, Access::VertexRead)
-            .record(|cmd| {
+            .record(|c| {
                 let extent = self.map.extent();
                 for v in &views {
                     let mode = f32::from_bits(v.info[0]);
                     for face in 0..v.info[1] {
-                        // One depth image serves every view: each view's clear
-                        // and tests must wait for the previous view's depth
-                        // writes (write-after-write), which this barrier orders.
-                        step(&ctx, cmd)
-                            .overwrite(&self.depth, Access::DepthAttachment)
-                            .emit();
                         let layer = (v.info[2] + face) as usize;
-                        begin_rendering(
-                            &ctx,
-                            cmd,
-                            extent,
-                            &[(self.map.layer_views[layer], Some([SHADOW_CLEAR; 4]))],
-                            Some(self.depth.view),
-                        );
-                        if scene.triangle_count > 0 {
-                            let push = ShadowPush {
-                                view_proj: v.view_proj[face as usize],
-                                origin: [v.origin[0], v.origin[1], v.origin[2], mode],
-                                direction: v.direction,
-                            };
-                            self.pipeline.bind(
-                                cmd,
-                                &[&scene.set],
-                                bytemuck::bytes_of(&push),
-                                extent,
-                            );
-                            crate::vk::draw(&ctx, cmd, 3 * scene.triangle_count);
-                        }
-                        end_rendering(&ctx, cmd);
+                        let colors = [(self.map.layer_views[layer], Some([SHADOW_CLEAR; 4]))];
+                        c.render(extent, &colors, Some((self.depth.view, true)), |r| {
+                            if scene.triangle_count > 0 {
+                                let push = ShadowPush {
+                                    view_proj: v.view_proj[face as usize],
+                                    origin: [v.origin[0], v.origin[1], v.origin[2], mode],
+                                    direction: v.direction,
+                                };
+                                r.bind(&self.pipeline, &[&scene.set], bytemuck::bytes_of(&push));
+                                r.draw(3 * scene.triangle_count);
+                            }
+                        });
                     }
                 }
             });

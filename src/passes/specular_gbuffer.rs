@@ -20,8 +20,8 @@
 use crate::frame::SceneGpu;
 use crate::shader_bindings as b;
 use crate::vk::{
-    begin_rendering, end_rendering, step, Access, Context, DescriptorSet, DescriptorSetLayout,
-    FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, Pass, VkResult,
+    Access, Commands, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
+    GraphicsPipelineDesc, Image, ImageDesc, Pass, VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -128,7 +128,6 @@ impl SpecularGBuffer {
     /// overwritten; the barriers wait for the previous readers
     /// (write-after-read) and for writes to the triangles.
     pub fn record(&self, rec: &mut FrameRecorder, name: &str, scene: &SceneGpu, view: &Viewpoint) {
-        let ctx = rec.ctx().clone();
         rec.pass(name)
             .overwrite(&self.front_position, Access::ColorAttachment)
             .overwrite(&self.front_normal, Access::ColorAttachment)
@@ -136,10 +135,12 @@ impl SpecularGBuffer {
             .overwrite(&self.back_normal, Access::ColorAttachment)
             .overwrite(&self.depth, Access::DepthAttachment)
             .read(&scene.triangles, Access::VertexRead)
-            .record(|cmd| self.draw(&ctx, cmd, scene, view));
+            .record(|c| self.draw(c, scene, view));
     }
 
-    fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer, scene: &SceneGpu, view: &Viewpoint) {
+    /// The front draw, then the back draw; the depth image both use is
+    /// ordered between them by the pass's declaration (write-after-write).
+    fn draw(&self, c: &mut Commands, scene: &SceneGpu, view: &Viewpoint) {
         let extent = self.front_position.extent();
         let (view_proj, origin, forward, kind) = match *view {
             Viewpoint::Camera => (
@@ -176,33 +177,21 @@ impl SpecularGBuffer {
                 &self.back_normal,
             ),
         ] {
-            if pass == b::SPECULAR_GBUFFER_BACK {
-                // The depth image is shared by both draws (write-after-write).
-                step(ctx, cmd)
-                    .overwrite(&self.depth, Access::DepthAttachment)
-                    .emit();
-            }
-            begin_rendering(
-                ctx,
-                cmd,
-                extent,
-                &[
-                    (position.view, Some(NOT_COVERED)),
-                    (normal.view, Some([0.0; 4])),
-                ],
-                Some(self.depth.view),
-            );
-            if scene.triangle_count > 0 {
-                let push = SpecularGBufferPush {
-                    view_proj: view_proj.to_cols_array_2d(),
-                    origin: origin.extend(f32::from_bits(kind)).to_array(),
-                    forward: forward.extend(f32::from_bits(pass)).to_array(),
-                };
-                self.pipeline
-                    .bind(cmd, &[&scene.set], bytemuck::bytes_of(&push), extent);
-                crate::vk::draw(ctx, cmd, 3 * scene.triangle_count);
-            }
-            end_rendering(ctx, cmd);
+            let colors = [
+                (position.view, Some(NOT_COVERED)),
+                (normal.view, Some([0.0; 4])),
+            ];
+            c.render(extent, &colors, Some((self.depth.view, true)), |r| {
+                if scene.triangle_count > 0 {
+                    let push = SpecularGBufferPush {
+                        view_proj: view_proj.to_cols_array_2d(),
+                        origin: origin.extend(f32::from_bits(kind)).to_array(),
+                        forward: forward.extend(f32::from_bits(pass)).to_array(),
+                    };
+                    r.bind(&self.pipeline, &[&scene.set], bytemuck::bytes_of(&push));
+                    r.draw(3 * scene.triangle_count);
+                }
+            });
         }
     }
 

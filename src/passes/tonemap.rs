@@ -31,11 +31,14 @@ impl Tonemap {
         rec.pass("tonemap")
             .storage_image(set, 0, radiance, Access::ComputeRead)
             .overwrite_storage_image(set, 1, &self.display, Access::ComputeWrite)
-            .record(|cmd| {
+            .record(|c| {
                 let groups = groups_8x8(radiance.desc.width, radiance.desc.height);
-                self.pass
-                    .pipeline
-                    .dispatch(cmd, &[set], bytemuck::bytes_of(&exposure), groups);
+                c.dispatch(
+                    &self.pass.pipeline,
+                    &[set],
+                    bytemuck::bytes_of(&exposure),
+                    groups,
+                );
             });
     }
 }

@@ -104,9 +104,13 @@ impl WaterSurface {
         // them, e.g. last frame's raster) only need to be ordered before.
         rec.pass("water surface")
             .write(&self.vertices, Access::ComputeWrite)
-            .record(|cmd| {
-                self.pipeline
-                    .dispatch(cmd, &[&self.set], bytemuck::bytes_of(&push), self.groups);
+            .record(|c| {
+                c.dispatch(
+                    &self.pipeline,
+                    &[&self.set],
+                    bytemuck::bytes_of(&push),
+                    self.groups,
+                );
             });
     }
 }

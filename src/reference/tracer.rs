@@ -7,8 +7,8 @@ use crate::frame::{FrameTargets, SceneGpu};
 use crate::radiometry::Component;
 use crate::shader_bindings as b;
 use crate::vk::{
-    groups_8x8, step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context,
-    DescriptorSet, DescriptorSetLayout, FrameRecorder, VkResult,
+    groups_8x8, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    DescriptorSetLayout, FrameRecorder, VkResult,
 };
 use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
@@ -231,10 +231,10 @@ impl Reference {
 
     /// Clears the sums (first pass); records it through the recorder.
     pub fn record_clear(&mut self, rec: &mut FrameRecorder) {
-        let ctx = rec.ctx().clone();
-        let cleared = [&self.total, &self.pass_sums, &self.moments];
-        rec.pass("reference clear").record(|cmd| {
-            fill(&ctx, cmd, &cleared, 0);
+        rec.pass("reference clear").record(|c| {
+            for sums in [&self.total, &self.pass_sums, &self.moments] {
+                c.fill(sums, 0);
+            }
         });
         self.photons = 0;
         self.passes = 0;
@@ -245,7 +245,6 @@ impl Reference {
     /// along camera chains (scenes with a medium), then the fold into the
     /// sums. Shrinks the radii for the next pass.
     pub fn record_pass(&mut self, rec: &mut FrameRecorder, scene_gpu: &SceneGpu) -> PassReport {
-        let ctx = rec.ctx().clone();
         self.dispatches = self.dispatches.wrapping_add(1);
         let seed = self
             .dispatches
@@ -255,32 +254,30 @@ impl Reference {
         let push = bytemuck::bytes_of(&push);
         let sets = [&scene_gpu.set, &self.set];
         let pixel_groups = groups_8x8(self.width, self.height);
-        rec.pass("reference visible points").record(|cmd| {
-            fill(&ctx, cmd, &[&self.surface_heads], b::REFERENCE_GRID_NONE);
-            step(&ctx, cmd)
-                .write(&self.pass_sums, Access::ComputeWrite)
-                .write(&self.visible_points, Access::ComputeWrite)
-                .write(&self.surface_heads, Access::ComputeWrite)
-                .write(&self.surface_next, Access::ComputeWrite)
-                .emit();
-            self.camera.dispatch(cmd, &sets, push, pixel_groups);
-        });
-        rec.pass("reference photons").record(|cmd| {
-            fill(&ctx, cmd, &[&self.volume_heads], b::REFERENCE_GRID_NONE);
-            fill(&ctx, cmd, &[&self.stats], 0);
-            step(&ctx, cmd)
-                .write(&self.pass_sums, Access::ComputeWrite)
-                .read(&self.visible_points, Access::ComputeRead)
-                .read(&self.surface_heads, Access::ComputeRead)
-                .read(&self.surface_next, Access::ComputeRead)
-                .write(&self.volume_photons, Access::ComputeWrite)
-                .write(&self.volume_heads, Access::ComputeWrite)
-                .write(&self.volume_next, Access::ComputeWrite)
-                .write(&self.stats, Access::ComputeWrite)
-                .emit();
-            self.trace
-                .dispatch(cmd, &sets, push, [(self.pass_photons() / 64) as u32, 1, 1]);
-        });
+        rec.pass("reference visible points")
+            .write(&self.pass_sums, Access::ComputeWrite)
+            .write(&self.visible_points, Access::ComputeWrite)
+            .write(&self.surface_heads, Access::ComputeWrite)
+            .write(&self.surface_next, Access::ComputeWrite)
+            .record(|c| {
+                c.fill(&self.surface_heads, b::REFERENCE_GRID_NONE);
+                c.dispatch(&self.camera, &sets, push, pixel_groups);
+            });
+        rec.pass("reference photons")
+            .write(&self.pass_sums, Access::ComputeWrite)
+            .read(&self.visible_points, Access::ComputeRead)
+            .read(&self.surface_heads, Access::ComputeRead)
+            .read(&self.surface_next, Access::ComputeRead)
+            .write(&self.volume_photons, Access::ComputeWrite)
+            .write(&self.volume_heads, Access::ComputeWrite)
+            .write(&self.volume_next, Access::ComputeWrite)
+            .write(&self.stats, Access::ComputeWrite)
+            .record(|c| {
+                c.fill(&self.volume_heads, b::REFERENCE_GRID_NONE);
+                c.fill(&self.stats, 0);
+                let groups = [(self.pass_photons() / 64) as u32, 1, 1];
+                c.dispatch(&self.trace, &sets, push, groups);
+            });
         if self.volume_capacity > 0 {
             rec.pass("reference volume gather")
                 .write(&self.pass_sums, Access::ComputeWrite)
@@ -288,18 +285,15 @@ impl Reference {
                 .read(&self.volume_heads, Access::ComputeRead)
                 .read(&self.volume_next, Access::ComputeRead)
                 .read(&self.stats, Access::ComputeRead)
-                .record(|cmd| {
-                    self.camera_volume.dispatch(cmd, &sets, push, pixel_groups);
-                });
+                .record(|c| c.dispatch(&self.camera_volume, &sets, push, pixel_groups));
         }
         rec.pass("reference fold")
             .write(&self.pass_sums, Access::ComputeWrite)
             .write(&self.total, Access::ComputeWrite)
             .write(&self.moments, Access::ComputeWrite)
-            .record(|cmd| {
+            .record(|c| {
                 let pixels = self.width * self.height;
-                self.fold
-                    .dispatch(cmd, &sets, push, [pixels.div_ceil(64), 1, 1]);
+                c.dispatch(&self.fold, &sets, push, [pixels.div_ceil(64), 1, 1]);
             });
         let report = PassReport {
             radius: self.radius,
@@ -316,23 +310,17 @@ impl Reference {
 
     /// Records the noise reduction over the image (counters 1 and 2 of `stats`).
     pub fn record_noise(&self, rec: &mut FrameRecorder, scene_gpu: &SceneGpu) {
-        let ctx = rec.ctx().clone();
         let push = self.push(0, Component::All);
         let sets = [&scene_gpu.set, &self.set];
-        rec.pass("reference noise").record(|cmd| {
-            fill(&ctx, cmd, &[&self.stats], 0);
-            step(&ctx, cmd)
-                .read(&self.moments, Access::ComputeRead)
-                .write(&self.stats, Access::ComputeWrite)
-                .emit();
-            let pixels = self.width * self.height;
-            self.noise.dispatch(
-                cmd,
-                &sets,
-                bytemuck::bytes_of(&push),
-                [pixels.div_ceil(64), 1, 1],
-            );
-        });
+        rec.pass("reference noise")
+            .read(&self.moments, Access::ComputeRead)
+            .write(&self.stats, Access::ComputeWrite)
+            .record(|c| {
+                c.fill(&self.stats, 0);
+                let pixels = self.width * self.height;
+                let groups = [pixels.div_ceil(64), 1, 1];
+                c.dispatch(&self.noise, &sets, bytemuck::bytes_of(&push), groups);
+            });
     }
 
     /// Resolves `component` into the frame's radiance image.
@@ -353,13 +341,9 @@ impl Reference {
                 Access::ComputeWrite,
             )
             .read(&self.total, Access::ComputeRead)
-            .record(|cmd| {
-                self.resolve.dispatch(
-                    cmd,
-                    &sets,
-                    bytemuck::bytes_of(&push),
-                    groups_8x8(self.width, self.height),
-                );
+            .record(|c| {
+                let groups = groups_8x8(self.width, self.height);
+                c.dispatch(&self.resolve, &sets, bytemuck::bytes_of(&push), groups);
             });
     }
 
@@ -378,18 +362,6 @@ impl Reference {
     /// Medium collisions one pass can store.
     pub fn volume_capacity(&self) -> u32 {
         self.volume_capacity
-    }
-}
-
-/// Fills whole buffers with `value` before a compute pass writes them.
-fn fill(ctx: &Context, cmd: ash::vk::CommandBuffer, buffers: &[&Buffer], value: u32) {
-    let mut fills = step(ctx, cmd);
-    for b in buffers {
-        fills = fills.write(*b, Access::TransferWrite);
-    }
-    fills.emit();
-    for b in buffers {
-        crate::vk::fill_buffer(ctx, cmd, b, value);
     }
 }
 

@@ -13,6 +13,11 @@ use super::Scene;
 /// for a translation plus an orbit plus a bob.
 pub const MAX_WORLD_EXTENT: f32 = 1e7;
 
+/// Most point, spot and directional lights a scene may hold (the renderer's
+/// light buffers and shadow maps are sized for them: `frame/stand_ins.rs`
+/// checks that its GPU constant agrees).
+pub const MAX_LIGHTS: usize = 8;
+
 /// Most emissive triangles (glTF `emissiveFactor`) one object may hold: each
 /// is an area light of its own, which `direct` gives a shadow ray per pixel
 /// and the reference's light selection scans.

@@ -23,7 +23,7 @@ pub mod texture;
 mod types;
 pub mod water;
 
-pub use bounds::{MAX_EMISSIVE_TRIANGLES, MAX_WORLD_EXTENT};
+pub use bounds::{MAX_EMISSIVE_TRIANGLES, MAX_LIGHTS, MAX_WORLD_EXTENT};
 pub use error::{escape_control, SceneError};
 pub use file::DEFAULT_FOV_Y_DEG;
 pub use node::{MAX_MAGNITUDE, MAX_RADIOMETRIC};

@@ -29,9 +29,10 @@
 //! (submit to observed completion), frames still overlap, and per-pass numbers
 //! come only on request (`per_pass`): one submission per pass, each waited for.
 
-use super::pass::{step, Pass};
+use super::pass::Pass;
 use super::ring::Ring;
-use super::{fault, Access, Buffer, Context, VkError, VkResult};
+use super::sync::barrier;
+use super::{fault, Access, Buffer, BufferAccess, Context, VkError, VkResult};
 use ash::vk;
 use std::any::Any;
 use std::collections::VecDeque;
@@ -430,12 +431,6 @@ impl<'a> FrameRecorder<'a> {
         self.slot
     }
 
-    /// The frame's command buffer, for commands outside the timed passes
-    /// (the demo's blit to the swapchain).
-    pub fn cmd(&self) -> vk::CommandBuffer {
-        self.frames.slots[self.slot].cmd
-    }
-
     /// Signalled by vkAcquireNextImageKHR for this frame (the demo).
     pub fn acquire_semaphore(&self) -> vk::Semaphore {
         self.frames.slots[self.slot].acquired
@@ -458,27 +453,44 @@ impl<'a> FrameRecorder<'a> {
     }
 
     /// Records one named pass (its barrier is the first command `record`
-    /// records).
-    pub(super) fn record_pass(&mut self, name: &str, record: impl FnOnce(vk::CommandBuffer)) {
+    /// records): timed, or `untimed` into the frame's command buffer.
+    pub(super) fn record_pass<R>(
+        &mut self,
+        name: &str,
+        untimed: bool,
+        record: impl FnOnce(vk::CommandBuffer) -> R,
+    ) -> Option<R> {
         if self.error.is_some() {
-            return;
+            return None;
         }
         let ctx = self.frames.ctx.clone();
-        if self.per_pass() {
+        let cmd = self.frames.slots[self.slot].cmd;
+        if untimed {
+            ctx.begin_label(cmd, name);
+            let result = record(cmd);
+            ctx.end_label(cmd);
+            return Some(result);
+        }
+        let result = if self.per_pass() {
             let start = Instant::now();
-            let result = ctx.submit_and_wait(|cmd| {
+            let submitted = ctx.submit_and_wait(|cmd| {
                 ctx.begin_label(cmd, name);
-                record(cmd);
+                let result = record(cmd);
                 ctx.end_label(cmd);
+                result
             });
-            if let Err(e) = result {
-                self.error = Some(e);
-                return;
+            match submitted {
+                Ok(result) => {
+                    self.wall_ms.push(start.elapsed().as_secs_f64() * 1e3);
+                    Some(result)
+                }
+                Err(e) => {
+                    self.error = Some(e);
+                    return None;
+                }
             }
-            self.wall_ms.push(start.elapsed().as_secs_f64() * 1e3);
         } else {
-            let slot = &self.frames.slots[self.slot];
-            let (cmd, pool) = (slot.cmd, slot.queries);
+            let pool = self.frames.slots[self.slot].queries;
             let index = self.names.len() as u32;
             if index >= self.frames.max_passes {
                 panic!(
@@ -495,7 +507,7 @@ impl<'a> FrameRecorder<'a> {
                     index * 2,
                 )
             };
-            record(cmd);
+            let result = record(cmd);
             unsafe {
                 ctx.device.cmd_write_timestamp2(
                     cmd,
@@ -505,8 +517,10 @@ impl<'a> FrameRecorder<'a> {
                 )
             };
             ctx.end_label(cmd);
-        }
+            Some(result)
+        };
         self.names.push(name.to_string());
+        result
     }
 
     /// Writes `bytes` to the start of `dst` for this frame: into the frame's
@@ -536,12 +550,17 @@ impl<'a> FrameRecorder<'a> {
         // their sets without declaring it) and the buffer's last write; the
         // new contents are then made visible to every later command.
         let copy = |cmd: vk::CommandBuffer| {
-            step(&ctx, cmd).write(dst, Access::TransferWrite).emit();
+            barrier(
+                &ctx,
+                cmd,
+                &[],
+                &[BufferAccess::new(dst, Access::TransferWrite)],
+            );
             let region = vk::BufferCopy::default()
                 .src_offset(offset)
                 .size(bytes.len() as u64);
             unsafe { ctx.device.cmd_copy_buffer(cmd, src, dst.raw, &[region]) };
-            step(&ctx, cmd).read(dst, Access::AnyRead).emit();
+            barrier(&ctx, cmd, &[], &[BufferAccess::new(dst, Access::AnyRead)]);
         };
         if self.per_pass() {
             // Passes are separate submissions here: the copy must run before
@@ -550,7 +569,7 @@ impl<'a> FrameRecorder<'a> {
                 self.error = Some(e);
             }
         } else {
-            copy(self.cmd());
+            copy(self.frames.slots[self.slot].cmd);
         }
     }
 

@@ -33,9 +33,7 @@ mod ring;
 mod swapchain;
 mod sync;
 
-pub use commands::{
-    clear_color_image, copy_buffer, draw, draw_indirect, fill_buffer, update_buffer,
-};
+pub use commands::{Commands, Rendering, Step};
 pub use context::{Context, ContextOptions, ValidationCounts};
 pub use descriptors::{BindingKind, DescriptorSet, DescriptorSetLayout, Sampler};
 pub use device::{DeviceInfo, RequiredFeature};
@@ -47,18 +45,16 @@ pub use host_memory::{rust_heap, vulkan_host_memory, CountingAllocator, HostCoun
 pub use image::{Image, ImageDesc};
 pub use limits::{bytes, host_rss, trim_host_heap, MemoryHeaps, MemoryReport};
 pub use objects::{CommandPool, Semaphores};
-pub use pass::{step, Pass, Resource, Sync};
-pub use pipeline::{
-    begin_rendering, begin_rendering_with_depth, end_rendering, groups_8x8, ComputePipeline,
-    GraphicsPipeline,
-};
+pub use pass::{Pass, Resource};
+pub use pipeline::{groups_8x8, ComputePipeline, GraphicsPipeline};
 pub use pipeline_store::{
     CacheLoad, GraphicsPipelineDesc, PipelineCounts, PipelineStore, Specialization,
 };
 pub use profiler::Profiler;
 pub use resources::{Buffer, BufferUsage};
 pub use swapchain::{Acquired, Surface, Swapchain};
-pub use sync::{copy_image, Access, BufferAccess, ImageAccess};
+pub use sync::Access;
+use sync::{BufferAccess, ImageAccess};
 
 pub use ash::vk;
 

@@ -8,7 +8,7 @@
 //!     .sampled(&set, BINDING_SHADOW_MAP, &shadows.map, &sampler, Access::ComputeRead)
 //!     .overwrite_storage_image(&set, BINDING_RADIANCE, &targets.radiance, Access::ComputeWrite)
 //!     .read(&sh, Access::ComputeRead)
-//!     .record(|cmd| pipeline.dispatch(cmd, &[&scene.set, &set], push, groups));
+//!     .record(|c| c.dispatch(&pipeline, &[&scene.set, &set], push, groups));
 //! ```
 //!
 //! A binding's layout is the layout its access puts the image in
@@ -19,10 +19,10 @@
 //! pending command buffer uses it); changing one after the set was bound
 //! earlier in the same frame is a programming error and panics.
 //!
-//! Within one pass, a later step that depends on an earlier one (a dispatch
-//! reading what the previous dispatch wrote) is ordered by `step`, a
-//! declaration of the same kind: `step(ctx, cmd).read(..).write(..).emit()`.
+//! The closure records through `Commands` (`vk/commands.rs`), which orders
+//! a pass's later steps after its earlier ones from the same declaration.
 
+use super::commands::Commands;
 use super::descriptors::Bound;
 use super::sync::{barrier, ImageAccess};
 use super::{Access, Buffer, BufferAccess, Context, DescriptorSet, FrameRecorder, Image, Sampler};
@@ -69,7 +69,7 @@ impl<'a> Accesses<'a> {
         }
     }
 
-    fn read(&mut self, resource: Resource<'a>, access: Access) {
+    pub(super) fn read(&mut self, resource: Resource<'a>, access: Access) {
         assert!(
             !access.is_write(),
             "read declared with the writing access {access:?}"
@@ -77,7 +77,7 @@ impl<'a> Accesses<'a> {
         self.add(resource, access, false);
     }
 
-    fn write(&mut self, resource: Resource<'a>, access: Access, discard: bool) {
+    pub(super) fn write(&mut self, resource: Resource<'a>, access: Access, discard: bool) {
         assert!(
             access.is_write(),
             "write declared with the read-only access {access:?}"
@@ -85,34 +85,39 @@ impl<'a> Accesses<'a> {
         self.add(resource, access, discard);
     }
 
-    fn emit(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+    pub(super) fn emit(&self, ctx: &Context, cmd: vk::CommandBuffer) {
         barrier(ctx, cmd, &self.images, &self.buffers);
     }
-}
 
-/// `read`, `write` and `overwrite`, shared by a pass (`Pass`) and a step
-/// within one (`Sync`): both gather `Accesses` in a field `accesses`.
-macro_rules! declarations {
-    () => {
-        /// Reads `resource` (for a pass: bound elsewhere, such as set 0, an
-        /// attachment or an indirect argument buffer).
-        pub fn read(mut self, resource: impl Into<Resource<'a>>, access: Access) -> Self {
-            self.accesses.read(resource.into(), access);
-            self
-        }
-
-        /// Writes `resource`, keeping what is not overwritten.
-        pub fn write(mut self, resource: impl Into<Resource<'a>>, access: Access) -> Self {
-            self.accesses.write(resource.into(), access, false);
-            self
-        }
-
-        /// Overwrites every texel of `image`: its contents need not be kept.
-        pub fn overwrite(mut self, image: &'a Image, access: Access) -> Self {
-            self.accesses.write(Resource::Image(image), access, true);
-            self
-        }
-    };
+    /// The declaration again, keeping every image's contents, with `step`'s
+    /// accesses in place of it for the resources `step` names.
+    pub(super) fn emit_kept(&self, ctx: &Context, cmd: vk::CommandBuffer, step: Option<&Accesses>) {
+        let step_images = step.map_or(&[][..], |s| &s.images[..]);
+        let step_buffers = step.map_or(&[][..], |s| &s.buffers[..]);
+        let images: Vec<ImageAccess> = self
+            .images
+            .iter()
+            .filter(|a| step_images.iter().all(|s| s.image.raw != a.image.raw))
+            .map(|a| ImageAccess::new(a.image, a.next))
+            .chain(
+                step_images
+                    .iter()
+                    .map(|s| ImageAccess::new(s.image, s.next)),
+            )
+            .collect();
+        let buffers: Vec<BufferAccess> = self
+            .buffers
+            .iter()
+            .filter(|a| step_buffers.iter().all(|s| s.buffer.raw != a.buffer.raw))
+            .map(|a| BufferAccess::new(a.buffer, a.next))
+            .chain(
+                step_buffers
+                    .iter()
+                    .map(|s| BufferAccess::new(s.buffer, s.next)),
+            )
+            .collect();
+        barrier(ctx, cmd, &images, &buffers);
+    }
 }
 
 /// One binding a pass declares, written before its commands are recorded.
@@ -131,6 +136,7 @@ pub struct Pass<'r, 'f, 'a> {
     name: String,
     accesses: Accesses<'a>,
     bindings: Vec<Binding<'a>>,
+    untimed: bool,
 }
 
 impl<'r, 'f, 'a> Pass<'r, 'f, 'a> {
@@ -140,10 +146,38 @@ impl<'r, 'f, 'a> Pass<'r, 'f, 'a> {
             name: name.to_string(),
             accesses: Accesses::default(),
             bindings: Vec::new(),
+            untimed: false,
         }
     }
 
-    declarations!();
+    /// Reads `resource`, bound elsewhere (set 0, an attachment, an indirect
+    /// argument buffer).
+    pub fn read(mut self, resource: impl Into<Resource<'a>>, access: Access) -> Self {
+        self.accesses.read(resource.into(), access);
+        self
+    }
+
+    /// Writes `resource`, keeping what is not overwritten.
+    pub fn write(mut self, resource: impl Into<Resource<'a>>, access: Access) -> Self {
+        self.accesses.write(resource.into(), access, false);
+        self
+    }
+
+    /// Overwrites every texel of `image` at the start of the pass: its
+    /// contents need not be kept.
+    pub fn overwrite(mut self, image: &'a Image, access: Access) -> Self {
+        self.accesses.write(Resource::Image(image), access, true);
+        self
+    }
+
+    /// Records the pass into the frame's command buffer untimed, even when
+    /// every other pass is a submission of its own (`TimingSource::WallClock`):
+    /// the demo's blit to the swapchain image, which must wait for the
+    /// frame's acquire semaphore.
+    pub fn untimed(mut self) -> Self {
+        self.untimed = true;
+        self
+    }
 
     fn declare(&mut self, resource: Resource<'a>, access: Access) {
         if access.is_write() {
@@ -260,13 +294,15 @@ impl<'r, 'f, 'a> Pass<'r, 'f, 'a> {
     }
 
     /// Writes the declared bindings that changed, then records the pass: its
-    /// barrier first, then `commands`.
-    pub fn record(self, commands: impl FnOnce(vk::CommandBuffer)) {
+    /// barrier first, then `commands` through the recorder. `None` when an
+    /// earlier pass of the frame failed (the frame is not recorded further).
+    pub fn record<R>(self, commands: impl FnOnce(&mut Commands) -> R) -> Option<R> {
         let Pass {
             rec,
             name,
             accesses,
             bindings,
+            untimed,
         } = self;
         let serial = rec.serial();
         let mut waited = false;
@@ -297,35 +333,8 @@ impl<'r, 'f, 'a> Pass<'r, 'f, 'a> {
             }
         }
         let ctx = rec.ctx().clone();
-        rec.record_pass(&name, |cmd| {
-            accesses.emit(&ctx, cmd);
-            commands(cmd);
-        });
-    }
-}
-
-/// Starts a mid-pass declaration: a step of a pass that depends on an
-/// earlier step of it (`emit` records the barrier between them).
-pub fn step<'c, 'a>(ctx: &'c Context, cmd: vk::CommandBuffer) -> Sync<'c, 'a> {
-    Sync {
-        ctx,
-        cmd,
-        accesses: Accesses::default(),
-    }
-}
-
-/// A mid-pass declaration (`step`); `emit` records its barrier.
-#[must_use = "a sync declaration takes effect only through `emit`"]
-pub struct Sync<'c, 'a> {
-    ctx: &'c Context,
-    cmd: vk::CommandBuffer,
-    accesses: Accesses<'a>,
-}
-
-impl<'a> Sync<'_, 'a> {
-    declarations!();
-
-    pub fn emit(self) {
-        self.accesses.emit(self.ctx, self.cmd);
+        rec.record_pass(&name, untimed, |cmd| {
+            commands(&mut Commands::begin(&ctx, cmd, &accesses))
+        })
     }
 }

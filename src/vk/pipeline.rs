@@ -34,14 +34,14 @@ fn push(ctx: &Context, cmd: vk::CommandBuffer, layout: vk::PipelineLayout, data:
     }
 }
 
-/// A compute pipeline; equal ones are shared through the context's
-/// `PipelineStore`.
 /// Workgroups of 8x8 invocations covering a `width` x `height` grid (the
 /// local size of every per-pixel and per-texel compute shader here).
 pub fn groups_8x8(width: u32, height: u32) -> [u32; 3] {
     [width.div_ceil(8), height.div_ceil(8), 1]
 }
 
+/// A compute pipeline; equal ones are shared through the context's
+/// `PipelineStore`.
 pub struct ComputePipeline {
     // Declared before `ctx`: fields drop in order, and the shared pipeline
     // must go while the device it was made on is still held.
@@ -104,8 +104,9 @@ impl ComputePipeline {
         })
     }
 
-    /// Binds the pipeline and sets, pushes constants and dispatches `groups`.
-    pub fn dispatch(
+    /// Binds the pipeline and sets, pushes constants and dispatches `groups`
+    /// (`Commands::dispatch`).
+    pub(super) fn dispatch(
         &self,
         cmd: vk::CommandBuffer,
         sets: &[&DescriptorSet],
@@ -128,7 +129,7 @@ impl ComputePipeline {
     /// Binds the pipeline and sets, pushes constants and dispatches the
     /// `VkDispatchIndirectCommand` at byte `offset` of `args` (a
     /// `StorageIndirect` buffer the caller has barriered to `IndirectRead`).
-    pub fn dispatch_indirect(
+    pub(super) fn dispatch_indirect(
         &self,
         cmd: vk::CommandBuffer,
         sets: &[&DescriptorSet],
@@ -196,8 +197,9 @@ impl GraphicsPipeline {
         })
     }
 
-    /// Binds the pipeline, its sets and push constants, and sets a full viewport and scissor.
-    pub fn bind(
+    /// Binds the pipeline, its sets and push constants, and sets a full
+    /// viewport and scissor (`Rendering::bind`).
+    pub(super) fn bind(
         &self,
         cmd: vk::CommandBuffer,
         sets: &[&DescriptorSet],
@@ -229,77 +231,4 @@ impl GraphicsPipeline {
         bind_sets(ctx, cmd, vk::PipelineBindPoint::GRAPHICS, self.layout, sets);
         push(ctx, cmd, self.layout, push_data);
     }
-}
-
-/// Begins dynamic rendering into `colors` (cleared to `clear` when given) and an optional depth image (cleared to 1).
-pub fn begin_rendering(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    extent: vk::Extent2D,
-    colors: &[(vk::ImageView, Option<[f32; 4]>)],
-    depth: Option<vk::ImageView>,
-) {
-    begin_rendering_with_depth(ctx, cmd, extent, colors, depth.map(|v| (v, true)));
-}
-
-/// As `begin_rendering`, with the depth image `(view, clear)`: cleared to 1
-/// when `clear`, else loaded (a depth test against an earlier pass's depth).
-pub fn begin_rendering_with_depth(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    extent: vk::Extent2D,
-    colors: &[(vk::ImageView, Option<[f32; 4]>)],
-    depth: Option<(vk::ImageView, bool)>,
-) {
-    let color_attachments: Vec<_> = colors
-        .iter()
-        .map(|&(view, clear)| {
-            vk::RenderingAttachmentInfo::default()
-                .image_view(view)
-                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                .load_op(if clear.is_some() {
-                    vk::AttachmentLoadOp::CLEAR
-                } else {
-                    vk::AttachmentLoadOp::LOAD
-                })
-                .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(vk::ClearValue {
-                    color: vk::ClearColorValue {
-                        float32: clear.unwrap_or_default(),
-                    },
-                })
-        })
-        .collect();
-    let depth_attachment = depth.map(|(view, clear)| {
-        vk::RenderingAttachmentInfo::default()
-            .image_view(view)
-            .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
-            .load_op(if clear {
-                vk::AttachmentLoadOp::CLEAR
-            } else {
-                vk::AttachmentLoadOp::LOAD
-            })
-            .store_op(vk::AttachmentStoreOp::STORE)
-            .clear_value(vk::ClearValue {
-                depth_stencil: vk::ClearDepthStencilValue {
-                    depth: 1.0,
-                    stencil: 0,
-                },
-            })
-    });
-    let mut info = vk::RenderingInfo::default()
-        .render_area(vk::Rect2D {
-            offset: vk::Offset2D::default(),
-            extent,
-        })
-        .layer_count(1)
-        .color_attachments(&color_attachments);
-    if let Some(d) = depth_attachment.as_ref() {
-        info = info.depth_attachment(d);
-    }
-    unsafe { ctx.device.cmd_begin_rendering(cmd, &info) };
-}
-
-pub fn end_rendering(ctx: &Context, cmd: vk::CommandBuffer) {
-    unsafe { ctx.device.cmd_end_rendering(cmd) };
 }

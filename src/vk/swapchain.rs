@@ -8,7 +8,8 @@
 //! destroys the old one only after the caller has waited for the frames that
 //! used it.
 
-use super::{step, Access, Context, Image, VkError, VkResult};
+use super::sync::{barrier, ImageAccess};
+use super::{Access, Commands, Context, Image, VkError, VkResult};
 use ash::vk;
 use std::sync::Arc;
 
@@ -233,12 +234,16 @@ impl Swapchain {
     /// acquire semaphore is waited at (`Image::acquired`). A blit, not a
     /// copy, so RGBA sources reach BGRA swapchains with their channels in
     /// place and mismatched sizes are scaled.
-    pub fn blit_to_image(&self, cmd: vk::CommandBuffer, index: u32, src: &Image, then_draw: bool) {
+    pub fn blit_to_image(&self, commands: &mut Commands, index: u32, src: &Image, then_draw: bool) {
+        let cmd = commands.raw();
         let image = &self.images[index as usize];
         image.acquired();
-        step(&self.ctx, cmd)
-            .overwrite(image, Access::TransferWrite)
-            .emit();
+        barrier(
+            &self.ctx,
+            cmd,
+            &[ImageAccess::discard(image, Access::TransferWrite)],
+            &[],
+        );
         let layers = vk::ImageSubresourceLayers {
             aspect_mask: vk::ImageAspectFlags::COLOR,
             mip_level: 0,
@@ -268,19 +273,23 @@ impl Swapchain {
         };
         // Presentation needs no access mask: the render-finished semaphore
         // signalled at the end of the submission makes the writes visible.
-        let next = step(&self.ctx, cmd);
-        if then_draw {
-            next.write(image, Access::ColorAttachment).emit();
+        let next = if then_draw {
+            Access::ColorAttachment
         } else {
-            next.read(image, Access::Present).emit();
-        }
+            Access::Present
+        };
+        barrier(&self.ctx, cmd, &[ImageAccess::new(image, next)], &[]);
     }
 
     /// After drawing on top of a blit: swapchain image `index` to presentation.
-    pub fn attachment_to_present(&self, cmd: vk::CommandBuffer, index: u32) {
-        step(&self.ctx, cmd)
-            .read(&self.images[index as usize], Access::Present)
-            .emit();
+    pub fn attachment_to_present(&self, commands: &mut Commands, index: u32) {
+        let image = &self.images[index as usize];
+        barrier(
+            &self.ctx,
+            commands.raw(),
+            &[ImageAccess::new(image, Access::Present)],
+            &[],
+        );
     }
 }
 

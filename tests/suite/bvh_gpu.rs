@@ -25,8 +25,7 @@ use caustics::gpu::GpuTriangle;
 use caustics::scene::Scene;
 use caustics::shader_bindings as b;
 use caustics::vk::{
-    step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, DescriptorSet,
-    DescriptorSetLayout,
+    Access, BindingKind, Buffer, BufferUsage, ComputePipeline, DescriptorSet, DescriptorSetLayout,
 };
 use common::*;
 use glam::Vec3;
@@ -168,18 +167,17 @@ fn check(path: &str, scene: Scene, seed: u64) {
     // write it so the set holds no uninitialised data.
     scene_gpu.update_frame(&scene, 128, 128, 0.0, 0).unwrap();
     let start = std::time::Instant::now();
-    ctx.submit_and_wait(|cmd| {
-        step(&ctx, cmd)
+    ctx.submit_commands_and_wait(|c| {
+        c.step()
             .read(&ray_buf, Access::ComputeRead)
             .write(&results, Access::ComputeWrite)
             .write(&any, Access::ComputeWrite)
-            .emit();
-        pipeline.dispatch(
-            cmd,
-            &[&scene_gpu.set, &set],
-            &[],
-            [(RAYS as u32).div_ceil(64), 1, 1],
-        );
+            .dispatch(
+                &pipeline,
+                &[&scene_gpu.set, &set],
+                &[],
+                [(RAYS as u32).div_ceil(64), 1, 1],
+            );
     })
     .unwrap();
     let gpu_s = start.elapsed().as_secs_f64();

@@ -12,9 +12,7 @@ use caustics::scene::Camera;
 use caustics::techniques::water_photons::denoise::{
     adaptive_vs_fixed, c_scene, DenoiseConfig, DenoiseKind, Denoiser,
 };
-use caustics::vk::{
-    copy_image, step, vk, Access, Buffer, BufferUsage, Context, Image, ImageDesc, Profiler,
-};
+use caustics::vk::{vk, Buffer, BufferUsage, Context, Image, ImageDesc, Profiler};
 use common::{assert_validation_clean, validated_context};
 use glam::Vec3;
 use std::sync::Arc;
@@ -50,33 +48,8 @@ fn upload_sized(ctx: &Arc<Context>, name: &str, data: &[f32], size: u32) -> Imag
     )
     .unwrap();
     let staging = Buffer::with_data(ctx, "staging", data, BufferUsage::Upload).unwrap();
-    ctx.submit_and_wait(|cmd| {
-        step(ctx, cmd)
-            .overwrite(&image, Access::TransferWrite)
-            .emit();
-        let region = vk::BufferImageCopy::default()
-            .image_subresource(vk::ImageSubresourceLayers {
-                aspect_mask: vk::ImageAspectFlags::COLOR,
-                mip_level: 0,
-                base_array_layer: 0,
-                layer_count: 1,
-            })
-            .image_extent(vk::Extent3D {
-                width: size,
-                height: size,
-                depth: 1,
-            });
-        unsafe {
-            ctx.device.cmd_copy_buffer_to_image(
-                cmd,
-                staging.raw,
-                image.raw,
-                image.layout(),
-                &[region],
-            )
-        };
-    })
-    .unwrap();
+    ctx.submit_commands_and_wait(|c| c.copy_buffer_to_image(&staging, &image))
+        .unwrap();
     image
 }
 
@@ -614,9 +587,8 @@ fn real_gbuffer_edges() {
         let denoiser = Denoiser::new(&ctx, config, &caustics, &gbuffer.position).unwrap();
         profiler
             .frame(|rec| {
-                let ctx = rec.ctx().clone();
                 rec.pass("copy")
-                    .record(|cmd| copy_image(&ctx, cmd, &staged, &caustics));
+                    .record(|c| c.copy_image(&staged, &caustics));
                 denoiser.record(
                     rec,
                     &caustics,

@@ -54,7 +54,7 @@ fn sky_environment_loads() {
     assert_eq!(sky.sun_direction, Vec3::Y);
     assert_eq!(sky.horizon, Vec3::splat(0.3));
     // E = L 2π(1 − cos α).
-    let (dir, e) = caustics::environment::sun_irradiance(&env).expect("a sun");
+    let (dir, e) = caustics::emitters::sun_irradiance(&env).expect("a sun");
     assert_eq!(dir, Vec3::NEG_Y);
     let expected = 1000.0 * 2.0 * std::f32::consts::PI * (1.0 - 0.5f32.to_radians().cos());
     assert!((e.x - expected).abs() < 1e-3 * expected);
@@ -178,7 +178,7 @@ fn area_lights_load_with_their_geometry() {
         let [a, b, c] = t.positions;
         assert!((b - a).cross(c - a).normalize().dot(Vec3::NEG_Y) > 0.999);
     }
-    let power = caustics::environment::emitter_power(&s.emitters[0]);
+    let power = caustics::emitters::emitter_power(&s.emitters[0]);
     assert!((power.x - std::f32::consts::PI * 10.0 * 0.125).abs() < 1e-4);
 }
 
@@ -287,7 +287,7 @@ fn canonical_light_scenes_load() {
     assert_eq!((t.width, t.height), (256, 128));
     // Brighter toward the sun (-x, 25 degrees up) than straight up.
     let texel = |d: Vec3| {
-        let (u, v) = caustics::environment::equirect_uv(d);
+        let (u, v) = caustics::emitters::equirect_uv(d);
         let (i, j) = ((u * 256.0) as usize, (v * 128.0) as usize);
         Vec3::from(t.texels[j * 256 + i])
     };
@@ -295,7 +295,7 @@ fn canonical_light_scenes_load() {
     assert!(texel(to_sun).x > 100.0 * texel(Vec3::Y).x);
     // The sun `direct` extracts from the image: the script's 700 W/m² red
     // (less the faint rim texels left to the sky), from -x at 25 degrees.
-    let (travel, e) = caustics::environment::sun_irradiance(&env).expect("a sun in the image");
+    let (travel, e) = caustics::emitters::sun_irradiance(&env).expect("a sun in the image");
     eprintln!("extracted sun: E {e}, toward {}", -travel);
     assert!((-travel).dot(to_sun) > 0.9995, "{travel}");
     assert!((e.x / 700.0 - 1.0).abs() < 0.05, "{e}");

@@ -189,9 +189,8 @@ impl Probe {
         let out = Buffer::new(ctx, "probe", 16, BufferUsage::Storage).unwrap();
         let set = DescriptorSet::new(ctx, &self.layout).unwrap();
         set.write_buffer(b::PROBE_BINDING_RESULTS, &out);
-        ctx.submit_and_wait(|cmd| {
-            self.scaled
-                .dispatch(cmd, &[&set], bytemuck::bytes_of(&value), [1, 1, 1])
+        ctx.submit_commands_and_wait(|c| {
+            c.dispatch(&self.scaled, &[&set], bytemuck::bytes_of(&value), [1, 1, 1])
         })
         .unwrap();
         out.download_pod::<u32>().unwrap()[0]

@@ -145,9 +145,9 @@ fn algorithm_1_on_the_gpu_matches_the_cpu() {
             0,
             0,
         ];
-        ctx.submit_and_wait(|cmd| {
-            pipeline.dispatch(
-                cmd,
+        ctx.submit_commands_and_wait(|c| {
+            c.dispatch(
+                &pipeline,
                 &[&set],
                 bytemuck::bytes_of(&push),
                 [threads.div_ceil(64), 1, 1],

@@ -12,7 +12,6 @@ use super::error::Source;
 use super::node::{self, Tbl, R};
 use super::paths::{AllowedPaths, Confinement};
 use super::types::*;
-use crate::shader_bindings::MAX_LIGHTS;
 use glam::Vec3;
 use materials::Materials;
 use std::path::Path;
@@ -79,12 +78,13 @@ pub(crate) fn parse(text: &str, path: &Path, allowed: &AllowedPaths) -> R<Scene>
                 emitter_shapes.push(emitters::area_light(t)?);
             }
             _ => {
-                if lights.len() == MAX_LIGHTS as usize {
+                if lights.len() == super::MAX_LIGHTS {
                     return Err(src.err(
                         &t.span,
                         &t.path,
                         format!(
-                            "too many lights: at most {MAX_LIGHTS} point, spot and directional lights are supported"
+                            "too many lights: at most {} point, spot and directional lights are supported",
+                            super::MAX_LIGHTS
                         ),
                     ));
                 }

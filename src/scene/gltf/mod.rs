@@ -20,7 +20,6 @@ use super::obj::{accumulate_normals, fix_zero_normals};
 use super::paths::{AllowedPaths, Confinement};
 use super::texture;
 use super::types::*;
-use crate::shader_bindings::MAX_LIGHTS;
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::mesh::Mode;
 use ::gltf::texture::WrappingMode;

@@ -36,13 +36,14 @@ pub const DEFAULT_SUN_EXPOSURE: f32 = 0.004;
 /// floor unless `options` leaves it out. Warnings go to the log.
 pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError> {
     let mut asset = load_allowing(path, &options.allowed)?;
-    if asset.lights.len() > MAX_LIGHTS as usize {
+    if asset.lights.len() > crate::scene::MAX_LIGHTS {
         return Err(GltfError {
             file: path.to_path_buf(),
             at: "extensions.KHR_lights_punctual".into(),
             message: format!(
-                "the scene uses {} lights, at most {MAX_LIGHTS} are supported",
-                asset.lights.len()
+                "the scene uses {} lights, at most {} are supported",
+                asset.lights.len(),
+                crate::scene::MAX_LIGHTS
             ),
         });
     }

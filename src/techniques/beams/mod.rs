@@ -191,14 +191,14 @@ impl TechniqueBuild for Beams {
     type Params = BeamsParams;
 
     /// Thin sheets and emissive surfaces are outside its model. Area lights
-    /// become point stand-ins (`environment::caustic_lights`: a rect is a
+    /// become point stand-ins (`frame::caustic_lights`: a rect is a
     /// spot at its centre with the cosine profile, I = L A cos theta, whose
     /// light view and beams are a spot's), within their size limit; sphere
     /// lights are refused.
     fn check_scene(scene: &Scene) -> anyhow::Result<()> {
         super::check_materials(scene, Self::NAME)?;
         super::check_no_mixed(scene, Self::NAME)?;
-        crate::environment::check_stand_ins(scene, Self::NAME).map_err(anyhow::Error::msg)
+        crate::frame::check_stand_ins(scene, Self::NAME).map_err(anyhow::Error::msg)
     }
 
     fn build(

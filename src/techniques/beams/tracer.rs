@@ -17,9 +17,9 @@ use crate::passes::surface_frame::SurfaceFrame;
 use crate::radiometry::luminance;
 use crate::scene::{Density, Light, LightKind, Scene};
 use crate::vk::{
-    begin_rendering, end_rendering, groups_8x8, step, Access, BindingKind, Buffer, BufferUsage,
-    ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
-    GraphicsPipelineDesc, Image, ImageDesc, VkResult, MAX_FRAMES_IN_FLIGHT,
+    groups_8x8, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
+    VkResult, MAX_FRAMES_IN_FLIGHT,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -511,7 +511,7 @@ impl BeamTracer {
         // its sun and rect lights (without them the energy criterion of a
         // stand-in's view would split every triangle).
         let view_flux = view_fluxes(
-            &crate::environment::caustic_lights(scene),
+            &crate::frame::caustic_lights(scene),
             crate::passes::light_views::specular_bounds(scene),
             light_view_size,
         );
@@ -588,7 +588,6 @@ impl BeamTracer {
         surface: &SurfaceFrame,
         targets: &FrameTargets,
     ) {
-        let ctx = rec.ctx().clone();
         // The camera G-buffers were written by rasterisation; the
         // receivers are overwritten after last frame's fragments.
         let set = &self.sets.receivers;
@@ -612,37 +611,28 @@ impl BeamTracer {
                 Access::ComputeRead,
             )
             .write(&self.receivers, Access::ComputeWrite)
-            .record(|cmd| {
+            .record(|c| {
                 let groups = groups_8x8(targets.width, targets.height);
-                self.receivers_pipeline
-                    .dispatch(cmd, &[&scene.set, set], &[], groups);
+                c.dispatch(&self.receivers_pipeline, &[&scene.set, set], &[], groups);
             });
         // The frame's statistics start from zero (after last frame's
         // copy to the host); both targets are cleared.
         rec.pass("beam clear")
             .overwrite(&self.volume, Access::ColorAttachment)
             .overwrite(&self.surface, Access::ColorAttachment)
-            .write(&self.counters, Access::TransferWrite)
-            .record(|cmd| {
-                crate::vk::fill_buffer(&ctx, cmd, &self.counters, 0);
-                begin_rendering(
-                    &ctx,
-                    cmd,
-                    self.volume.extent(),
-                    &[
-                        (self.volume.view, Some([0.0; 4])),
-                        (self.surface.view, Some([0.0; 4])),
-                    ],
-                    None,
-                );
-                end_rendering(&ctx, cmd);
+            .record(|c| {
+                c.fill(&self.counters, 0);
+                let colors = [
+                    (self.volume.view, Some([0.0; 4])),
+                    (self.surface.view, Some([0.0; 4])),
+                ];
+                c.render(self.volume.extent(), &colors, None, |_| {});
             });
     }
 
     /// Records "beam apply": the surface caustics into the opaque frame
     /// (before the surface frame's refraction reads it).
     pub fn apply(&self, rec: &mut FrameRecorder, scene: &SceneGpu, surface: &SurfaceFrame) {
-        let ctx = rec.ctx().clone();
         if self.surface_filter > 0 {
             let e = self.surface.extent();
             let groups = groups_8x8(e.width, e.height);
@@ -665,23 +655,20 @@ impl BeamTracer {
                     Access::ComputeWrite,
                 )
                 .read(&self.receivers, Access::ComputeRead)
-                .record(|cmd| {
+                .record(|c| {
                     let push = [self.surface_filter, 0];
-                    self.filter_pipeline.dispatch(
-                        cmd,
+                    c.dispatch(
+                        &self.filter_pipeline,
                         &[&scene.set, set],
                         bytemuck::cast_slice(&push),
                         groups,
                     );
                     // y: the intermediate -> the surface target (read-after-
-                    // write one way, write-after-read the other).
-                    step(&ctx, cmd)
-                        .write(&self.surface_filtered, Access::ComputeWrite)
-                        .write(&self.surface, Access::ComputeWrite)
-                        .emit();
+                    // write one way, write-after-read the other: the
+                    // declaration's barrier again, `Commands`).
                     let push = [self.surface_filter, 1];
-                    self.filter_pipeline.dispatch(
-                        cmd,
+                    c.dispatch(
+                        &self.filter_pipeline,
                         &[&scene.set, set],
                         bytemuck::cast_slice(&push),
                         groups,
@@ -722,11 +709,11 @@ impl BeamTracer {
                 surface.opaque(),
                 Access::ComputeWrite,
             )
-            .record(|cmd| {
+            .record(|c| {
                 let e = surface.opaque().extent();
                 let groups = groups_8x8(e.width, e.height);
-                self.apply_pipeline.dispatch(
-                    cmd,
+                c.dispatch(
+                    &self.apply_pipeline,
                     &[&scene.set, set],
                     bytemuck::bytes_of(&self.volume_push.medium_steps),
                     groups,
@@ -738,7 +725,6 @@ impl BeamTracer {
     /// radiance, after the refraction wrote it) and the counters' copy to
     /// this frame's read-back buffer.
     pub fn composite(&self, rec: &mut FrameRecorder, scene: &SceneGpu, targets: &FrameTargets) {
-        let ctx = rec.ctx().clone();
         let readback = &self.readbacks[rec.slot()];
         let set = &self.sets.composite;
         rec.pass("beam composite")
@@ -754,14 +740,10 @@ impl BeamTracer {
                 &targets.radiance,
                 Access::ComputeWrite,
             )
-            .read(&self.counters, Access::TransferRead)
-            .write(readback, Access::TransferWrite)
-            .record(|cmd| {
+            .record(|c| {
                 let groups = groups_8x8(targets.width, targets.height);
-                self.composite_pipeline
-                    .dispatch(cmd, &[&scene.set, set], &[], groups);
-                crate::vk::copy_buffer(&ctx, cmd, &self.counters, readback, self.counters.size);
-                step(&ctx, cmd).read(readback, Access::HostRead).emit();
+                c.dispatch(&self.composite_pipeline, &[&scene.set, set], &[], groups);
+                c.read_back(&self.counters, readback, self.counters.size);
             });
     }
 }
@@ -781,7 +763,6 @@ impl LightViewConsumer for BeamTracer {
         view: &LightView,
         light_view: &SpecularGBuffer,
     ) {
-        let ctx = rec.ctx().clone();
         let base = self.refine.grid[2];
         let first = 2 * base * base;
         let mut push = self.refine;
@@ -795,7 +776,7 @@ impl LightViewConsumer for BeamTracer {
         rec.pass("beam grid")
             .write(&self.counters, Access::TransferWrite)
             .write(&self.indirect, Access::TransferWrite)
-            .record(|cmd| {
+            .record(|c| {
                 let mut light_words = [0u32; bb::BEAMS_COUNTER_LIGHT_WORDS as usize];
                 light_words[bb::BEAMS_COUNTER_TRIS as usize] = first;
                 let mut args = [0u32; bb::BEAMS_INDIRECT_WORDS as usize];
@@ -803,9 +784,9 @@ impl LightViewConsumer for BeamTracer {
                 args[1] = 1;
                 args[2] = 1;
                 let words = bytemuck::cast_slice(&light_words);
-                crate::vk::update_buffer(&ctx, cmd, &self.counters, 0, words);
+                c.update(&self.counters, 0, words);
                 let words = bytemuck::cast_slice(&args);
-                crate::vk::update_buffer(&ctx, cmd, &self.indirect, 0, words);
+                c.update(&self.indirect, 0, words);
             });
         for level in 0..=self.refine.grid[1] {
             push.grid[0] = level;
@@ -832,9 +813,9 @@ impl LightViewConsumer for BeamTracer {
                         bb::BEAMS_BINDING_BACK_NORMAL,
                     ],
                 )
-                .record(|cmd| {
-                    self.refine_pipeline.dispatch_indirect(
-                        cmd,
+                .record(|c| {
+                    c.dispatch_indirect(
+                        &self.refine_pipeline,
                         &[&scene.set, set],
                         bytemuck::bytes_of(&push),
                         &self.indirect,
@@ -843,16 +824,15 @@ impl LightViewConsumer for BeamTracer {
                     // The next level's arguments (and the draw's) from the
                     // counts this level appended (read-after-write), written
                     // after this level's indirect read (write-after-read).
-                    step(&ctx, cmd)
+                    c.step()
                         .read(&self.counters, Access::ComputeRead)
                         .write(&self.indirect, Access::ComputeWrite)
-                        .emit();
-                    self.args_pipeline.dispatch(
-                        cmd,
-                        &[&scene.set, set],
-                        bytemuck::bytes_of(&self.args),
-                        [1, 1, 1],
-                    );
+                        .dispatch(
+                            &self.args_pipeline,
+                            &[&scene.set, set],
+                            bytemuck::bytes_of(&self.args),
+                            [1, 1, 1],
+                        );
                 });
         }
         // The volumes (nothing to integrate without a medium), then the
@@ -881,7 +861,6 @@ impl BeamTracer {
         target: &Image,
         pipeline: &GraphicsPipeline,
     ) {
-        let ctx = rec.ctx().clone();
         // Beams pulled by the geometry shader and read again by the
         // fragments; the draw's count as indirect arguments; the fragment
         // counters by fragment atomics; the receivers per pixel; the
@@ -894,18 +873,12 @@ impl BeamTracer {
             .write(&self.counters, Access::FragmentWrite)
             .read(&self.receivers, Access::FragmentRead)
             .read(&scene.triangles, Access::FragmentRead)
-            .record(|cmd| {
-                let extent = target.extent();
-                begin_rendering(&ctx, cmd, extent, &[(target.view, None)], None);
-                pipeline.bind(
-                    cmd,
-                    &[&scene.set, set],
-                    bytemuck::bytes_of(&self.volume_push),
-                    extent,
-                );
-                let offset = 4 * bb::BEAMS_INDIRECT_DRAW as u64;
-                crate::vk::draw_indirect(&ctx, cmd, &self.indirect, offset);
-                end_rendering(&ctx, cmd);
+            .record(|c| {
+                c.render(target.extent(), &[(target.view, None)], None, |r| {
+                    let push = bytemuck::bytes_of(&self.volume_push);
+                    r.bind(pipeline, &[&scene.set, set], push);
+                    r.draw_indirect(&self.indirect, 4 * bb::BEAMS_INDIRECT_DRAW as u64);
+                });
             });
     }
 }

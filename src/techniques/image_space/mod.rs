@@ -130,7 +130,7 @@ impl TechniqueBuild for ImageSpace {
     fn check_scene(scene: &Scene) -> anyhow::Result<()> {
         super::check_materials(scene, Self::NAME)?;
         super::check_no_mixed(scene, Self::NAME)?;
-        crate::environment::check_stand_ins(scene, Self::NAME).map_err(anyhow::Error::msg)
+        crate::frame::check_stand_ins(scene, Self::NAME).map_err(anyhow::Error::msg)
     }
 }
 

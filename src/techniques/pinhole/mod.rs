@@ -65,8 +65,8 @@ use crate::radiometry::Component;
 use crate::scene::{EnvironmentKind, Scene};
 use crate::shader_bindings as sb;
 use crate::vk::{
-    groups_8x8, step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context,
-    DescriptorSet, DescriptorSetLayout, FrameRecorder, Image, ImageDesc, Sampler, VkResult,
+    groups_8x8, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    DescriptorSetLayout, FrameRecorder, Image, ImageDesc, Sampler, VkResult,
 };
 use ash::vk;
 use bindings as b;
@@ -361,7 +361,6 @@ impl Pinhole {
     /// Records the sample points, clusters, light maps and receivers'
     /// caustics into the opaque frame (steps 1-7 of the module's list).
     fn record_caustics(&self, rec: &mut FrameRecorder, scene: &SceneGpu) {
-        let ctx = rec.ctx().clone();
         let push = bytemuck::bytes_of(&self.push);
         let sets = [&scene.set, &self.set];
         let one = [1, 1, 1];
@@ -373,48 +372,47 @@ impl Pinhole {
             .write(&self.cdf, w)
             .write(&self.state, w)
             .write(&self.heads, w)
-            .record(|cmd| self.areas.dispatch(cmd, &sets, push, one));
+            .record(|c| c.dispatch(&self.areas, &sets, push, one));
         rec.pass("pinhole candidates")
             .read(&self.cdf, r)
             .read(&self.state, r)
             .write(&self.candidates, w)
             .write(&self.heads, w)
             .write(&self.next, w)
-            .record(|cmd| {
+            .record(|c| {
                 let groups = [self.push.candidates.div_ceil(64), 1, 1];
-                self.candidates_pass.dispatch(cmd, &sets, push, groups);
+                c.dispatch(&self.candidates_pass, &sets, push, groups);
             });
-        rec.pass("pinhole samples").record(|cmd| {
-            // One dispatch per chunk of candidates; each continues the
-            // previous one's kept count and flags.
-            for first in (0..self.push.candidates).step_by(b::PINHOLE_SELECT_CHUNK as usize) {
-                step(&ctx, cmd)
-                    .write(&self.candidates, w)
-                    .read(&self.heads, r)
-                    .read(&self.next, r)
-                    .write(&self.samples, w)
-                    .write(&self.state, w)
-                    .emit();
-                let chunk = PinholePush {
-                    first_candidate: first,
-                    ..self.push
-                };
-                self.select
-                    .dispatch(cmd, &sets, bytemuck::bytes_of(&chunk), one);
-            }
-        });
+        rec.pass("pinhole samples")
+            .write(&self.candidates, w)
+            .read(&self.heads, r)
+            .read(&self.next, r)
+            .write(&self.samples, w)
+            .write(&self.state, w)
+            .record(|c| {
+                // One dispatch per chunk of candidates; each continues the
+                // previous one's kept count and flags (ordered by the
+                // declaration's barrier before each, `Commands`).
+                for first in (0..self.push.candidates).step_by(b::PINHOLE_SELECT_CHUNK as usize) {
+                    let chunk = PinholePush {
+                        first_candidate: first,
+                        ..self.push
+                    };
+                    c.dispatch(&self.select, &sets, bytemuck::bytes_of(&chunk), one);
+                }
+            });
         rec.pass("pinhole gradients")
             .read(&self.candidates, r)
             .read(&self.state, r)
             .write(&self.samples, w)
-            .record(|cmd| {
+            .record(|c| {
                 let groups = [self.push.target.div_ceil(64), 1, 1];
-                self.gradients.dispatch(cmd, &sets, push, groups);
+                c.dispatch(&self.gradients, &sets, push, groups);
             });
         rec.pass("pinhole clusters")
             .write(&self.samples, w)
             .write(&self.state, w)
-            .record(|cmd| self.clusters.dispatch(cmd, &sets, push, one));
+            .record(|c| c.dispatch(&self.clusters, &sets, push, one));
         let set = &self.light_map_set;
         rec.pass("pinhole light maps")
             .write(&self.state, w)
@@ -425,11 +423,10 @@ impl Pinhole {
                 self.light_map.level_views[0],
                 w,
             )
-            .record(|cmd| {
+            .record(|c| {
                 let s = self.push.cube_size.div_ceil(8);
                 let groups = [s, s, self.light_map.desc.layers];
-                self.light_maps
-                    .dispatch(cmd, &[&scene.set, set], push, groups);
+                c.dispatch(&self.light_maps, &[&scene.set, set], push, groups);
             });
         let mut mips = rec.pass("pinhole light mips");
         for (l, set) in self.mip_sets.iter().enumerate() {
@@ -450,13 +447,13 @@ impl Pinhole {
                     w,
                 );
         }
-        mips.record(|cmd| {
+        mips.record(|c| {
             for (l, set) in self.mip_sets.iter().enumerate() {
-                // Level l + 1 reads level l, written by the previous dispatch.
-                step(&ctx, cmd).write(&self.light_map, w).emit();
+                // Level l + 1 reads level l, written by the previous
+                // dispatch (the declaration's barrier again, `Commands`).
                 let s = (self.push.cube_size >> (l + 1)).max(1).div_ceil(8);
                 let groups = [s, s, self.light_map.desc.layers];
-                self.mips.dispatch(cmd, &[&scene.set, set], &[], groups);
+                c.dispatch(&self.mips, &[&scene.set, set], &[], groups);
             }
         });
         let gbuffer = self.surface.gbuffer();
@@ -476,11 +473,10 @@ impl Pinhole {
             .storage_image(set, b::PINHOLE_BINDING_RADIANCE, opaque, w)
             .read(&self.samples, r)
             .read(&self.state, r)
-            .record(|cmd| {
+            .record(|c| {
                 let extent = opaque.extent();
                 let groups = groups_8x8(extent.width, extent.height);
-                self.receivers
-                    .dispatch(cmd, &[&scene.set, set], push, groups);
+                c.dispatch(&self.receivers, &[&scene.set, set], push, groups);
             });
     }
 }

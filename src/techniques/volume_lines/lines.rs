@@ -10,9 +10,9 @@ use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::passes::surface_frame::SurfaceFrame;
 use crate::scene::{Density, Scene};
 use crate::vk::{
-    begin_rendering, end_rendering, groups_8x8, Access, BindingKind, Buffer, BufferUsage,
-    ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
-    GraphicsPipelineDesc, Image, ImageDesc, VkResult,
+    groups_8x8, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
+    VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -277,7 +277,6 @@ impl VolumeRays {
         surface: &SurfaceFrame,
         targets: &FrameTargets,
     ) {
-        let ctx = rec.ctx().clone();
         // The camera G-buffers were written by rasterisation; the
         // distances are overwritten after last frame's line fragments.
         let set = &self.visibility_set;
@@ -295,22 +294,15 @@ impl VolumeRays {
                 Access::ComputeRead,
             )
             .write(&self.visibility, Access::ComputeWrite)
-            .record(|cmd| {
+            .record(|c| {
                 let groups = groups_8x8(targets.width, targets.height);
-                self.visibility_pipeline
-                    .dispatch(cmd, &[&scene.set, set], &[], groups);
+                c.dispatch(&self.visibility_pipeline, &[&scene.set, set], &[], groups);
             });
         rec.pass("volume clear")
             .overwrite(&self.volume, Access::ColorAttachment)
-            .record(|cmd| {
-                begin_rendering(
-                    &ctx,
-                    cmd,
-                    self.volume.extent(),
-                    &[(self.volume.view, Some([0.0; 4]))],
-                    None,
-                );
-                end_rendering(&ctx, cmd);
+            .record(|c| {
+                let colors = [(self.volume.view, Some([0.0; 4]))];
+                c.render(self.volume.extent(), &colors, None, |_| {});
             });
     }
 
@@ -333,10 +325,9 @@ impl VolumeRays {
                 &targets.radiance,
                 Access::ComputeWrite,
             )
-            .record(|cmd| {
+            .record(|c| {
                 let groups = groups_8x8(targets.width, targets.height);
-                self.composite_pipeline
-                    .dispatch(cmd, &[&scene.set, set], &[], groups);
+                c.dispatch(&self.composite_pipeline, &[&scene.set, set], &[], groups);
             });
     }
 }
@@ -355,7 +346,6 @@ impl LightViewConsumer for VolumeRays {
         view: &LightView,
         light_view: &SpecularGBuffer,
     ) {
-        let ctx = rec.ctx().clone();
         let push = SegmentPush {
             origin: view.origin,
             right: view.right,
@@ -381,10 +371,10 @@ impl LightViewConsumer for VolumeRays {
                     bindings::VOLUME_LINES_BINDING_BACK_NORMAL,
                 ],
             )
-            .record(|cmd| {
+            .record(|c| {
                 let groups = groups_8x8(self.buffer_size, self.buffer_size);
-                self.segment_pipeline.dispatch(
-                    cmd,
+                c.dispatch(
+                    &self.segment_pipeline,
                     &[&scene.set, &self.set],
                     bytemuck::bytes_of(&push),
                     groups,
@@ -397,17 +387,17 @@ impl LightViewConsumer for VolumeRays {
             .write(&self.volume, Access::ColorAttachment)
             .read(&self.segments, Access::GraphicsRead)
             .read(&self.visibility, Access::FragmentRead)
-            .record(|cmd| {
-                let extent = self.volume.extent();
-                begin_rendering(&ctx, cmd, extent, &[(self.volume.view, None)], None);
-                self.line_pipeline.bind(
-                    cmd,
-                    &[&scene.set, &self.set],
-                    bytemuck::bytes_of(&self.line_push),
-                    extent,
+            .record(|c| {
+                c.render(
+                    self.volume.extent(),
+                    &[(self.volume.view, None)],
+                    None,
+                    |r| {
+                        let push = bytemuck::bytes_of(&self.line_push);
+                        r.bind(&self.line_pipeline, &[&scene.set, &self.set], push);
+                        r.draw(self.draw_count);
+                    },
                 );
-                crate::vk::draw(&ctx, cmd, self.draw_count);
-                end_rendering(&ctx, cmd);
             });
     }
 }

@@ -9,9 +9,8 @@ use super::bindings;
 use crate::passes::water_surface::WaterSurface;
 use crate::scene::Water;
 use crate::vk::{
-    begin_rendering, end_rendering, Access, BindingKind, Context, DescriptorSet,
-    DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
-    VkResult,
+    Access, BindingKind, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder,
+    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -96,7 +95,6 @@ impl Ccm {
     /// (one layer per entry of `view_projs`, nearest water to the light).
     pub fn record(&self, rec: &mut FrameRecorder, time: f32, view_projs: &[Mat4]) {
         self.surface.record(rec, time);
-        let ctx = rec.ctx().clone();
         // The vertices written by compute are pulled by the vertex
         // shader; every layer is cleared and redrawn (last frame's
         // trace reads done first).
@@ -105,28 +103,22 @@ impl Ccm {
             .overwrite(&self.normal, Access::ColorAttachment)
             .overwrite(&self.depth, Access::DepthAttachment)
             .read(&self.surface.vertices, Access::VertexRead)
-            .record(|cmd| {
+            .record(|c| {
                 let extent = self.position.extent();
-                for (c, view_proj) in view_projs.iter().enumerate() {
-                    begin_rendering(
-                        &ctx,
-                        cmd,
-                        extent,
-                        &[
-                            (self.position.layer_views[c], Some([0.0; 4])),
-                            (self.normal.layer_views[c], Some([0.0; 4])),
-                        ],
-                        Some(self.depth.layer_views[c]),
-                    );
-                    let push = CcmPush {
-                        view_proj: view_proj.to_cols_array_2d(),
-                        grid: [self.grid[0], self.grid[1], 0, 0],
-                    };
-                    self.pipeline
-                        .bind(cmd, &[&self.set], bytemuck::bytes_of(&push), extent);
-                    let vertices = 6 * self.grid[0] * self.grid[1];
-                    crate::vk::draw(&ctx, cmd, vertices);
-                    end_rendering(&ctx, cmd);
+                for (layer, view_proj) in view_projs.iter().enumerate() {
+                    let colors = [
+                        (self.position.layer_views[layer], Some([0.0; 4])),
+                        (self.normal.layer_views[layer], Some([0.0; 4])),
+                    ];
+                    let depth = Some((self.depth.layer_views[layer], true));
+                    c.render(extent, &colors, depth, |r| {
+                        let push = CcmPush {
+                            view_proj: view_proj.to_cols_array_2d(),
+                            grid: [self.grid[0], self.grid[1], 0, 0],
+                        };
+                        r.bind(&self.pipeline, &[&self.set], bytemuck::bytes_of(&push));
+                        r.draw(6 * self.grid[0] * self.grid[1]);
+                    });
                 }
             });
     }

@@ -49,7 +49,7 @@ use super::bindings;
 use crate::radiometry::luminance;
 use crate::scene::{Camera, Light, LightKind, Scene};
 use crate::vk::{
-    copy_image, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
     FrameRecorder, Image, ImageDesc, Profiler, TimingSource,
 };
 use anyhow::{bail, ensure, Context as _};
@@ -343,9 +343,13 @@ impl Denoiser {
                         output,
                         Access::ComputeWrite,
                     )
-                    .record(|cmd| {
-                        self.pipeline
-                            .dispatch(cmd, &[set], bytemuck::bytes_of(&push(axis)), groups)
+                    .record(|c| {
+                        c.dispatch(
+                            &self.pipeline,
+                            &[set],
+                            bytemuck::bytes_of(&push(axis)),
+                            groups,
+                        )
                     });
             }
         }
@@ -408,9 +412,8 @@ pub fn adaptive_vs_fixed(
         let mut total_ms = 0.0;
         for frame in 0..=frames {
             let timings = profiler.frame(|rec| {
-                let ctx = rec.ctx().clone();
-                rec.pass("denoise input copy").record(|cmd| {
-                    copy_image(&ctx, cmd, input, &work);
+                rec.pass("denoise input copy").record(|c| {
+                    c.copy_image(input, &work);
                 });
                 denoiser.record(
                     rec,

@@ -85,7 +85,7 @@
 //! with σ = s^c, no differentials (the paper's comparison).
 //!
 //! Light: the scene's first directional light (the paper's sun), else the
-//! environment's sun as a directional light (`environment::sun_irradiance`); a scene
+//! environment's sun as a directional light (`emitters::sun_irradiance`); a scene
 //! without one, or without a water object, is refused. The first water
 //! object is the one traced. The light range (`light_range` 0) is derived
 //! so that the outermost cascade covers the whole water seen from Eq. 1's
@@ -214,7 +214,7 @@ fn environment_sun(scene: &Scene) -> Option<Light> {
     let (direction, irradiance) = scene
         .environment
         .as_ref()
-        .and_then(crate::environment::sun_irradiance)?;
+        .and_then(crate::emitters::sun_irradiance)?;
     Some(Light {
         kind: LightKind::Directional,
         position: glam::Vec3::ZERO,

@@ -17,9 +17,9 @@ use super::WpParamsBuffer;
 use crate::frame::SceneGpu;
 use crate::passes::gbuffer::{GBuffer, DEPTH_FORMAT};
 use crate::vk::{
-    begin_rendering_with_depth, end_rendering, groups_8x8, Access, BindingKind, Buffer,
-    ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
-    GraphicsPipelineDesc, Image, ImageDesc, Sampler, Specialization, VkResult,
+    groups_8x8, Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet,
+    DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
+    Sampler, Specialization, VkResult,
 };
 use ash::vk;
 use std::sync::Arc;
@@ -99,7 +99,6 @@ impl Splat {
         photons: &Buffer,
         draw: &Buffer,
     ) {
-        let ctx = rec.ctx().clone();
         // The trace's atomics (instanceCount) must be visible to the
         // indirect read, its photon writes to the vertex shader; the
         // G-buffer's depth is tested (read) and its normals read by
@@ -117,19 +116,13 @@ impl Splat {
             )
             .read(draw, Access::IndirectRead)
             .read(photons, Access::VertexRead)
-            .record(|cmd| {
-                let extent = self.caustics.extent();
-                begin_rendering_with_depth(
-                    &ctx,
-                    cmd,
-                    extent,
-                    &[(self.caustics.view, Some([0.0; 4]))],
-                    Some((gbuffer.depth.view, false)),
-                );
-                self.pipeline
-                    .bind(cmd, &[&scene.set, &self.set], &[], extent);
-                crate::vk::draw_indirect(&ctx, cmd, draw, 0);
-                end_rendering(&ctx, cmd);
+            .record(|c| {
+                let colors = [(self.caustics.view, Some([0.0; 4]))];
+                let depth = Some((gbuffer.depth.view, false));
+                c.render(self.caustics.extent(), &colors, depth, |r| {
+                    r.bind(&self.pipeline, &[&scene.set, &self.set], &[]);
+                    r.draw_indirect(draw, 0);
+                });
             });
     }
 }
@@ -218,11 +211,10 @@ impl Composite {
                 radiance,
                 Access::ComputeWrite,
             )
-            .record(|cmd| {
+            .record(|c| {
                 let e = radiance.extent();
                 let groups = groups_8x8(e.width, e.height);
-                self.pipeline
-                    .dispatch(cmd, &[&scene.set, &self.set], &[], groups);
+                c.dispatch(&self.pipeline, &[&scene.set, &self.set], &[], groups);
             });
     }
 }

@@ -14,7 +14,7 @@ use super::cascades::CascadeLayout;
 use super::WpParamsBuffer;
 use crate::frame::SceneGpu;
 use crate::vk::{
-    step, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
     DescriptorSetLayout, FrameRecorder, Image, ImageDesc, VkResult, MAX_FRAMES_IN_FLIGHT,
 };
 use ash::vk;
@@ -194,7 +194,6 @@ impl Trace {
         ccm_position: &Image,
         ccm_normal: &Image,
     ) {
-        let ctx = rec.ctx().clone();
         self.last_slot.set(rec.slot());
         let readback = &self.readbacks[rec.slot()];
         // Reset by a transfer write, after last frame's indirect read
@@ -206,7 +205,7 @@ impl Trace {
         rec.pass("photon reset")
             .overwrite(&self.slots, Access::TransferWrite)
             .write(&self.draw, Access::TransferWrite)
-            .record(|cmd| {
+            .record(|c| {
                 let reset = DrawCounters {
                     vertex_count: 4,
                     ..Zeroable::zeroed()
@@ -214,8 +213,8 @@ impl Trace {
                 let none = vk::ClearColorValue {
                     uint32: [u32::MAX; 4],
                 };
-                crate::vk::update_buffer(&ctx, cmd, &self.draw, 0, bytemuck::bytes_of(&reset));
-                crate::vk::clear_color_image(&ctx, cmd, &self.slots, none);
+                c.update(&self.draw, 0, bytemuck::bytes_of(&reset));
+                c.clear_image(&self.slots, none);
             });
         // The reset before the atomics; the CCM attachments before the
         // storage-image reads; the photons after last frame's vertex reads;
@@ -243,7 +242,7 @@ impl Trace {
             .write(&self.draw, Access::ComputeWrite)
             .write(&self.photons, Access::ComputeWrite)
             .read(&scene.triangles, Access::ComputeRead)
-            .record(|cmd| {
+            .record(|c| {
                 let per_row =
                     (bindings::WP_TRACE_GROUP_SIZE * bindings::WP_TRACE_GROUPS_PER_ROW) as u64;
                 let groups = if self.threads <= per_row {
@@ -259,14 +258,9 @@ impl Trace {
                         1,
                     ]
                 };
-                self.pipeline.dispatch(cmd, &[&scene.set, set], &[], groups);
-                // The atomics done, the counts go to the host...
-                step(&ctx, cmd)
-                    .read(&self.draw, Access::TransferRead)
-                    .write(readback, Access::TransferWrite)
-                    .emit();
-                crate::vk::copy_buffer(&ctx, cmd, &self.draw, readback, self.draw.size);
-                step(&ctx, cmd).read(readback, Access::HostRead).emit();
+                c.dispatch(&self.pipeline, &[&scene.set, set], &[], groups);
+                // The atomics done, the counts go to the host.
+                c.read_back(&self.draw, readback, self.draw.size);
             });
     }
 }

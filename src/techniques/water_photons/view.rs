@@ -143,9 +143,9 @@ impl WaterView {
                 Access::ComputeWrite,
             )
             .read(photons, Access::ComputeRead)
-            .record(|cmd| {
+            .record(|c| {
                 let groups = groups_8x8(targets.width, targets.height);
-                self.pipeline.dispatch(cmd, &[&scene.set, set], &[], groups);
+                c.dispatch(&self.pipeline, &[&scene.set, set], &[], groups);
             });
     }
 }
