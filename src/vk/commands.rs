@@ -157,20 +157,10 @@ impl<'c, 'a> Commands<'c, 'a> {
             ],
             &[],
         );
-        let layers = vk::ImageSubresourceLayers {
-            aspect_mask: src.aspect(),
-            mip_level: 0,
-            base_array_layer: 0,
-            layer_count: 1,
-        };
         let region = vk::ImageCopy::default()
-            .src_subresource(layers)
-            .dst_subresource(layers)
-            .extent(vk::Extent3D {
-                width: src.desc.width,
-                height: src.desc.height,
-                depth: 1,
-            });
+            .src_subresource(src.level0_layer(0))
+            .dst_subresource(dst.level0_layer(0))
+            .extent(src.extent_3d());
         // SAFETY: as `fill`, for both images, in the layouts just set.
         unsafe {
             self.ctx.device.cmd_copy_image(
@@ -237,17 +227,8 @@ impl<'c, 'a> Commands<'c, 'a> {
             &[BufferAccess::new(src, Access::TransferRead)],
         );
         let region = vk::BufferImageCopy::default()
-            .image_subresource(vk::ImageSubresourceLayers {
-                aspect_mask: image.aspect(),
-                mip_level: 0,
-                base_array_layer: 0,
-                layer_count: 1,
-            })
-            .image_extent(vk::Extent3D {
-                width: image.desc.width,
-                height: image.desc.height,
-                depth: 1,
-            });
+            .image_subresource(image.level0_layer(0))
+            .image_extent(image.extent_3d());
         // SAFETY: as `fill`, for the buffer and the image in the layout just set.
         unsafe {
             self.ctx.device.cmd_copy_buffer_to_image(

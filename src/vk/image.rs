@@ -335,6 +335,25 @@ impl Image {
         }
     }
 
+    /// Mip level 0 of `layer`, as a copy addresses it.
+    pub(super) fn level0_layer(&self, layer: u32) -> vk::ImageSubresourceLayers {
+        vk::ImageSubresourceLayers {
+            aspect_mask: self.aspect(),
+            mip_level: 0,
+            base_array_layer: layer,
+            layer_count: 1,
+        }
+    }
+
+    /// Mip level 0's extent, as a copy addresses it.
+    pub(super) fn extent_3d(&self) -> vk::Extent3D {
+        vk::Extent3D {
+            width: self.desc.width,
+            height: self.desc.height,
+            depth: 1,
+        }
+    }
+
     pub fn aspect(&self) -> vk::ImageAspectFlags {
         aspect_of(self.desc.format)
     }
@@ -383,17 +402,8 @@ impl Image {
                 &[],
             );
             let region = vk::BufferImageCopy::default()
-                .image_subresource(vk::ImageSubresourceLayers {
-                    aspect_mask: self.aspect(),
-                    mip_level: 0,
-                    base_array_layer: layer,
-                    layer_count: 1,
-                })
-                .image_extent(vk::Extent3D {
-                    width: self.desc.width,
-                    height: self.desc.height,
-                    depth: 1,
-                });
+                .image_subresource(self.level0_layer(layer))
+                .image_extent(self.extent_3d());
             unsafe {
                 self.ctx.device.cmd_copy_image_to_buffer(
                     cmd,

@@ -55,16 +55,30 @@ pub struct Accesses<'a> {
 }
 
 impl<'a> Accesses<'a> {
+    /// Adds one access; the same access to the same resource again (one
+    /// image bound through several views, as a mip chain's levels are)
+    /// adds nothing, so the barrier, emitted again before each later
+    /// command of the pass, holds each resource once.
     fn add(&mut self, resource: Resource<'a>, access: Access, discard: bool) {
         match resource {
-            Resource::Image(image) => self.images.push(if discard {
-                ImageAccess::discard(image, access)
-            } else {
-                ImageAccess::new(image, access)
-            }),
+            Resource::Image(image) => {
+                let same = |a: &ImageAccess| {
+                    a.image.raw == image.raw && a.next == access && a.discard == discard
+                };
+                if !self.images.iter().any(same) {
+                    self.images.push(if discard {
+                        ImageAccess::discard(image, access)
+                    } else {
+                        ImageAccess::new(image, access)
+                    });
+                }
+            }
             Resource::Buffer(buffer) => {
                 assert!(!discard, "only an image's contents can be discarded");
-                self.buffers.push(BufferAccess::new(buffer, access));
+                let same = |a: &BufferAccess| a.buffer.raw == buffer.raw && a.next == access;
+                if !self.buffers.iter().any(same) {
+                    self.buffers.push(BufferAccess::new(buffer, access));
+                }
             }
         }
     }
