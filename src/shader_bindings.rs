@@ -181,7 +181,15 @@ pub const REFERENCE_BINDING_VOLUME_PHOTONS: u32 = 7;
 pub const REFERENCE_BINDING_VOLUME_HEADS: u32 = 8;
 pub const REFERENCE_BINDING_VOLUME_NEXT: u32 = 9;
 /// Counters: [0] volume photons stored this pass (may pass the capacity),
-/// [1] noise sum of the variance of the mean, [2] sum of the mean.
+/// [1] noise sum of the variance of the mean, [2] sum of the mean,
+/// [3] gather points appended (may pass their capacity), [4..7] the volume
+/// gather's dispatch arguments, [7] its longest cell walk.
 pub const REFERENCE_BINDING_STATS: u32 = 10;
+/// Points on camera paths in the medium where the volume photon map is gathered.
+pub const REFERENCE_BINDING_GATHER_POINTS: u32 = 11;
 /// End of a hash-grid chain.
 pub const REFERENCE_GRID_NONE: u32 = 4294967295;
+/// The volume gather stops a cell's chain after this many links (below
+/// llvmpipe's 65535 loop iterations per invocation, past which every loop
+/// of the invocation exits silently); a walk that reaches it is reported.
+pub const REFERENCE_GATHER_WALK_LIMIT: u32 = 60000;

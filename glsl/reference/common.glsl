@@ -38,7 +38,9 @@ layout(set = 1, binding = REFERENCE_BINDING_SURFACE_NEXT, std430) buffer Surface
 
 // Volume photon map: every tentative medium collision of the photon pass,
 // with its flux already weighted by sigma_s / majorant (the same weight its
-// camera connection gets), in a hash grid of cell side 2 r_v.
+// camera connection gets), in a hash grid of cell side r_v: the ball of
+// radius r_v around a gather point overlaps at most 3x3x3 cells, each of
+// which volume_gather.comp walks in its own invocation.
 struct VolumePhoton {
     vec4 position; // w: path-type tag (uint bits)
     vec4 direction;
@@ -47,11 +49,26 @@ struct VolumePhoton {
 layout(set = 1, binding = REFERENCE_BINDING_VOLUME_PHOTONS, std430) buffer VolumePhotons { VolumePhoton volume_photons[]; };
 layout(set = 1, binding = REFERENCE_BINDING_VOLUME_HEADS, std430) buffer VolumeHeads { uint volume_heads[]; };
 layout(set = 1, binding = REFERENCE_BINDING_VOLUME_NEXT, std430) buffer VolumeNext { uint volume_next[]; };
+
+// A point on a camera path in the medium where the volume photon map is
+// gathered (volume_points.comp appends them, volume_gather.comp sums).
+struct GatherPoint {
+    vec4 position;  // w: pixel index (uint bits)
+    vec4 direction; // the camera ray's direction; w: path-type mask (uint bits)
+    vec4 weight;    // camera path weight times the quadrature step (m)
+};
+layout(set = 1, binding = REFERENCE_BINDING_GATHER_POINTS, std430) buffer GatherPoints { GatherPoint gather_points[]; };
+// Cells a gather point's ball can overlap: one volume_gather.comp invocation each.
+const uint GATHER_CELLS = 27u;
+
 layout(set = 1, binding = REFERENCE_BINDING_STATS, std430) buffer Stats {
     uint volume_photon_count;
     float noise_variance_sum;
     float noise_mean_sum;
-    uint stats_pad;
+    uint gather_point_count;   // appended this pass (may pass the capacity)
+    // VkDispatchIndirectCommand of volume_gather.comp (byte 16):
+    uint gather_groups_x, gather_groups_y, gather_groups_z;
+    uint gather_longest_walk;  // the most photons one cell walk visited this pass
 };
 
 layout(push_constant) uniform Push {
@@ -69,7 +86,8 @@ layout(push_constant) uniform Push {
     uint gather;           // 1: progressive photon mapping on (0: light tracer only)
     vec4 aim;              // bounding sphere of the specular triangles (w = 0: none)
     float aim_share;       // share of photons aimed at it
-    uint pad0, pad1, pad2;
+    uint gather_capacity;  // gather points stored at most
+    uint pad1, pad2;
 } pc;
 
 uint image_width() { return uint(frame.viewport.x); }
@@ -87,6 +105,7 @@ void add_pass(uint index, uint component, vec3 value) {
 
 // The hash-grid cell of x for cells of side `side`, and its bucket.
 ivec3 grid_cell(vec3 x, float side) { return ivec3(floor(x / side)); }
+float volume_cell_side() { return pc.volume_radius; }
 uint grid_bucket(ivec3 c, uint mask) {
     return (uint(c.x) * 73856093u ^ uint(c.y) * 19349663u ^ uint(c.z) * 83492791u) & mask;
 }

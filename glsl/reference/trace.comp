@@ -267,7 +267,7 @@ void gather_surface(vec3 x, vec3 arrival_side, vec3 flux, uint tag) {
     }
 }
 
-// Stores a medium collision in the volume photon map (camera_volume.comp
+// Stores a medium collision in the volume photon map (volume_gather.comp
 // gathers it along camera paths seen through specular chains).
 void store_volume_photon(vec3 x, vec3 d, vec3 flux, uint tag) {
     uint index = atomicAdd(volume_photon_count, 1u);
@@ -277,7 +277,7 @@ void store_volume_photon(vec3 x, vec3 d, vec3 flux, uint tag) {
     photon.direction = vec4(d, 0.0);
     photon.flux = vec4(flux / pc.pass_photons, 0.0);
     volume_photons[index] = photon;
-    uint bucket = grid_bucket(grid_cell(x, 2.0 * pc.volume_radius), pc.volume_mask);
+    uint bucket = grid_bucket(grid_cell(x, volume_cell_side()), pc.volume_mask);
     volume_next[index] = atomicExchange(volume_heads[bucket], index);
 }
 
@@ -336,7 +336,7 @@ void main() {
                         // Straight from a sampled light: airlight, which
                         // camera.comp samples along the camera rays.
                         // Multiple scattering (tag `other`) seen directly is
-                        // camera_volume.comp's gather when the volume photon
+                        // the volume gather (volume_points.comp) when the volume photon
                         // map is on (finite variance near the eye).
                         bool gathered_on_first_segment = pc.volume_capacity != 0u && tag == COMPONENT_OTHER;
                         if (!straight_from_sampled_light && !gathered_on_first_segment) {

@@ -168,5 +168,18 @@ pub(super) fn trace_reference(
             reference.reference.volume_capacity()
         );
     }
+    if reference.gather_overflow > 0 {
+        eprintln!(
+            "warning: {} points on camera paths in the medium did not fit the gather buffer ({} per pass); the volume gather missed them",
+            reference.gather_overflow,
+            reference.reference.gather_capacity()
+        );
+    }
+    if reference.longest_walk >= caustics::shader_bindings::REFERENCE_GATHER_WALK_LIMIT {
+        eprintln!(
+            "warning: a volume gather walk reached {} photons in one grid cell and was cut short; pass fewer photons a pass (--pass-photons) or a smaller --radius",
+            caustics::shader_bindings::REFERENCE_GATHER_WALK_LIMIT
+        );
+    }
     Ok(interrupted)
 }

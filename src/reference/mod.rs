@@ -138,6 +138,11 @@ pub struct ReferenceRenderer {
     pub pass_ms: Vec<(String, f64)>,
     /// Medium collisions dropped because a pass's volume photon map was full.
     pub volume_overflow: u64,
+    /// Gather points dropped because a pass's gather point buffer was full.
+    pub gather_overflow: u64,
+    /// The longest cell walk of any pass's volume gather
+    /// (`REFERENCE_GATHER_WALK_LIMIT`: walks were cut short, photons missed).
+    pub longest_walk: u32,
 }
 
 impl ReferenceRenderer {
@@ -182,6 +187,8 @@ impl ReferenceRenderer {
             trace_seconds: 0.0,
             pass_ms: Vec::new(),
             volume_overflow: 0,
+            gather_overflow: 0,
+            longest_walk: 0,
         })
     }
 
@@ -197,7 +204,8 @@ impl ReferenceRenderer {
     }
 
     /// Runs one pass (see `Reference::record_pass`); adds its per-stage
-    /// milliseconds to `pass_ms` and counts volume photons that did not fit.
+    /// milliseconds to `pass_ms` and counts volume photons and gather points
+    /// that did not fit.
     pub fn pass(&mut self) -> VkResult<PassReport> {
         let start = std::time::Instant::now();
         let reference = &mut self.reference;
@@ -215,9 +223,14 @@ impl ReferenceRenderer {
             }
         }
         if self.reference.volume_capacity() > 0 {
-            let (stored, _, _) = self.reference.read_stats()?;
-            report.volume_photons = stored;
-            self.volume_overflow += stored.saturating_sub(self.reference.volume_capacity()) as u64;
+            let stats = self.reference.read_stats()?;
+            report.volume_photons = stats.volume_photons;
+            report.gather_points = stats.gather_points;
+            report.longest_walk = stats.longest_walk;
+            let excess = |count: u32, capacity: u32| count.saturating_sub(capacity) as u64;
+            self.volume_overflow += excess(stats.volume_photons, self.reference.volume_capacity());
+            self.gather_overflow += excess(stats.gather_points, self.reference.gather_capacity());
+            self.longest_walk = self.longest_walk.max(stats.longest_walk);
         }
         Ok(report)
     }
@@ -235,7 +248,8 @@ impl ReferenceRenderer {
             reference.record_noise(rec, scene_gpu);
             Ok(())
         })?;
-        let (_, variance, mean) = self.reference.read_stats()?;
+        let stats = self.reference.read_stats()?;
+        let (variance, mean) = (stats.noise_variance_sum, stats.noise_mean_sum);
         Ok((mean > 0.0)
             .then(|| (variance as f64).sqrt() / mean as f64 * (self.pixels() as f64).sqrt()))
     }

@@ -31,7 +31,18 @@ struct Push {
     gather: u32,
     aim: [f32; 4],
     aim_share: f32,
-    pad: [u32; 3],
+    gather_capacity: u32,
+    pad: [u32; 2],
+}
+
+/// The counters of `stats` (glsl/reference/common.glsl).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Stats {
+    pub volume_photons: u32,
+    pub noise_variance_sum: f32,
+    pub noise_mean_sum: f32,
+    pub gather_points: u32,
+    pub longest_walk: u32,
 }
 
 /// What one pass leaves behind, for the progress report.
@@ -42,12 +53,19 @@ pub struct PassReport {
     pub volume_radius: f32,
     /// Medium collisions the pass tried to store (more than the capacity: overflow).
     pub volume_photons: u32,
+    /// Gather points the camera paths in the medium tried to append (more
+    /// than the capacity: overflow).
+    pub gather_points: u32,
+    /// The most photons one cell walk of the volume gather visited
+    /// (`REFERENCE_GATHER_WALK_LIMIT`: cut short).
+    pub longest_walk: u32,
 }
 
 pub struct Reference {
     trace: ComputePipeline,
     camera: ComputePipeline,
-    camera_volume: ComputePipeline,
+    volume_points: ComputePipeline,
+    volume_gather: ComputePipeline,
     fold: ComputePipeline,
     noise: ComputePipeline,
     resolve: ComputePipeline,
@@ -66,11 +84,13 @@ pub struct Reference {
     volume_photons: Buffer,
     volume_heads: Buffer,
     volume_next: Buffer,
+    gather_points: Buffer,
     stats: Buffer,
     settings: ReferenceSettings,
     surface_table: u32,
     volume_table: u32,
     volume_capacity: u32,
+    gather_capacity: u32,
     /// Where photons are aimed: centre and radius (0: nowhere).
     aim: [f32; 4],
     /// Radii of the next pass.
@@ -126,6 +146,7 @@ impl Reference {
                 storage(b::REFERENCE_BINDING_VOLUME_HEADS),
                 storage(b::REFERENCE_BINDING_VOLUME_NEXT),
                 storage(b::REFERENCE_BINDING_STATS),
+                storage(b::REFERENCE_BINDING_GATHER_POINTS),
             ],
         )?;
         let sets = [&scene_gpu.layout, &layout];
@@ -140,19 +161,32 @@ impl Reference {
             0
         };
         let volume_table = (2 * volume_capacity as u64).next_power_of_two().max(1) as u32;
-        let vp_bytes = pixels * std::mem::size_of::<[f32; 12]>() as u64;
-        let volume_bytes = volume_capacity as u64 * std::mem::size_of::<[f32; 12]>() as u64;
-        if vp_bytes.max(volume_bytes) > ctx.limits.max_storage_buffer_range as u64 {
+        // Gather points: FIRST_SEGMENT_POINTS (8) a pixel on the first
+        // segment plus up to 32 on each later one (volume_points.comp); 24 a
+        // pixel on average leaves room for a quarter of the image seen
+        // through glass or in a mirror, up to 2^22 points (192 MiB).
+        let gather_capacity = if volume_capacity > 0 {
+            (pixels * 24).min(1 << 22) as u32
+        } else {
+            0
+        };
+        let point_bytes = std::mem::size_of::<[f32; 12]>() as u64;
+        let vp_bytes = pixels * point_bytes;
+        let volume_bytes = volume_capacity as u64 * point_bytes;
+        let gather_bytes = gather_capacity as u64 * point_bytes;
+        let largest = vp_bytes.max(volume_bytes).max(gather_bytes);
+        if largest > ctx.limits.max_storage_buffer_range as u64 {
             anyhow::bail!(
                 "the reference's photon-mapping buffers ({} MiB) exceed the device's {} MiB per buffer",
-                vp_bytes.max(volume_bytes) >> 20,
+                largest >> 20,
                 ctx.limits.max_storage_buffer_range >> 20
             );
         }
         let reference = Self {
             trace: pipeline("reference/trace.comp")?,
             camera: pipeline("reference/camera.comp")?,
-            camera_volume: pipeline("reference/camera_volume.comp")?,
+            volume_points: pipeline("reference/volume_points.comp")?,
+            volume_gather: pipeline("reference/volume_gather.comp")?,
             fold: pipeline("reference/fold.comp")?,
             noise: pipeline("reference/noise.comp")?,
             resolve: pipeline("reference/resolve.comp")?,
@@ -165,7 +199,9 @@ impl Reference {
             volume_photons: buffer("reference volume photons", volume_bytes)?,
             volume_heads: buffer("reference volume grid", volume_table as u64 * 4)?,
             volume_next: buffer("reference volume links", volume_capacity as u64 * 4)?,
-            stats: buffer("reference counters", 16)?,
+            // Every buffer needs a size above 0.
+            gather_points: buffer("reference gather points", gather_bytes.max(point_bytes))?,
+            stats: Buffer::new(ctx, "reference counters", 32, BufferUsage::StorageIndirect)?,
             set: DescriptorSet::new(ctx, &layout)?,
             resolve_set: DescriptorSet::new(ctx, &layout)?,
             _layout: layout,
@@ -173,6 +209,7 @@ impl Reference {
             surface_table,
             volume_table,
             volume_capacity,
+            gather_capacity,
             aim: aim.map_or([0.0; 4], |(c, r)| [c.x, c.y, c.z, r]),
             radius,
             volume_radius: settings
@@ -200,7 +237,8 @@ impl Reference {
                 )
                 .write_buffer(b::REFERENCE_BINDING_VOLUME_HEADS, &reference.volume_heads)
                 .write_buffer(b::REFERENCE_BINDING_VOLUME_NEXT, &reference.volume_next)
-                .write_buffer(b::REFERENCE_BINDING_STATS, &reference.stats);
+                .write_buffer(b::REFERENCE_BINDING_STATS, &reference.stats)
+                .write_buffer(b::REFERENCE_BINDING_GATHER_POINTS, &reference.gather_points);
         }
         Ok(reference)
     }
@@ -225,7 +263,8 @@ impl Reference {
             gather: self.settings.photon_mapping as u32,
             aim: self.aim,
             aim_share: self.settings.aim_share,
-            pad: [0; 3],
+            gather_capacity: self.gather_capacity,
+            pad: [0; 2],
         }
     }
 
@@ -275,17 +314,25 @@ impl Reference {
             .record(|c| {
                 c.fill(&self.volume_heads, b::REFERENCE_GRID_NONE);
                 c.fill(&self.stats, 0);
+                // The volume gather's dispatch is (x, 1, 1); volume_points.comp raises x.
+                c.update(&self.stats, 20, bytemuck::cast_slice(&[1u32, 1]));
                 let groups = [(self.pass_photons() / 64) as u32, 1, 1];
                 c.dispatch(&self.trace, &sets, push, groups);
             });
         if self.volume_capacity > 0 {
+            rec.pass("reference volume points")
+                .write(&self.gather_points, Access::ComputeWrite)
+                .write(&self.stats, Access::ComputeWrite)
+                .record(|c| c.dispatch(&self.volume_points, &sets, push, pixel_groups));
             rec.pass("reference volume gather")
                 .write(&self.pass_sums, Access::ComputeWrite)
+                .read(&self.gather_points, Access::ComputeRead)
                 .read(&self.volume_photons, Access::ComputeRead)
                 .read(&self.volume_heads, Access::ComputeRead)
                 .read(&self.volume_next, Access::ComputeRead)
-                .read(&self.stats, Access::ComputeRead)
-                .record(|c| c.dispatch(&self.camera_volume, &sets, push, pixel_groups));
+                .write(&self.stats, Access::ComputeWrite)
+                .read(&self.stats, Access::IndirectRead)
+                .record(|c| c.dispatch_indirect(&self.volume_gather, &sets, push, &self.stats, 16));
         }
         rec.pass("reference fold")
             .write(&self.pass_sums, Access::ComputeWrite)
@@ -299,6 +346,8 @@ impl Reference {
             radius: self.radius,
             volume_radius: self.volume_radius,
             volume_photons: 0,
+            gather_points: 0,
+            longest_walk: 0,
         };
         self.photons += self.pass_photons();
         self.passes += 1;
@@ -347,11 +396,16 @@ impl Reference {
             });
     }
 
-    /// The counters the last pass (or noise reduction) left: volume photons
-    /// stored, sum of the variance of the mean, sum of the mean.
-    pub fn read_stats(&self) -> VkResult<(u32, f32, f32)> {
+    /// The counters the last pass (or noise reduction) left.
+    pub fn read_stats(&self) -> VkResult<Stats> {
         let words: Vec<u32> = self.stats.download_pod()?;
-        Ok((words[0], f32::from_bits(words[1]), f32::from_bits(words[2])))
+        Ok(Stats {
+            volume_photons: words[0],
+            noise_variance_sum: f32::from_bits(words[1]),
+            noise_mean_sum: f32::from_bits(words[2]),
+            gather_points: words[3],
+            longest_walk: words[7],
+        })
     }
 
     /// The surface gather radius of the next pass (m).
@@ -362,6 +416,11 @@ impl Reference {
     /// Medium collisions one pass can store.
     pub fn volume_capacity(&self) -> u32 {
         self.volume_capacity
+    }
+
+    /// Gather points one pass can store.
+    pub fn gather_capacity(&self) -> u32 {
+        self.gather_capacity
     }
 }
 

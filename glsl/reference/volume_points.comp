@@ -8,16 +8,23 @@
 // this pass covers every later segment of a camera path, after at least one
 // specular bounce, and the first segment's multiple scattering, by
 // ray-marched visible points in the medium gathering the volume photon map
-// of this pass (progressive photon mapping with the
-// volume kernel, Knaus & Zwicker 2011 Sect. 5 / Jensen & Christensen 1998):
+// of this pass (progressive photon mapping with the volume kernel, Knaus &
+// Zwicker 2011 Sect. 5 / Jensen & Christensen 1998):
 //     L = W sum_k dt T(eye, y_k) sum_p Phi_p p(theta_p) / (V(y_k) N_i)
 // with V(y) the volume of the ball of radius r_v around y inside the
-// medium's bounds ((4/3) pi r_v^3 away from its faces)
-// over steps y_k of length dt = r_v (on the first segment at least a
-// FIRST_SEGMENT_POINTS-th of it) from a jittered start (an unbiased
-// quadrature of the segment integral), Phi_p the photon flux already
-// weighted by sigma_s / majorant at its tentative collision (the collision
-// density times that weight is sigma_s times the fluence), p the HG phase.
+// medium's bounds ((4/3) pi r_v^3 away from its faces), over steps y_k of
+// length dt = max(r_v, segment / points) from a jittered start (an unbiased
+// quadrature of the segment integral whatever the step; FIRST_SEGMENT_POINTS
+// on the first segment, at most LATER_SEGMENT_POINTS on later ones), Phi_p
+// the photon flux already weighted by sigma_s / majorant at its tentative
+// collision (the collision density times that weight is sigma_s times the
+// fluence), p the HG phase.
+// This pass follows the camera paths and appends the points y_k with their
+// weights W dt T / V; volume_gather.comp sums the photons around each, one
+// grid cell an invocation. (Gathering here, up to hundreds of points times
+// thousands of photons per invocation, passed llvmpipe's limit of 65535
+// loop iterations per shader invocation, after which every loop exits
+// silently: the gather lost up to 45% of its photons, BENCHMARKS.md.)
 // The camera path is sampled afresh (its own jitter and Fresnel choices): it
 // is another unbiased sample of the same chain distribution as camera.comp.
 #include "common.glsl"
@@ -50,43 +57,27 @@ float kernel_share_inside_medium(vec3 y, float r) {
     return float(in_both) / float(max(in_ball, 1u));
 }
 
-// The volume photons within r_v of y, weighted by the phase toward the eye
-// (the camera ray travels along `dir`, so the light leaves y along -dir).
-void gather_volume(uint index, vec3 y, vec3 dir, vec3 weight, uint tag_mask) {
+// Appends a gather point at y: the camera path's weight times the step
+// and the kernel's normalisation 1 / V(y), so volume_gather.comp only sums
+// photons times the phase.
+void append_gather_point(uint index, vec3 y, vec3 dir, vec3 weight, uint tag_mask) {
     float r = pc.volume_radius;
-    float side = 2.0 * r;
-    ivec3 lo = grid_cell(y - vec3(r), side);
-    ivec3 hi = grid_cell(y + vec3(r), side);
-    float g = medium.sigma_s.w;
     float share = kernel_share_inside_medium(y, r);
-    if (share <= 0.0) return;
-    float kernel = 1.0 / (4.0 / 3.0 * PI * r * r * r * share);
-    uint stored = min(volume_photon_count, pc.volume_capacity);
-    vec3 sums[COMPONENT_COUNT];
-    for (uint c = 0u; c < COMPONENT_COUNT; ++c) sums[c] = vec3(0.0);
-    for (int cz = lo.z; cz <= hi.z; ++cz)
-    for (int cy = lo.y; cy <= hi.y; ++cy)
-    for (int cx = lo.x; cx <= hi.x; ++cx) {
-        ivec3 c = ivec3(cx, cy, cz);
-        uint i = volume_heads[grid_bucket(c, pc.volume_mask)];
-        for (uint guard = 0u; i != REFERENCE_GRID_NONE && guard < stored; ++guard) {
-            VolumePhoton photon = volume_photons[i];
-            if (grid_cell(photon.position.xyz, side) == c) {
-                vec3 d = photon.position.xyz - y;
-                uint tag = floatBitsToUint(photon.position.w);
-                if (dot(d, d) < r * r && (tag_mask & (1u << tag)) != 0u) {
-                    sums[tag] += photon.flux.rgb * hg_phase(dot(photon.direction.xyz, -dir), g);
-                }
-            }
-            i = volume_next[i];
-        }
-    }
-    for (uint c = 0u; c < COMPONENT_COUNT; ++c) {
-        if (any(greaterThan(sums[c], vec3(0.0)))) add_pass(index, c, weight * kernel * sums[c]);
-    }
+    if (share <= 0.0 || luminance(weight) <= 0.0) return;
+    uint slot = atomicAdd(gather_point_count, 1u);
+    if (slot >= pc.gather_capacity) return; // counted: the host reports the overflow
+    GatherPoint point;
+    point.position = vec4(y, uintBitsToFloat(index));
+    point.direction = vec4(dir, uintBitsToFloat(tag_mask));
+    point.weight = vec4(weight / (4.0 / 3.0 * PI * r * r * r * share), 0.0);
+    gather_points[slot] = point;
+    // The gather's indirect dispatch covers every appended point's cells.
+    atomicMax(gather_groups_x, ((slot + 1u) * GATHER_CELLS + 63u) / 64u);
 }
 
+// Gather points on the first segment and, at most, on each later one.
 const uint FIRST_SEGMENT_POINTS = 8u;
+const uint LATER_SEGMENT_POINTS = 32u;
 
 void main() {
     uvec2 p = gl_GlobalInvocationID.xy;
@@ -119,14 +110,14 @@ void main() {
             // quadrature stays unbiased whatever the step.
             uint tag_mask = depth == 0u ? (1u << COMPONENT_OTHER) : 0xffffffffu;
             if (in_medium) {
-                float step_length = pc.volume_radius;
-                if (depth == 0u) step_length = max(step_length, (t1 - t0) / float(FIRST_SEGMENT_POINTS));
+                uint points = depth == 0u ? FIRST_SEGMENT_POINTS : LATER_SEGMENT_POINTS;
+                float step_length = max(pc.volume_radius, (t1 - t0) / float(points));
                 vec3 w = s.weight * medium_transmittance(s.origin, s.dir, t0, rng);
                 float t = t0 + rng_next(rng) * step_length;
                 float previous = t0;
-                for (uint k = 0u; k < 4096u && t < t1; ++k) {
+                for (uint k = 0u; k <= points && t < t1; ++k) {
                     w *= medium_transmittance(s.origin + previous * s.dir, s.dir, t - previous, rng);
-                    gather_volume(index, s.origin + t * s.dir, s.dir, w * step_length, tag_mask);
+                    append_gather_point(index, s.origin + t * s.dir, s.dir, w * step_length, tag_mask);
                     previous = t;
                     t += step_length;
                 }
