@@ -199,22 +199,28 @@ vec3 traced_radiance(vec3 o, vec3 d, out float t_hit) {
 // ray passing behind a nearer object, not meeting it: the march goes on.
 // Past the frustum the search can find nothing (the frustum is convex, the
 // ray never comes back): there, and where the march ends without a hit,
-// the ray is traced (`traced_radiance`).
-vec3 search_opaque_hit(vec3 o, vec3 d, out float t_hit) {
+// it returns false and the caller traces the ray (`traced_radiance`).
+// True: `l` is what the ray meets (the environment where it leaves the
+// scene's sphere, t_hit -1 then).
+bool search_opaque(vec3 o, vec3 d, out vec3 l, out float t_hit) {
     t_hit = -1.0;
+    l = vec3(0.0);
     vec3 oc = o - frame.scene_sphere.xyz;
     float b = dot(oc, d);
     float disc = b * b - (dot(oc, oc) - frame.scene_sphere.w * frame.scene_sphere.w);
-    if (disc <= 0.0) return component_weight(COMPONENT_EMITTED) * environment_radiance(d);
+    if (disc <= 0.0) {
+        l = component_weight(COMPONENT_EMITTED) * environment_radiance(d);
+        return true;
+    }
     float t_max = min(-b + sqrt(disc), frustum_exit(o, d));
-    if (t_max <= 0.0) return traced_radiance(o, d, t_hit);
+    if (t_max <= 0.0) return false;
     float step = t_max / float(max(pc.search_steps, 1u));
     float t_prev = 0.0;
     for (uint i = 1u; i <= pc.search_steps; ++i) {
         float t = step * float(i);
         ivec2 q;
         float gap, z;
-        if (!project(o + t * d, q, z)) return traced_radiance(o, d, t_hit);
+        if (!project(o + t * d, q, z)) return false;
         if (behind_opaque(o + t * d, q, gap)) {
             float lo = t_prev, hi = t;
             for (int k = 0; k < BISECTIONS; ++k) {
@@ -226,18 +232,25 @@ vec3 search_opaque_hit(vec3 o, vec3 d, out float t_hit) {
             behind_opaque(o + hi * d, q, gap);
             if (gap <= step + pixel_depth_extent(q)) {
                 t_hit = hi;
-                return imageLoad(opaque_radiance, q).rgb;
+                l = imageLoad(opaque_radiance, q).rgb;
+                return true;
             }
         }
         t_prev = t;
     }
-    return traced_radiance(o, d, t_hit);
+    return false;
 }
 
-vec3 search_opaque(vec3 o, vec3 d) {
-    float t_hit;
-    return search_opaque_hit(o, d, t_hit);
-}
+// The rays a pixel's specular surface sends on (the reflected one and the
+// refracted one), each with its weight; `absorbing`: the open sheet's
+// refracted ray, weighted by exp(-sigma_a t) over the distance t it
+// travels to what it meets.
+struct SecondaryRay {
+    vec3 origin;
+    vec3 dir;
+    vec3 weight;
+    bool absorbing;
+};
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -253,40 +266,49 @@ void main() {
     vec3 v = normalize(p1 - frame.eye.xyz);
     vec3 n1 = normalize(fn.xyz);
     if (dot(n1, v) > 0.0) n1 = -n1;
-    vec3 r = reflect(v, n1);
     // The reflected ray starts on the surface; the opaque frame holds no
     // specular surface, so only the start's own pixel could be met early,
     // and its opaque surface lies behind p1.
-    if (material_kind(m) == MATERIAL_MIRROR) {
-        imageStore(radiance, p, vec4(materials[m].color.rgb * search_opaque(p1, r), 1.0));
-        return;
-    }
-    float ior = materials[m].absorption_ior.w;
-    float f1 = fresnel_dielectric(-dot(v, n1), 1.0 / ior);
-    vec3 l = f1 * search_opaque(p1, r);
-    // d_V: front to the farthest back face along this pixel's ray; a sheet
-    // with no back face here has no thickness.
-    vec4 bp = imageLoad(back_position, p);
+    SecondaryRay rays[2];
+    uint count = 1u;
+    rays[0] = SecondaryRay(p1, reflect(v, n1), materials[m].color.rgb, false);
     vec3 sigma_a = materials[m].absorption_ior.rgb;
-    if (bp.w < 0.0 && fp.w <= 0.0) {
-        // One interface (no back face here and no d_N: an open sheet, see
-        // the header). Eq. 6.3.2 stays for closed objects whose back-face
-        // texel at p2 is empty (d_N > 0 there).
-        vec3 t1;
-        if (refract_dir(v, n1, 1.0 / ior, t1)) {
-            float t;
-            vec3 behind = search_opaque_hit(p1, t1, t);
-            vec3 absorbed = exp(-sigma_a * max(t, 0.0));
-            l += (1.0 - f1) / (ior * ior) * absorbed * behind;
+    if (material_kind(m) != MATERIAL_MIRROR) {
+        float ior = materials[m].absorption_ior.w;
+        float f1 = fresnel_dielectric(-dot(v, n1), 1.0 / ior);
+        rays[0].weight = vec3(f1);
+        // d_V: front to the farthest back face along this pixel's ray; a
+        // sheet with no back face here has no thickness.
+        vec4 bp = imageLoad(back_position, p);
+        if (bp.w < 0.0 && fp.w <= 0.0) {
+            // One interface (no back face here and no d_N: an open sheet,
+            // see the header). Eq. 6.3.2 stays for closed objects whose
+            // back-face texel at p2 is empty (d_N > 0 there).
+            vec3 t1;
+            if (refract_dir(v, n1, 1.0 / ior, t1)) {
+                rays[count++] = SecondaryRay(p1, t1, vec3((1.0 - f1) / (ior * ior)), true);
+            }
+        } else {
+            float d_v = bp.w >= 0.0 ? max(length(bp.xyz - p1), 0.0) : 0.0;
+            TwoSidedExit e;
+            if (two_sided_refraction(v, p1, n1, ior, d_v, fp.w, pc.tir_remedy, pc.use_eq632 != 0u, e)) {
+                vec3 absorbed = exp(-sigma_a * e.dist);
+                rays[count++] = SecondaryRay(e.p2, e.dir, (1.0 - f1) * e.transmit * absorbed, false);
+            }
         }
-        imageStore(radiance, p, vec4(l, 1.0));
-        return;
     }
-    float d_v = bp.w >= 0.0 ? max(length(bp.xyz - p1), 0.0) : 0.0;
-    TwoSidedExit e;
-    if (two_sided_refraction(v, p1, n1, ior, d_v, fp.w, pc.tir_remedy, pc.use_eq632 != 0u, e)) {
-        vec3 absorbed = exp(-sigma_a * e.dist);
-        l += (1.0 - f1) * e.transmit * absorbed * search_opaque(e.p2, e.dir);
+    // One call site for the search and the traced fallback: inlined once
+    // per ray kind they made this lavapipe's slowest shader to compile
+    // (about 4 minutes of LLVM on a fresh shader cache, BENCHMARKS.md).
+    vec3 l = vec3(0.0);
+    for (uint k = 0u; k < count; ++k) {
+        vec3 seen;
+        float t;
+        if (!search_opaque(rays[k].origin, rays[k].dir, seen, t)) {
+            seen = traced_radiance(rays[k].origin, rays[k].dir, t);
+        }
+        vec3 absorbed = rays[k].absorbing ? exp(-sigma_a * max(t, 0.0)) : vec3(1.0);
+        l += rays[k].weight * absorbed * seen;
     }
     imageStore(radiance, p, vec4(l, 1.0));
 }
