@@ -107,7 +107,7 @@ pub(super) struct Snapshot {
 
 impl Snapshot {
     pub(super) fn passes(&self) -> u64 {
-        self.reference.reference.passes
+        self.reference.passes()
     }
 }
 
@@ -216,7 +216,9 @@ impl Compare {
         s.generation += 1;
         println!(
             "compare: pass {}, {} photons, FLIP mean {:.4} (live vs reference, {w}x{h})",
-            s.reference.reference.passes, s.reference.reference.photons, m.flip
+            s.reference.passes(),
+            s.reference.photons(),
+            m.flip
         );
         Ok(())
     }
@@ -240,8 +242,8 @@ impl Compare {
         });
         CompareStatus {
             view: self.view,
-            passes: s.map(|s| s.reference.reference.passes),
-            photons: s.map_or(0, |s| s.reference.reference.photons),
+            passes: s.map(|s| s.reference.passes()),
+            photons: s.map_or(0, |s| s.reference.photons()),
             flip_mean: s.and_then(|s| s.flip_mean),
             size: s.map_or((0, 0), |s| s.key.size),
             component: s.map_or("all", |s| s.component.name()),

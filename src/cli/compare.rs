@@ -291,7 +291,7 @@ fn reference_images(
         )?,
     };
     let first_half = r.resolve(Component::All)?;
-    let half_photons = r.reference.photons;
+    let half_photons = r.photons();
     if interrupted || trace_reference(&mut r, 2 * half_photons, None)? {
         anyhow::bail!("interrupted while tracing the reference; nothing written");
     }
@@ -303,8 +303,8 @@ fn reference_images(
     let info = ReferenceInfo {
         source: "traced".into(),
         path: folder.as_ref().map(|d| d.display().to_string()),
-        photons: r.reference.photons,
-        passes: r.reference.passes,
+        photons: r.photons(),
+        passes: r.passes(),
         trace_seconds: r.trace_seconds,
         diffuse_bounces: args.diffuse_bounces,
         noise: None,

@@ -103,7 +103,7 @@ pub(super) fn trace_reference(
         let elapsed = start.elapsed().as_secs_f64();
         let done = match seconds {
             Some(s) => elapsed >= s,
-            None => reference.reference.photons >= photons,
+            None => reference.photons() >= photons,
         };
         if done {
             break;
@@ -113,7 +113,7 @@ pub(super) fn trace_reference(
         let noise = noise.map_or("-".to_string(), |n| format!("{:.2}%", n * 100.0));
         let message = format!(
             "pass {} at {:.1} s, r {:.4} m, noise {}",
-            reference.reference.passes,
+            reference.passes(),
             start.elapsed().as_secs_f64(),
             report.radius,
             noise
@@ -124,12 +124,12 @@ pub(super) fn trace_reference(
                 bar.set_message(format!("{s:.0}s, {message}"));
             }
             None => {
-                bar.set_position(reference.reference.photons.min(photons));
+                bar.set_position(reference.photons().min(photons));
                 bar.set_message(message.clone());
             }
         }
         if bar.is_hidden() {
-            eprintln!("{} photons, {message}", reference.reference.photons);
+            eprintln!("{} photons, {message}", reference.photons());
         }
         if finish.requested() {
             interrupted = true;
@@ -141,20 +141,20 @@ pub(super) fn trace_reference(
     if interrupted {
         println!(
             "interrupted: writing the {} photons traced so far",
-            reference.reference.photons
+            reference.photons()
         );
     }
     let noise = reference.noise()?;
     println!(
         "traced {} photons in {} passes, {:.2} s: {:.3} M photons/s; last radius {:.4} m; remaining noise {}",
-        reference.reference.photons,
-        reference.reference.passes,
+        reference.photons(),
+        reference.passes(),
         reference.trace_seconds,
         reference.photons_per_second() / 1e6,
-        reference.reference.radius(),
+        reference.radius(),
         noise.map_or("unknown (one pass)".to_string(), |n| format!("{:.2}%", n * 100.0)),
     );
-    let passes = reference.reference.passes.max(1) as f64;
+    let passes = reference.passes().max(1) as f64;
     let stages: Vec<String> = reference
         .pass_ms
         .iter()
@@ -165,14 +165,14 @@ pub(super) fn trace_reference(
         eprintln!(
             "warning: {} medium collisions did not fit the volume photon map ({} per pass); the volume gather saw fewer photons than the light tracer",
             reference.volume_overflow,
-            reference.reference.volume_capacity()
+            reference.volume_capacity()
         );
     }
     if reference.gather_overflow > 0 {
         eprintln!(
             "warning: {} points on camera paths in the medium did not fit the gather buffer ({} per pass); the volume gather missed them",
             reference.gather_overflow,
-            reference.reference.gather_capacity()
+            reference.gather_capacity()
         );
     }
     if reference.longest_walk >= caustics::shader_bindings::REFERENCE_GATHER_WALK_LIMIT {

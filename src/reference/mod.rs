@@ -131,7 +131,9 @@ pub struct ReferenceRenderer {
     pub targets: FrameTargets,
     pub tonemap: crate::passes::tonemap::Tonemap,
     pub profiler: crate::vk::Profiler,
-    pub reference: Reference,
+    /// The tracer; callers read its progress through `photons`, `passes`
+    /// and the other accessors below.
+    reference: Reference,
     /// Seconds spent tracing so far (photons/s = photons / this).
     pub trace_seconds: f64,
     /// Milliseconds per stage of a pass, summed over passes (profiler names).
@@ -274,6 +276,31 @@ impl ReferenceRenderer {
 
     pub fn display(&self) -> VkResult<Vec<u8>> {
         self.tonemap.display.download_bytes(4)
+    }
+
+    /// Photons traced so far.
+    pub fn photons(&self) -> u64 {
+        self.reference.photons
+    }
+
+    /// Passes so far (each: camera chains, one batch of photons, gathers).
+    pub fn passes(&self) -> u64 {
+        self.reference.passes
+    }
+
+    /// The surface gather radius of the next pass (m).
+    pub fn radius(&self) -> f32 {
+        self.reference.radius()
+    }
+
+    /// Medium collisions one pass can store.
+    pub fn volume_capacity(&self) -> u32 {
+        self.reference.volume_capacity()
+    }
+
+    /// Gather points one pass can store.
+    pub fn gather_capacity(&self) -> u32 {
+        self.reference.gather_capacity()
     }
 
     pub fn photons_per_second(&self) -> f64 {

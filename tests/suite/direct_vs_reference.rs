@@ -105,7 +105,7 @@ fn direct_matches_reference_direct_component() {
     let truth = reference.resolve(Component::Direct).unwrap();
     let truth_ldr = reference.display().unwrap();
     assert_finite(&truth);
-    let passes = reference.reference.passes;
+    let passes = reference.passes();
     let trace_s = reference.trace_seconds;
     drop(reference);
 

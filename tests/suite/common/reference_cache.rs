@@ -166,7 +166,7 @@ impl ReferenceImages {
         let whole = resolve_all(&mut r);
         let noise = r.noise().expect("reference noise");
         Self {
-            photons: r.reference.photons,
+            photons: r.photons(),
             noise,
             first_half,
             whole,
