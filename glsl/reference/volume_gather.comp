@@ -45,7 +45,9 @@ void main() {
         }
         i = volume_next[i];
     }
-    if (walked > 0u) atomicMax(gather_longest_walk, walked);
+    // A plain read first: once a long walk is recorded, shorter ones need
+    // no atomic on this one shared word (every invocation would contend).
+    if (walked > gather_longest_walk) atomicMax(gather_longest_walk, walked);
     uint pixel = floatBitsToUint(point.position.w);
     for (uint k = 0u; k < COMPONENT_COUNT; ++k) {
         if (any(greaterThan(sums[k], vec3(0.0)))) add_pass(pixel, k, point.weight.rgb * sums[k]);

@@ -227,8 +227,6 @@ impl ReferenceRenderer {
         if self.reference.volume_capacity() > 0 {
             let stats = self.reference.read_stats()?;
             report.volume_photons = stats.volume_photons;
-            report.gather_points = stats.gather_points;
-            report.longest_walk = stats.longest_walk;
             let excess = |count: u32, capacity: u32| count.saturating_sub(capacity) as u64;
             self.volume_overflow += excess(stats.volume_photons, self.reference.volume_capacity());
             self.gather_overflow += excess(stats.gather_points, self.reference.gather_capacity());

@@ -53,12 +53,6 @@ pub struct PassReport {
     pub volume_radius: f32,
     /// Medium collisions the pass tried to store (more than the capacity: overflow).
     pub volume_photons: u32,
-    /// Gather points the camera paths in the medium tried to append (more
-    /// than the capacity: overflow).
-    pub gather_points: u32,
-    /// The most photons one cell walk of the volume gather visited
-    /// (`REFERENCE_GATHER_WALK_LIMIT`: cut short).
-    pub longest_walk: u32,
 }
 
 pub struct Reference {
@@ -346,8 +340,6 @@ impl Reference {
             radius: self.radius,
             volume_radius: self.volume_radius,
             volume_photons: 0,
-            gather_points: 0,
-            longest_walk: 0,
         };
         self.photons += self.pass_photons();
         self.passes += 1;

@@ -21,13 +21,6 @@ use common::*;
 use glam::{DVec3, Vec3};
 use std::sync::Arc;
 
-fn load(name: &str) -> Scene {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("assets/scenes")
-        .join(format!("{name}.toml"));
-    Scene::load(&path).unwrap()
-}
-
 struct Frame {
     tech: Beams,
     targets: FrameTargets,
@@ -99,7 +92,7 @@ fn lens_ior(scene: &mut Scene, ior: f32) {
 #[test]
 fn beams_carry_the_flux_entering_their_base_triangles() {
     let ctx = validated_context();
-    let mut scene = load("ball_lens");
+    let mut scene = canonical_scene("ball_lens");
     lens_ior(&mut scene, 1.0);
     let intensity = 60.0f32; // W/sr, white
     let lens_solid_angle = {
@@ -210,7 +203,7 @@ fn ball_lens_focuses_at_the_paraxial_focus() {
 fn index_one_restores_the_floor_without_the_lens() {
     let ctx = validated_context();
     let size = 64u32;
-    let mut with = load("ball_lens");
+    let mut with = canonical_scene("ball_lens");
     lens_ior(&mut with, 1.0);
     let mut without = with.clone();
     without.objects.retain(|o| o.name != "lens");
@@ -248,7 +241,7 @@ const BOUND_IOR1_FLIP: f32 = 0.006;
 #[test]
 fn no_scattering_no_volume_caustic() {
     let ctx = validated_context();
-    let mut scene = load("volume_cone");
+    let mut scene = canonical_scene("volume_cone");
     set_medium(&mut scene, 0.0, 0.005, 0.0);
     let f = render(&ctx, &scene, &[], Component::VolumeCaustics.mask(), 32);
     let c = f.counts();
@@ -268,7 +261,7 @@ fn no_scattering_no_volume_caustic() {
 #[test]
 fn optically_thin_volume_caustic_is_linear_in_sigma_s() {
     let ctx = validated_context();
-    let mut scene = load("volume_cone");
+    let mut scene = canonical_scene("volume_cone");
     set_medium(&mut scene, 0.002, 0.0, 0.0);
     let one = energy(&render(&ctx, &scene, &[], Component::VolumeCaustics.mask(), 32).radiance());
     set_medium(&mut scene, 0.004, 0.0, 0.0);
@@ -401,7 +394,7 @@ fn red_energy(img: &[f32]) -> f64 {
 fn beams_match_their_in_scattering_integral_and_the_phase_function() {
     let ctx = validated_context();
     let size = 64u32;
-    let mut scene = load("volume_cone");
+    let mut scene = canonical_scene("volume_cone");
     scene.materials = vec![Material {
         name: "mirror".into(),
         kind: MaterialKind::Mirror,
@@ -458,7 +451,7 @@ fn beams_match_their_in_scattering_integral_and_the_phase_function() {
 #[test]
 fn tight_volumes_lose_nothing_and_shade_fewer_fragments() {
     let ctx = validated_context();
-    let scene = load("volume_cone");
+    let scene = canonical_scene("volume_cone");
     let size = 48u32;
     let mut results = Vec::new();
     for volume in [0u32, 1] {
@@ -639,7 +632,7 @@ fn matches_reference(
 #[test]
 fn ball_lens_surface_energy_does_not_depend_on_image_size() {
     let ctx = validated_context();
-    let scene = load("ball_lens");
+    let scene = canonical_scene("ball_lens");
     let sizes = [48u32, 64, 96];
     // Per size: (energy, FLIP) bounds of the image-space exit and the traced mode.
     let bounds = [
@@ -740,7 +733,7 @@ fn surface_gather_deposits_each_beams_flux() {
         );
         deposited
     };
-    let ball_lens = load("ball_lens");
+    let ball_lens = canonical_scene("ball_lens");
     let deposits: Vec<f64> = [24u32, 37, 64]
         .iter()
         .map(|&size| deposited(&ball_lens, &[], size))
@@ -751,7 +744,7 @@ fn surface_gather_deposits_each_beams_flux() {
             "deposits {deposits:?}"
         );
     }
-    let mut past_focus = load("volume_cone");
+    let mut past_focus = canonical_scene("volume_cone");
     past_focus.medium = None;
     for overrides in [&[][..], &["refraction=0"][..]] {
         deposited(&past_focus, overrides, 64);
@@ -780,7 +773,7 @@ fn surface_gather_deposits_each_beams_flux() {
 #[test]
 fn volume_cone_volume_caustics_match_reference() {
     let ctx = validated_context();
-    let scene = load("volume_cone");
+    let scene = canonical_scene("volume_cone");
     let truth = reference_truth(&ctx, &scene, Component::VolumeCaustics, 64, 1_000_000);
     let cases = [
         ("volume_cone_volume", &[][..], 0.205, 0.018),
@@ -893,7 +886,7 @@ fn benchmark_statistics() {
         device: None,
     })
     .unwrap();
-    let scene = load("volume_cone");
+    let scene = canonical_scene("volume_cone");
     let mask = first_hit_mask(&scene, size, true, |k| k == MaterialKind::Diffuse);
     let mut reference = ReferenceRenderer::new(
         &ctx,
@@ -996,7 +989,7 @@ fn benchmark_statistics() {
 #[test]
 fn components_add_up_to_the_frame() {
     let ctx = validated_context();
-    let scene = load("volume_cone");
+    let scene = canonical_scene("volume_cone");
     // Midpoint airlight samples: the same airlight in every render.
     let opts = ["airlight_jitter=0", "airlight_steps=16", "levels=1"];
     let draw = |mask: u32| render(&ctx, &scene, &opts, mask, 32).radiance();
@@ -1026,7 +1019,7 @@ fn components_add_up_to_the_frame() {
 #[test]
 fn directional_beams_carry_the_irradiance_times_the_projected_area() {
     let ctx = validated_context();
-    let mut scene = load("ball_lens");
+    let mut scene = canonical_scene("ball_lens");
     lens_ior(&mut scene, 1.0);
     scene.lights = vec![directional_light(Vec3::new(0.3, -1.0, 0.2), 2.0)];
     let f = render(&ctx, &scene, &[], Component::SurfaceCaustics.mask(), 32);
@@ -1058,7 +1051,7 @@ fn directional_beams_carry_the_irradiance_times_the_projected_area() {
 #[test]
 fn energy_cutoff_trades_thin_light_for_fragments() {
     let ctx = validated_context();
-    let scene = load("volume_cone");
+    let scene = canonical_scene("volume_cone");
     let run = |cutoff: &str| {
         let f = render(
             &ctx,
@@ -1096,7 +1089,7 @@ fn energy_cutoff_trades_thin_light_for_fragments() {
 #[test]
 fn surface_filter_smooths_and_keeps_the_energy() {
     let ctx = validated_context();
-    let scene = load("ball_lens");
+    let scene = canonical_scene("ball_lens");
     // The floor seen directly (through the lens the refraction looks the
     // filtered image up elsewhere).
     let mask = first_hit_mask(&scene, 64, false, |k| k == MaterialKind::Diffuse);
@@ -1377,7 +1370,7 @@ fn multiple_bounces_match_reference() {
     );
     reference(
         "mirror_caustic_surface",
-        &load("mirror_caustic"),
+        &canonical_scene("mirror_caustic"),
         &[],
         0.08,
         0.041,
@@ -1468,11 +1461,11 @@ fn small_rect_lights_are_point_stand_ins() {
 #[test]
 fn medium_scenes_match_reference() {
     let ctx = validated_context();
-    let smoke = load("smoke");
+    let smoke = canonical_scene("smoke");
     let cases = [
         (
             "volume_cone_surface",
-            load("volume_cone"),
+            canonical_scene("volume_cone"),
             Component::SurfaceCaustics,
             1_000_000,
             0.071,

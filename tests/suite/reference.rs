@@ -7,6 +7,23 @@ use caustics::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use common::*;
 use glam::Vec3;
 
+/// `scene` at 32², default settings but `batch` photons a pass, after
+/// `photons` photons.
+fn traced_32px(
+    ctx: &std::sync::Arc<caustics::vk::Context>,
+    scene: &caustics::scene::Scene,
+    batch: u32,
+    photons: u64,
+) -> ReferenceRenderer {
+    let settings = ReferenceSettings {
+        batch,
+        ..ReferenceSettings::default()
+    };
+    let mut r = ReferenceRenderer::new(ctx, scene.clone(), 32, 32, 0.0, settings).unwrap();
+    r.trace(photons, |_, _| {}).unwrap();
+    r
+}
+
 /// What the camera side samples (direct light and single scattering from
 /// spot and rect lights, through a heterogeneous and a homogeneous medium;
 /// the airlight where no ray of the pixel meets a specular surface first)
@@ -18,16 +35,9 @@ fn camera_side_components_do_not_depend_on_the_photons() {
     use caustics::scene::MaterialKind::Diffuse;
     let ctx = validated_context();
     for name in ["smoke", "volume_box"] {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join(format!("assets/scenes/{name}.toml"));
-        let s = caustics::scene::Scene::load(&path).unwrap();
+        let s = canonical_scene(name);
         let images = |batch: u32| {
-            let settings = ReferenceSettings {
-                batch,
-                ..ReferenceSettings::default()
-            };
-            let mut r = ReferenceRenderer::new(&ctx, s.clone(), 32, 32, 0.0, settings).unwrap();
-            r.trace(2 * batch as u64, |_, _| {}).unwrap();
+            let mut r = traced_32px(&ctx, &s, batch, 2 * batch as u64);
             [Component::Direct, Component::Airlight].map(|c| r.resolve(c).unwrap())
         };
         let (full, camera_side) = (images(1 << 16), images(CAMERA_SIDE_BATCH));
@@ -61,15 +71,9 @@ fn camera_side_components_do_not_depend_on_the_photons() {
 #[test]
 fn volume_gather_does_not_depend_on_the_photons_per_pass() {
     let ctx = validated_context();
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/smoke.toml");
-    let s = caustics::scene::Scene::load(&path).unwrap();
+    let s = canonical_scene("smoke");
     let other = |batch: u32| {
-        let settings = ReferenceSettings {
-            batch,
-            ..ReferenceSettings::default()
-        };
-        let mut r = ReferenceRenderer::new(&ctx, s.clone(), 32, 32, 0.0, settings).unwrap();
-        r.trace(1 << 20, |_, _| {}).unwrap();
+        let mut r = traced_32px(&ctx, &s, batch, 1 << 20);
         assert_eq!(r.gather_overflow, 0, "gather points dropped");
         assert!(
             r.longest_walk < caustics::shader_bindings::REFERENCE_GATHER_WALK_LIMIT,

@@ -13,18 +13,10 @@ use crate::common;
 use caustics::params::Params;
 use caustics::reference::Component;
 use caustics::renderer::Renderer;
-use caustics::scene::Scene;
 use caustics::techniques;
 use common::*;
 
 const SIZE: u32 = 64;
-
-fn load(name: &str) -> Scene {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("assets/scenes")
-        .join(format!("{name}.toml"));
-    Scene::load(&path).unwrap()
-}
 
 /// Bounds on one comparison: |relative energy| and FLIP mean, per
 /// component (direct, surface caustics) and for the full frame's FLIP.
@@ -41,8 +33,16 @@ fn compare(scene: &str, technique: &str, overrides: &[&str], photons: u64, bound
     let info = techniques::find(technique).unwrap();
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let params = Params::resolve(technique, info.params(), &overrides).unwrap();
-    let mut renderer =
-        Renderer::new(&ctx, load(scene), technique, &params, SIZE, SIZE, 0.0).unwrap();
+    let mut renderer = Renderer::new(
+        &ctx,
+        canonical_scene(scene),
+        technique,
+        &params,
+        SIZE,
+        SIZE,
+        0.0,
+    )
+    .unwrap();
     let mut frame = |component: &str| {
         renderer.scene_gpu.components = info.component_mask(component).unwrap();
         renderer.render_frame(0.0).unwrap();
@@ -52,7 +52,7 @@ fn compare(scene: &str, technique: &str, overrides: &[&str], photons: u64, bound
     drop(renderer);
     ours.iter().for_each(|img| assert_finite(img));
 
-    let reference = traced_reference(&ctx, &load(scene), SIZE, photons);
+    let reference = traced_reference(&ctx, &canonical_scene(scene), SIZE, photons);
     let truth = [
         Component::Direct,
         Component::SurfaceCaustics,

@@ -66,13 +66,6 @@ use std::sync::Arc;
 
 const SIZE: u32 = 128;
 
-fn load(name: &str) -> Scene {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("assets/scenes")
-        .join(format!("{name}.toml"));
-    Scene::load(&path).unwrap()
-}
-
 struct Frame {
     tech: VolumeLines,
     targets: FrameTargets,
@@ -131,7 +124,7 @@ fn set_medium(scene: &mut Scene, sigma_s: f32, sigma_a: f32, g: f32) {
 #[test]
 fn no_scattering_no_volume_caustic() {
     let ctx = validated_context();
-    let mut scene = load("volume_cone");
+    let mut scene = canonical_scene("volume_cone");
     set_medium(&mut scene, 0.0, 0.005, 0.0);
     let f = render(&ctx, &scene, &[], Component::VolumeCaustics.mask());
     let valid = f.segments().iter().filter(|s| s.p1[3] > 0.0).count();
@@ -148,7 +141,7 @@ fn no_scattering_no_volume_caustic() {
 #[test]
 fn optically_thin_volume_caustic_is_linear_in_sigma_s() {
     let ctx = validated_context();
-    let mut scene = load("volume_cone");
+    let mut scene = canonical_scene("volume_cone");
     set_medium(&mut scene, 0.002, 0.0, 0.0);
     let one = energy(&volume_caustic(&ctx, &scene, &[]));
     set_medium(&mut scene, 0.004, 0.0, 0.0);
@@ -243,7 +236,7 @@ fn volume_cone_matches_reference() {
             },
         ),
     ] {
-        let mut scene = load("volume_cone");
+        let mut scene = canonical_scene("volume_cone");
         scene.medium.as_mut().unwrap().g = g;
         matches_reference(
             &ctx,
@@ -262,7 +255,7 @@ fn smoke_matches_reference() {
     matches_reference(
         &ctx,
         "smoke",
-        &load("smoke"),
+        &canonical_scene("smoke"),
         PHOTONS_REFERENCE,
         Bound {
             energy: 0.045,
@@ -358,7 +351,7 @@ fn red_energy(img: &[f32]) -> f64 {
 #[test]
 fn lines_match_the_beam_integral_and_the_phase_function() {
     let ctx = validated_context();
-    let mut scene = load("volume_cone");
+    let mut scene = canonical_scene("volume_cone");
     scene.objects.retain(|o| o.name != "floor");
     scene.camera = camera(Vec3::new(0.0, -2.0, 1.5), Vec3::new(0.0, 1.0, 0.0), 30.0);
     let mut measured = Vec::new();
@@ -403,7 +396,7 @@ fn lines_match_the_beam_integral_and_the_phase_function() {
 #[test]
 fn one_line_per_texel_that_sees_the_lens() {
     let ctx = validated_context();
-    let scene = load("volume_cone");
+    let scene = canonical_scene("volume_cone");
     let n = 256u32;
     let f = render(
         &ctx,
@@ -472,7 +465,7 @@ fn one_line_per_texel_that_sees_the_lens() {
 #[ignore]
 fn coverage_statistics() {
     let ctx = validated_context();
-    let scene = load("volume_cone");
+    let scene = canonical_scene("volume_cone");
     println!("| volume caustic buffer | screen | lines | covered pixels | fragments |");
     println!("| ---: | ---: | ---: | ---: | ---: |");
     for buffer in [256u32, 512, 1024] {
@@ -501,7 +494,7 @@ fn coverage_statistics() {
 #[test]
 fn filter_radius_beyond_sixteen_steps_is_refused() {
     let ctx = validated_context();
-    let scene = load("volume_cone");
+    let scene = canonical_scene("volume_cone");
     let overrides = ["ray_step=0.01".to_string(), "filter_radius=0.5".to_string()];
     let params = VolumeLinesParams::parse("volume_lines", &overrides).unwrap();
     let scene_gpu = SceneGpu::new(&ctx, &scene, 0.0).unwrap();
@@ -522,7 +515,7 @@ fn filter_radius_beyond_sixteen_steps_is_refused() {
 #[test]
 fn components_add_up_to_the_frame() {
     let ctx = validated_context();
-    let scene = load("volume_cone");
+    let scene = canonical_scene("volume_cone");
     // Midpoint airlight samples: the same A in every render.
     let opts = [
         "volume_buffer_size=128",

@@ -561,6 +561,14 @@ pub fn block_errors(
 pub const BALL_LENS_POINT_LIGHT: &str =
     "[[light]]\nkind = \"point\"\nposition = [0.0, 8.0, 0.0]\nintensity = [60.0, 60.0, 60.0]\n";
 
+/// assets/scenes/<name>.toml, loaded.
+pub fn canonical_scene(name: &str) -> Scene {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("assets/scenes")
+        .join(format!("{name}.toml"));
+    Scene::load(&path).unwrap()
+}
+
 /// `ball_lens.toml` with its point light replaced by `light` (TOML).
 pub fn ball_lens_with_light(light: &str) -> Scene {
     let path =
