@@ -187,6 +187,14 @@ pub const REFERENCE_BINDING_VOLUME_NEXT: u32 = 9;
 pub const REFERENCE_BINDING_STATS: u32 = 10;
 /// Points on camera paths in the medium where the volume photon map is gathered.
 pub const REFERENCE_BINDING_GATHER_POINTS: u32 = 11;
+/// The aim guide (glsl/reference/aim_guide.glsl): per point, spot and
+/// directional light, what its aimed photons were useful for, by where they
+/// were aimed, and the distribution the next pass aims by.
+pub const REFERENCE_BINDING_AIM_GUIDE: u32 = 12;
+/// The aim guide's grid over the aimed region's sample square: rows over
+/// the radial coordinate, columns over the angle about the axis.
+pub const REFERENCE_GUIDE_ROWS: u32 = 64;
+pub const REFERENCE_GUIDE_COLUMNS: u32 = 32;
 /// End of a hash-grid chain.
 pub const REFERENCE_GRID_NONE: u32 = 4294967295;
 /// The volume gather stops a cell's chain after this many links (below

@@ -72,6 +72,15 @@ vec3 uniform_cone(vec2 u, vec3 axis, float cos_max) {
     return normalize(t * (sin_t * cos(phi)) + b * (sin_t * sin(phi)) + axis * cos_t);
 }
 
+// The inverse of uniform_cone: the u that maps to `dir` (inside the cone).
+vec2 uniform_cone_coords(vec3 dir, vec3 axis, float cos_max) {
+    vec3 t, b;
+    basis(axis, t, b);
+    float phi = atan(dot(dir, b), dot(dir, t));
+    if (phi < 0.0) phi += 2.0 * PI;
+    return vec2((1.0 - dot(dir, axis)) / (1.0 - cos_max), phi / (2.0 * PI));
+}
+
 vec3 cosine_hemisphere(vec2 u, vec3 n) {
     float r = sqrt(u.x);
     float phi = 2.0 * PI * u.y;

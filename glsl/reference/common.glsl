@@ -87,7 +87,8 @@ layout(push_constant) uniform Push {
     vec4 aim;              // bounding sphere of the specular triangles (w = 0: none)
     float aim_share;       // share of photons aimed at it
     uint gather_capacity;  // gather points stored at most
-    uint pad1, pad2;
+    uint aim_guide;        // 1: aimed photons follow the aim guide (aim_guide.glsl)
+    uint pad;
 } pc;
 
 uint image_width() { return uint(frame.viewport.x); }

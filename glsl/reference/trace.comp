@@ -16,8 +16,18 @@
 // A_pix the pixel's area on the image plane at unit distance; that is the
 // change of variables from image-plane area to surface area (or volume).
 #include "common.glsl"
+#include "aim_guide.glsl"
 
 layout(local_size_x = 64) in;
+
+// This invocation's photon for the aim guide: the light and cell it was
+// aimed by (guide_light = GUIDE_UNAIMED: not aimed by a guide), g there,
+// and whether it reached the image.
+const uint GUIDE_UNAIMED = 0xffffffffu;
+uint guide_light = GUIDE_UNAIMED;
+uint guide_photon_cell = 0u;
+float guide_photon_density = 1.0;
+bool photon_useful = false;
 
 // Adds a photon's contribution to pixel `pixel` of this pass's image
 // `component`, divided by the photons emitted this pass.
@@ -148,7 +158,9 @@ void emit_environment(bool sun, inout uint rng, out vec3 origin, out vec3 dir, o
 // flux divides by the mixture's pdf, so the estimate stays unbiased while
 // the caustics (what the visible points behind glass and water gather)
 // get a share q of the photons instead of the share of the solid angle
-// the specular objects subtend (0.6% for ball_lens).
+// the specular objects subtend (0.6% for ball_lens). Within the aimed
+// region the aim guide (aim_guide.glsl) places them where earlier passes'
+// photons reached the image: the aimed pdf is the uniform one times g.
 void emit(uint l, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) {
     Light light = lights[l];
     uint kind = floatBitsToUint(light.position.w);
@@ -160,6 +172,12 @@ void emit(uint l, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) 
     vec2 u = vec2(rng_next(rng), rng_next(rng));
     vec3 aim_center = pc.aim.xyz;
     float aim_radius = pc.aim.w;
+    bool guided = pc.aim_guide != 0u;
+    // An aimed photon's point of the square, drawn by the guide.
+    vec2 aimed_u = u;
+    if (guided && choice < pc.aim_share && aim_radius > 0.0) {
+        aimed_u = guide_sample(l, u, guide_photon_cell, guide_photon_density);
+    }
     if (kind == LIGHT_POINT || kind == LIGHT_SPOT) {
         origin = light.position.xyz;
         vec3 to_aim = aim_center - origin;
@@ -169,12 +187,20 @@ void emit(uint l, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) 
         vec3 axis = q > 0.0 ? to_aim / d : vec3(0.0, 1.0, 0.0);
         float cos_aim = q > 0.0 ? sqrt(max(0.0, 1.0 - aim_radius * aim_radius / (d * d))) : 1.0;
         float cos_outer = light.direction.w;
-        if (choice < q) dir = uniform_cone(u, axis, cos_aim);
+        bool aimed = choice < q;
+        if (aimed) dir = uniform_cone(aimed_u, axis, cos_aim);
         else if (kind == LIGHT_POINT) dir = uniform_sphere(u);
         else dir = uniform_cone(u, light.direction.xyz, cos_outer);
         float base_pdf = kind == LIGHT_POINT ? 1.0 / (4.0 * PI)
             : (dot(dir, light.direction.xyz) >= cos_outer ? 1.0 / (2.0 * PI * (1.0 - cos_outer)) : 0.0);
-        float aim_pdf = (q > 0.0 && dot(dir, axis) >= cos_aim) ? 1.0 / (2.0 * PI * (1.0 - cos_aim)) : 0.0;
+        float aim_pdf = 0.0;
+        if (q > 0.0 && dot(dir, axis) >= cos_aim) {
+            float g = !guided ? 1.0
+                : aimed ? guide_photon_density
+                : guide_density(l, uniform_cone_coords(dir, axis, cos_aim));
+            aim_pdf = g / (2.0 * PI * (1.0 - cos_aim));
+        }
+        if (aimed && guided) guide_light = l;
         float pdf = (1.0 - q) * base_pdf + q * aim_pdf;
         float falloff = kind == LIGHT_POINT ? 1.0
             : spot_falloff(dot(dir, light.direction.xyz), cos_outer, light.intensity.w);
@@ -190,16 +216,25 @@ void emit(uint l, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) 
         basis(dir, t, b);
         vec2 aim_offset = vec2(dot(aim_center - c, t), dot(aim_center - c, b));
         float q = aim_radius > 0.0 ? pc.aim_share : 0.0;
-        vec2 center = choice < q ? aim_offset : vec2(0.0);
-        float radius = choice < q ? aim_radius : r;
-        float rr = radius * sqrt(u.x);
-        float phi = 2.0 * PI * u.y;
+        bool aimed = choice < q;
+        vec2 center = aimed ? aim_offset : vec2(0.0);
+        float radius = aimed ? aim_radius : r;
+        vec2 v = aimed ? aimed_u : u;
+        float rr = radius * sqrt(v.x);
+        float phi = 2.0 * PI * v.y;
         vec2 p = center + vec2(rr * cos(phi), rr * sin(phi));
         origin = c - dir * (r * 1.01) + t * p.x + b * p.y;
         float base_pdf = dot(p, p) <= r * r ? 1.0 / (PI * r * r) : 0.0;
         vec2 from_aim = p - aim_offset;
-        float aim_pdf = (q > 0.0 && dot(from_aim, from_aim) <= aim_radius * aim_radius)
-            ? 1.0 / (PI * aim_radius * aim_radius) : 0.0;
+        float aim_pdf = 0.0;
+        if (q > 0.0 && dot(from_aim, from_aim) <= aim_radius * aim_radius) {
+            float from_phi = atan(from_aim.y, from_aim.x);
+            if (from_phi < 0.0) from_phi += 2.0 * PI;
+            vec2 disk_u = vec2(dot(from_aim, from_aim) / (aim_radius * aim_radius), from_phi / (2.0 * PI));
+            float g = !guided ? 1.0 : aimed ? guide_photon_density : guide_density(l, disk_u);
+            aim_pdf = g / (PI * aim_radius * aim_radius);
+        }
+        if (aimed && guided) guide_light = l;
         float pdf = (1.0 - q) * base_pdf + q * aim_pdf;
         // Beyond the scene's disk nothing is reached: such a photon is wasted.
         flux = (pdf > 0.0 && base_pdf > 0.0) ? light.intensity.rgb / pdf : vec3(0.0);
@@ -216,6 +251,7 @@ void connect_surface(vec3 x, vec3 n, vec3 weight, vec3 albedo, uint tag, inout u
     vec3 o = offset_origin(x, n);
     if (trace_any(o, to_eye, 0.0, dist * (1.0 - 1e-4))) return;
     vec3 tr = medium_transmittance(o, to_eye, dist, rng);
+    photon_useful = true;
     splat(pixel, tag, weight * (albedo / PI) * cos_x * measurement * tr);
 }
 
@@ -226,6 +262,7 @@ void connect_medium(vec3 x, vec3 d, vec3 weight_sigma_s, float g, uint tag, inou
     if (!camera_connection(x, pixel, to_eye, dist, measurement)) return;
     if (trace_any(x, to_eye, 0.0, dist * (1.0 - 1e-4))) return;
     vec3 tr = medium_transmittance(x, to_eye, dist, rng);
+    photon_useful = true;
     splat(pixel, tag, weight_sigma_s * hg_phase(dot(d, to_eye), g) * measurement * tr);
 }
 
@@ -260,6 +297,7 @@ void gather_surface(vec3 x, vec3 arrival_side, vec3 flux, uint tag) {
                 vec3 d = vp.position.xyz - x;
                 if (dot(d, d) < r * r && dot(vp.normal.xyz, arrival_side) > 0.5) {
                     add_pass(i, tag, scale * vp.weight.rgb);
+                    photon_useful = true;
                 }
             }
             i = surface_next[i];
@@ -272,6 +310,7 @@ void gather_surface(vec3 x, vec3 arrival_side, vec3 flux, uint tag) {
 void store_volume_photon(vec3 x, vec3 d, vec3 flux, uint tag) {
     uint index = atomicAdd(volume_photon_count, 1u);
     if (index >= pc.volume_capacity) return; // counted: the host reports the overflow
+    photon_useful = true; // whether a gather point finds it is not known here
     VolumePhoton photon;
     photon.position = vec4(x, uintBitsToFloat(tag));
     photon.direction = vec4(d, 0.0);
@@ -281,7 +320,8 @@ void store_volume_photon(vec3 x, vec3 d, vec3 flux, uint tag) {
     volume_next[index] = atomicExchange(volume_heads[bucket], index);
 }
 
-void main() {
+// Emits and follows one photon.
+void trace_photon() {
     uint rng = rng_seed(gl_GlobalInvocationID.x, pc.seed);
     float light_probability;
     uint l = pick_light(rng_next(rng), light_probability);
@@ -412,5 +452,14 @@ void main() {
             specular += 1u;
         }
         if (luminance(s.weight) <= 0.0) return;
+    }
+}
+
+void main() {
+    trace_photon();
+    // The aim guide's count: 1/g, so that a cell's sum estimates its useful
+    // photons under uniform aiming.
+    if (guide_light != GUIDE_UNAIMED && photon_useful) {
+        atomicAdd(aim_guide[guide_index(guide_light, GUIDE_COUNTS, guide_photon_cell)], 1.0 / guide_photon_density);
     }
 }

@@ -186,6 +186,11 @@ pub struct ReferenceArgs {
     /// distribution. Unbiased for any share; more caustic photons.
     #[arg(long, allow_negative_numbers = true, default_value_t = 0.5)]
     pub aim_share: f32,
+    /// Aim the photons uniformly over the specular objects' bounding sphere
+    /// instead of by the aim guide (where earlier passes' aimed photons
+    /// reached the image); for measuring what the guide gains.
+    #[arg(long)]
+    pub no_aim_guide: bool,
     /// Photons per pass, a multiple of 64 from 64 to 16,777,216: a pass is
     /// the unit of progress (its camera samples, its photons, its radius).
     /// Smaller passes show a first image sooner.

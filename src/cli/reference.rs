@@ -14,6 +14,7 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
         radius,
         no_photon_mapping,
         aim_share,
+        no_aim_guide,
         pass_photons,
         component,
         diffuse_bounces,
@@ -49,6 +50,7 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
         radius,
         photon_mapping: !no_photon_mapping,
         aim_share,
+        aim_guide: !no_aim_guide,
         batch: pass_photons,
         ..Default::default()
     };

@@ -47,6 +47,10 @@ pub struct ReferenceSettings {
     /// objects (a mixture with the light's own distribution, unbiased for
     /// any share below 1; 0: none aimed).
     pub aim_share: f32,
+    /// Aimed photons follow the aim guide (glsl/reference/aim_guide.glsl):
+    /// where earlier passes' aimed photons reached the image. Off: uniform
+    /// over the aimed region.
+    pub aim_guide: bool,
 }
 
 impl ReferenceSettings {
@@ -78,6 +82,7 @@ impl Default for ReferenceSettings {
             alpha: 2.0 / 3.0,
             volume_capacity: 1 << 21,
             aim_share: 0.5,
+            aim_guide: true,
         }
     }
 }
@@ -172,6 +177,7 @@ impl ReferenceRenderer {
             radius,
             scene.medium.is_some(),
             specular_sphere(&scene, time),
+            scene.lights.len(),
         )?;
         let profiler = crate::vk::Profiler::new(ctx, 16)?;
         profiler.frame(|rec| {

@@ -32,7 +32,8 @@ struct Push {
     aim: [f32; 4],
     aim_share: f32,
     gather_capacity: u32,
-    pad: [u32; 2],
+    aim_guide: u32,
+    pad: u32,
 }
 
 /// The counters of `stats` (glsl/reference/common.glsl).
@@ -60,6 +61,7 @@ pub struct Reference {
     camera: ComputePipeline,
     volume_points: ComputePipeline,
     volume_gather: ComputePipeline,
+    aim_guide_build: ComputePipeline,
     fold: ComputePipeline,
     noise: ComputePipeline,
     resolve: ComputePipeline,
@@ -79,6 +81,11 @@ pub struct Reference {
     volume_heads: Buffer,
     volume_next: Buffer,
     gather_points: Buffer,
+    /// Per point, spot and directional light: the aim guide
+    /// (glsl/reference/aim_guide.glsl), rebuilt before every photon pass.
+    aim_guide: Buffer,
+    /// Lights the guide is rebuilt for (0: no guide).
+    guided_lights: u32,
     stats: Buffer,
     settings: ReferenceSettings,
     surface_table: u32,
@@ -101,7 +108,9 @@ pub struct Reference {
 
 impl Reference {
     /// `radius`: the first pass's surface gather radius (m); `aim`: the
-    /// bounding sphere photons are aimed at (`specular_sphere`).
+    /// bounding sphere photons are aimed at (`specular_sphere`); `lights`:
+    /// the scene's point, spot and directional lights.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: &Arc<Context>,
         scene_gpu: &SceneGpu,
@@ -110,6 +119,7 @@ impl Reference {
         radius: f32,
         has_medium: bool,
         aim: Option<(glam::Vec3, f32)>,
+        lights: usize,
     ) -> anyhow::Result<Self> {
         let accum_bytes = check_image_size(ctx, targets.width, targets.height)?;
         if !(radius.is_finite() && radius > 0.0) {
@@ -141,6 +151,7 @@ impl Reference {
                 storage(b::REFERENCE_BINDING_VOLUME_NEXT),
                 storage(b::REFERENCE_BINDING_STATS),
                 storage(b::REFERENCE_BINDING_GATHER_POINTS),
+                storage(b::REFERENCE_BINDING_AIM_GUIDE),
             ],
         )?;
         let sets = [&scene_gpu.layout, &layout];
@@ -164,6 +175,15 @@ impl Reference {
         } else {
             0
         };
+        // Aiming by the guide: only where photons are aimed at all.
+        let guided_lights = if settings.aim_guide && aim.is_some() && settings.aim_share > 0.0 {
+            lights as u32
+        } else {
+            0
+        };
+        let cells = u64::from(b::REFERENCE_GUIDE_ROWS * b::REFERENCE_GUIDE_COLUMNS);
+        let guide_bytes =
+            (4 * cells + u64::from(b::REFERENCE_GUIDE_ROWS)) * 4 * u64::from(guided_lights.max(1));
         let point_bytes = std::mem::size_of::<[f32; 12]>() as u64;
         let vp_bytes = pixels * point_bytes;
         let volume_bytes = volume_capacity as u64 * point_bytes;
@@ -181,6 +201,7 @@ impl Reference {
             camera: pipeline("reference/camera.comp")?,
             volume_points: pipeline("reference/volume_points.comp")?,
             volume_gather: pipeline("reference/volume_gather.comp")?,
+            aim_guide_build: pipeline("reference/aim_guide.comp")?,
             fold: pipeline("reference/fold.comp")?,
             noise: pipeline("reference/noise.comp")?,
             resolve: pipeline("reference/resolve.comp")?,
@@ -195,6 +216,8 @@ impl Reference {
             volume_next: buffer("reference volume links", volume_capacity as u64 * 4)?,
             // Every buffer needs a size above 0.
             gather_points: buffer("reference gather points", gather_bytes.max(point_bytes))?,
+            aim_guide: buffer("reference aim guide", guide_bytes)?,
+            guided_lights,
             stats: Buffer::new(ctx, "reference counters", 32, BufferUsage::StorageIndirect)?,
             set: DescriptorSet::new(ctx, &layout)?,
             resolve_set: DescriptorSet::new(ctx, &layout)?,
@@ -232,7 +255,8 @@ impl Reference {
                 .write_buffer(b::REFERENCE_BINDING_VOLUME_HEADS, &reference.volume_heads)
                 .write_buffer(b::REFERENCE_BINDING_VOLUME_NEXT, &reference.volume_next)
                 .write_buffer(b::REFERENCE_BINDING_STATS, &reference.stats)
-                .write_buffer(b::REFERENCE_BINDING_GATHER_POINTS, &reference.gather_points);
+                .write_buffer(b::REFERENCE_BINDING_GATHER_POINTS, &reference.gather_points)
+                .write_buffer(b::REFERENCE_BINDING_AIM_GUIDE, &reference.aim_guide);
         }
         Ok(reference)
     }
@@ -258,14 +282,15 @@ impl Reference {
             aim: self.aim,
             aim_share: self.settings.aim_share,
             gather_capacity: self.gather_capacity,
-            pad: [0; 2],
+            aim_guide: (self.guided_lights > 0) as u32,
+            pad: 0,
         }
     }
 
-    /// Clears the sums (first pass); records it through the recorder.
+    /// Clears the sums and the aim guide (first pass); records it through the recorder.
     pub fn record_clear(&mut self, rec: &mut FrameRecorder) {
         rec.pass("reference clear").record(|c| {
-            for sums in [&self.total, &self.pass_sums, &self.moments] {
+            for sums in [&self.total, &self.pass_sums, &self.moments, &self.aim_guide] {
                 c.fill(sums, 0);
             }
         });
@@ -296,8 +321,17 @@ impl Reference {
                 c.fill(&self.surface_heads, b::REFERENCE_GRID_NONE);
                 c.dispatch(&self.camera, &sets, push, pixel_groups);
             });
+        if self.guided_lights > 0 {
+            rec.pass("reference aim guide")
+                .write(&self.aim_guide, Access::ComputeWrite)
+                .record(|c| {
+                    let groups = [self.guided_lights, 1, 1];
+                    c.dispatch(&self.aim_guide_build, &sets, push, groups);
+                });
+        }
         rec.pass("reference photons")
             .write(&self.pass_sums, Access::ComputeWrite)
+            .write(&self.aim_guide, Access::ComputeWrite)
             .read(&self.visible_points, Access::ComputeRead)
             .read(&self.surface_heads, Access::ComputeRead)
             .read(&self.surface_next, Access::ComputeRead)
