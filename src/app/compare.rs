@@ -1,8 +1,9 @@
 //! The overlay's compare panel: a reference snapshot of the current view
 //! (`ReferenceRenderer` for the demo's scene, time and camera at the
 //! window's size), traced one pass per live frame and compared with the live
-//! frame through the same code as `caustics compare` (src/compare/metrics.rs:
-//! the CPU display transform, LDR-FLIP and its magma error map).
+//! frame by the same driver as `caustics compare` (`compare::driver`:
+//! `LiveReference`; the metrics are src/compare/metrics.rs: the CPU display
+//! transform, LDR-FLIP and its magma error map).
 //!
 //! Synchronisation: a reference pass is its own submission on the demo's
 //! queue (`Profiler::frame` submits and waits for that submission's fence),
@@ -14,16 +15,12 @@
 //! Any change of what the snapshot shows (camera, time, technique or its
 //! parameters, drawn components, window size, scene edits) discards it.
 
+use crate::compare::driver::{self, LiveReference};
 use crate::compare::metrics;
-use crate::reference::{Component, ReferenceRenderer, ReferenceSettings};
 use crate::renderer::Renderer;
 use crate::scene::Camera;
 use crate::vk::Context;
 use std::sync::Arc;
-
-/// Photons per reference pass: a quarter of `caustics reference`'s batch,
-/// so that one pass per live frame keeps the window responsive.
-const PHOTONS_PER_PASS: u32 = 1 << 16;
 
 /// What the window shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -93,10 +90,8 @@ impl ViewKey {
 /// the chosen view shows.
 pub(super) struct Snapshot {
     key: ViewKey,
-    reference: ReferenceRenderer,
-    /// The component the reference resolves: the one the live frame draws
-    /// alone, else all.
-    component: Component,
+    /// Resolves the component the live frame draws alone, else all.
+    reference: LiveReference,
     pub(super) flip_mean: Option<f32>,
     /// RGBA8 of the reference (tonemapped) and of the FLIP map (magma).
     reference_rgba: Vec<u8>,
@@ -149,25 +144,14 @@ impl Compare {
     ) -> anyhow::Result<()> {
         self.snapshot = None;
         let (width, height) = key.size;
-        let component = renderer
-            .technique_info()
-            .components
-            .iter()
-            .copied()
-            .find(|c| c.mask() == key.components)
-            .unwrap_or(Component::All);
-        let settings = ReferenceSettings {
-            batch: PHOTONS_PER_PASS,
-            ..ReferenceSettings::default()
-        };
-        let reference = ReferenceRenderer::new(
-            ctx,
-            renderer.scene.clone(),
+        let component = driver::component_drawn(renderer.technique_info(), key.components);
+        let view = driver::View {
             width,
             height,
-            key.time,
-            settings,
-        )?;
+            time: key.time,
+            diffuse_bounces: 0,
+        };
+        let reference = LiveReference::new(ctx, &renderer.scene, view, component)?;
         println!(
             "compare: snapshot {width}x{height} at t = {:.2} s, {} ({})",
             key.time,
@@ -177,7 +161,6 @@ impl Compare {
         self.snapshot = Some(Snapshot {
             key,
             reference,
-            component,
             flip_mean: None,
             reference_rgba: Vec::new(),
             flip_rgba: Vec::new(),
@@ -204,21 +187,19 @@ impl Compare {
             return Ok(());
         }
         let s = self.snapshot.as_mut().expect("snapshot");
-        s.reference.pass()?;
-        let reference = s.reference.resolve(s.component)?;
         let live = renderer.radiance()?;
         let (w, h) = s.key.size;
         let exposure = renderer.scene.output.exposure;
-        let (m, map) = metrics::compare(&live, &reference, w, h, exposure);
-        s.reference_rgba = metrics::tonemap(&reference, exposure);
-        s.flip_rgba = metrics::rgba8(&map.magma_rgb8());
-        s.flip_mean = Some(m.flip);
+        let judged = s.reference.refine(&live, exposure)?;
+        s.reference_rgba = metrics::tonemap(&judged.reference, exposure);
+        s.flip_rgba = metrics::rgba8(&judged.map.magma_rgb8());
+        s.flip_mean = Some(judged.metrics.flip);
         s.generation += 1;
         println!(
             "compare: pass {}, {} photons, FLIP mean {:.4} (live vs reference, {w}x{h})",
             s.reference.passes(),
             s.reference.photons(),
-            m.flip
+            judged.metrics.flip
         );
         Ok(())
     }
@@ -246,7 +227,7 @@ impl Compare {
             photons: s.map_or(0, |s| s.reference.photons()),
             flip_mean: s.and_then(|s| s.flip_mean),
             size: s.map_or((0, 0), |s| s.key.size),
-            component: s.map_or("all", |s| s.component.name()),
+            component: s.map_or("all", |s| s.reference.component().name()),
             image,
         }
     }

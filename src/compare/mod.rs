@@ -1,9 +1,11 @@
 //! `caustics compare`'s library side: every technique judged against the
-//! ground truth by the same metrics the tests use (`metrics`), the report
+//! ground truth (`driver`, shared by the CLI and the demo's compare panel)
+//! by the same metrics the tests use (`metrics`), the report
 //! both write (`report`, the JSON schema `bench --json` shares), the
 //! contact sheet (`sheet`, labelled with a bitmap `font`) and the key of
 //! the reference cache (`cache_key`).
 
+pub mod driver;
 pub mod font;
 pub mod metrics;
 pub mod report;
