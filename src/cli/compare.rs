@@ -190,6 +190,9 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
             signed_percent(t.full.energy),
             t.timing.frame_ms
         );
+        for n in &t.not_applicable {
+            println!("{:<16} {}: not applicable ({})", "", n.component, n.reason);
+        }
     }
     for s in &report.skipped {
         println!("{:<16} skipped: {}", s.technique, s.reason);

@@ -6,7 +6,9 @@
 //! each (`metrics`, the tests' code path).
 
 use super::metrics::{self, FlipMap, Metrics};
-use super::report::{pass_stats, ComponentResult, ReferenceInfo, TechniqueResult, Timing};
+use super::report::{
+    pass_stats, ComponentResult, NotApplicable, ReferenceInfo, TechniqueResult, Timing,
+};
 use super::{cache_key, ReferenceKey};
 use crate::output;
 use crate::params::Params;
@@ -268,7 +270,8 @@ pub struct Judged {
 
 /// Renders technique `name` with its default parameters: each of its
 /// components (which also warm up every pass) against the reference's
-/// matching component, then `frames` timed full frames, the last against
+/// matching component (a component the scene has more of than the
+/// technique models is listed as not applicable instead), then `frames` timed full frames, the last against
 /// the reference's full frame. Each image goes to `sink` as it is made.
 /// `Ok(Err(reason))` when the technique does not take the scene (its
 /// scene check refused it); an error of `Renderer::new` carries its
@@ -298,6 +301,7 @@ pub fn judge_technique(
     // `SceneGpu::draws`), so they are the warm-up (pipeline compilation)
     // the timed frames need; a separate warm-up frame only without them.
     let mut components = Vec::new();
+    let mut not_applicable = Vec::new();
     for &c in info.components {
         r.scene_gpu.components = c.mask();
         r.render_frame(time)?;
@@ -306,6 +310,13 @@ pub fn judge_technique(
         let Some(truth) = reference.component(c) else {
             continue;
         };
+        if let Some(reason) = info.not_modelled(scene, c) {
+            not_applicable.push(NotApplicable {
+                component: c.name().into(),
+                reason,
+            });
+            continue;
+        }
         let (m, cmap) = metrics::compare(&img, truth, width, height, exposure);
         sink.flip_map(&format!("{name}_{}_flip", c.name()), &cmap)?;
         components.push(ComponentResult {
@@ -339,6 +350,7 @@ pub fn judge_technique(
         timing,
         full,
         components,
+        not_applicable,
     };
     Ok(Ok(Judged {
         result,

@@ -78,6 +78,18 @@ pub struct TechniqueResult {
     /// Each component the technique renders against the reference's
     /// matching path-type component (none with a `--reference` file).
     pub components: Vec<ComponentResult>,
+    /// Its components the scene has more of than the technique models
+    /// (`TechniqueInfo::not_modelled`), not scored.
+    #[serde(default)]
+    pub not_applicable: Vec<NotApplicable>,
+}
+
+/// A component left unscored, and why (e.g. `pinhole`'s surface caustics
+/// on a scene with glass: it renders reflection caustics only).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct NotApplicable {
+    pub component: String,
+    pub reason: String,
 }
 
 /// A technique left out, and why (e.g. `water_photons` without water).
@@ -152,6 +164,12 @@ impl CompareReport {
             md += &row("full frame", &t.full);
             for c in &t.components {
                 md += &row(&c.component, &c.metrics);
+            }
+            for n in &t.not_applicable {
+                md += &format!(
+                    "| {} | {} | not applicable: {} | | | |\n",
+                    t.technique, n.component, n.reason
+                );
             }
         }
         for s in &self.skipped {

@@ -2,7 +2,7 @@
 //! the base frame every technique adds to; the ground truth's L D
 //! component for diffuse surfaces seen directly.
 
-use super::{Technique, TechniqueBuild};
+use super::{CausticSources, Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::params::{ParamSet, Params};
 use crate::passes::direct_light::DirectLight;
@@ -21,6 +21,7 @@ impl TechniqueBuild for Direct {
     const DESCRIPTION: &'static str =
         "direct light with shadow maps (the base frame every technique adds to)";
     const COMPONENTS: &'static [Component] = &[Component::Direct, Component::Emitted];
+    const CAUSTIC_SOURCES: CausticSources = CausticSources::None;
     type Params = DirectParams;
 
     fn build(

@@ -77,6 +77,9 @@ pub trait TechniqueBuild: Technique + Sized + 'static {
     /// The path-type components it renders (the demo's C key and
     /// `caustics render --component` pick among them).
     const COMPONENTS: &'static [Component];
+    /// Which specular objects' caustics it renders (`caustics compare`
+    /// marks its caustic components "not applicable" on a scene with others).
+    const CAUSTIC_SOURCES: CausticSources;
     type Params: ParamSet;
 
     fn build(
@@ -116,12 +119,27 @@ fn create<T: TechniqueBuild>(
 pub type CreateFn =
     fn(&Arc<Context>, &Params, &Scene, &SceneGpu, u32, u32) -> anyhow::Result<Box<dyn Technique>>;
 
+/// Which specular objects' caustics (L S+ D, L S+ V) a technique renders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CausticSources {
+    /// It draws no caustics.
+    None,
+    /// Reflections only: mirrors and the outer Fresnel reflection of
+    /// dielectrics (Wand & Straßer's reflectors).
+    Reflection,
+    /// The surfaces of `water` objects only.
+    Water,
+    /// Every mirror and dielectric, reflected and refracted.
+    All,
+}
+
 /// A real-time technique in the registry.
 pub struct TechniqueInfo {
     pub name: &'static str,
     pub description: &'static str,
     /// The path-type components it renders.
     pub components: &'static [Component],
+    pub caustic_sources: CausticSources,
     specs: fn() -> &'static [ParamSpec],
     /// Builds it for frames of `width` x `height` from values validated
     /// against `params()`.
@@ -137,6 +155,7 @@ impl TechniqueInfo {
             name: T::NAME,
             description: T::DESCRIPTION,
             components: T::COMPONENTS,
+            caustic_sources: T::CAUSTIC_SOURCES,
             specs: <T::Params as ParamSet>::specs,
             create: create::<T>,
             check_scene: T::check_scene,
@@ -146,6 +165,51 @@ impl TechniqueInfo {
     /// Its parameters (`--param`, the overlay, `caustics info`).
     pub fn params(&self) -> &'static [ParamSpec] {
         (self.specs)()
+    }
+
+    /// Why `component` of `scene` is beyond what the technique models
+    /// (caustics of a specular object its `caustic_sources` leave out), or
+    /// None when the technique models all of it. A comparison reports such
+    /// a component as not applicable instead of scoring it.
+    pub fn not_modelled(&self, scene: &Scene, component: Component) -> Option<String> {
+        use crate::scene::MaterialKind;
+        if !matches!(
+            component,
+            Component::SurfaceCaustics | Component::VolumeCaustics
+        ) {
+            return None;
+        }
+        let name = self.name;
+        for o in &scene.objects {
+            for &m in &o.mesh.materials {
+                let Some(mat) = scene.materials.get(m as usize) else {
+                    continue;
+                };
+                let refracts = matches!(
+                    mat.kind,
+                    MaterialKind::Dielectric | MaterialKind::ThinDielectric
+                );
+                let specular = refracts || mat.kind == MaterialKind::Mirror || mat.is_mixed();
+                let why = match self.caustic_sources {
+                    CausticSources::All => None,
+                    CausticSources::None if specular => Some("draws no caustics".to_string()),
+                    CausticSources::Reflection if refracts => {
+                        Some("renders reflection caustics only".to_string())
+                    }
+                    CausticSources::Water if specular && o.water.is_none() => {
+                        Some("renders the water's caustics only".to_string())
+                    }
+                    _ => None,
+                };
+                if let Some(why) = why {
+                    return Some(format!(
+                        "{name} {why}; object `{}` (material `{}`) makes caustics it does not",
+                        o.name, mat.name
+                    ));
+                }
+            }
+        }
+        None
     }
 }
 
@@ -368,5 +432,61 @@ mod auto_tests {
             m.kind = crate::scene::MaterialKind::Diffuse;
         }
         assert_eq!(auto(&plain), "image_space");
+    }
+
+    /// What each technique's caustics leave out: pinhole the glass ball's
+    /// refraction, water_photons every specular object but the water.
+    #[test]
+    fn caustic_components_a_technique_does_not_model() {
+        let load = |name: &str| {
+            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("assets/scenes")
+                .join(name);
+            Scene::load(&path).unwrap()
+        };
+        let info = |name| find(name).unwrap();
+        let ball = load("ball_lens.toml");
+        let reason = info("pinhole").not_modelled(&ball, Component::SurfaceCaustics);
+        assert!(
+            reason
+                .as_deref()
+                .is_some_and(|r| r.contains("reflection caustics only") && r.contains("`lens`")),
+            "{reason:?}"
+        );
+        assert_eq!(info("pinhole").not_modelled(&ball, Component::Direct), None);
+        for name in ["image_space", "volume_lines", "beams"] {
+            assert_eq!(
+                info(name).not_modelled(&ball, Component::SurfaceCaustics),
+                None,
+                "{name}"
+            );
+        }
+        // Mirrors only: every reflector technique models them.
+        let ring = load("ring.toml");
+        assert_eq!(
+            info("pinhole").not_modelled(&ring, Component::SurfaceCaustics),
+            None
+        );
+        // The pool's water is water_photons' own; a glass ball beside it is not.
+        let pool = load("water_pool.toml");
+        assert_eq!(
+            info("water_photons").not_modelled(&pool, Component::SurfaceCaustics),
+            None
+        );
+        let mut with_ball = pool.clone();
+        with_ball.materials.push(ball.materials[0].clone());
+        let mut lens = ball.objects[0].clone();
+        lens.mesh
+            .materials
+            .iter_mut()
+            .for_each(|m| *m = with_ball.materials.len() as u32 - 1);
+        with_ball.objects.push(lens);
+        let reason = info("water_photons").not_modelled(&with_ball, Component::VolumeCaustics);
+        assert!(
+            reason
+                .as_deref()
+                .is_some_and(|r| r.contains("the water's caustics only")),
+            "{reason:?}"
+        );
     }
 }

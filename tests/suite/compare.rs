@@ -61,7 +61,7 @@ fn compare_writes_every_file_with_the_tests_numbers() {
         "--photons",
         "524288",
         "--techniques",
-        "direct,image_space,water_photons",
+        "direct,image_space,pinhole,water_photons",
         "--out",
         out.to_str().unwrap(),
     ]);
@@ -97,7 +97,7 @@ fn compare_writes_every_file_with_the_tests_numbers() {
         expected.push(format!("{stem}.png"));
     }
     let names: Vec<&str> = r.techniques.iter().map(|t| t.technique.as_str()).collect();
-    assert_eq!(names, ["direct", "image_space"]);
+    assert_eq!(names, ["direct", "image_space", "pinhole"]);
     for t in &r.techniques {
         let n = &t.technique;
         expected.extend([
@@ -113,8 +113,41 @@ fn compare_writes_every_file_with_the_tests_numbers() {
                 format!("{n}_{c}_flip.png"),
             ]);
         }
+        // Rendered and written, not scored: no FLIP map.
+        for c in &t.not_applicable {
+            let c = &c.component;
+            expected.extend([format!("{n}_{c}.exr"), format!("{n}_{c}.png")]);
+        }
         assert!(t.timing.frame_ms > 0.0 && !t.timing.passes_ms.is_empty());
     }
+    // pinhole renders reflection caustics only: the glass ball's are not
+    // its to score (issue 28).
+    let pinhole = r
+        .techniques
+        .iter()
+        .find(|t| t.technique == "pinhole")
+        .unwrap();
+    assert!(
+        pinhole
+            .components
+            .iter()
+            .all(|c| c.component != "surface_caustics"),
+        "{:?}",
+        pinhole.components
+    );
+    let na: Vec<&str> = pinhole
+        .not_applicable
+        .iter()
+        .map(|n| n.component.as_str())
+        .collect();
+    assert_eq!(na, ["surface_caustics"]);
+    let reason = &pinhole.not_applicable[0].reason;
+    assert!(
+        reason.contains("reflection caustics only") && reason.contains("`lens`"),
+        "{reason}"
+    );
+    let image_space_na = &r.techniques[1].not_applicable;
+    assert!(image_space_na.is_empty(), "{image_space_na:?}");
     let mut found: Vec<String> = std::fs::read_dir(&out)
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())
@@ -148,6 +181,10 @@ fn compare_writes_every_file_with_the_tests_numbers() {
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(
         md.contains(&format!("{:.4}", image_space.full.flip)),
+        "{md}"
+    );
+    assert!(
+        md.contains("| pinhole | surface_caustics | not applicable: pinhole renders reflection caustics only"),
         "{md}"
     );
 

@@ -103,7 +103,7 @@ mod tracer;
 
 pub use tracer::{BeamCounts, BeamTracer, GpuBeam};
 
-use super::{Technique, TechniqueBuild};
+use super::{CausticSources, Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::params::{ParamSet, Params};
 use crate::passes::airlight::{Airlight, AirlightParams};
@@ -188,6 +188,7 @@ impl TechniqueBuild for Beams {
         Component::VolumeCaustics,
         Component::Emitted,
     ];
+    const CAUSTIC_SOURCES: CausticSources = CausticSources::All;
     type Params = BeamsParams;
 
     /// Thin sheets and emissive surfaces are outside its model. Area lights

@@ -55,7 +55,7 @@
 //! any refractor, so two refractors one behind the other (with or without
 //! an opaque object between) share one back-face texture.
 
-use super::{Technique, TechniqueBuild};
+use super::{CausticSources, Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::params::{ParamSet, Params};
 use crate::passes::caustic_map::CausticMap;
@@ -113,6 +113,7 @@ impl TechniqueBuild for ImageSpace {
         Component::SurfaceCaustics,
         Component::Emitted,
     ];
+    const CAUSTIC_SOURCES: CausticSources = CausticSources::All;
     type Params = ImageSpaceParams;
 
     fn build(

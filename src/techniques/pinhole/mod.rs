@@ -56,7 +56,7 @@
 pub mod bindings;
 pub mod params;
 
-use super::{Technique, TechniqueBuild};
+use super::{CausticSources, Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::params::{ParamSet, Params};
 use crate::passes::camera_refraction::RefractionPush;
@@ -489,6 +489,7 @@ impl TechniqueBuild for Pinhole {
         Component::SurfaceCaustics,
         Component::Emitted,
     ];
+    const CAUSTIC_SOURCES: CausticSources = CausticSources::Reflection;
     type Params = PinholeParams;
 
     /// Thin sheets and emissive surfaces are outside its model.

@@ -90,7 +90,7 @@ mod lines;
 
 pub use lines::{GpuSegment, VolumeRays};
 
-use super::{Technique, TechniqueBuild};
+use super::{CausticSources, Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::params::{ParamSet, Params};
 use crate::passes::airlight::{Airlight, AirlightParams};
@@ -229,6 +229,7 @@ impl TechniqueBuild for VolumeLines {
         Component::VolumeCaustics,
         Component::Emitted,
     ];
+    const CAUSTIC_SOURCES: CausticSources = CausticSources::All;
     type Params = VolumeLinesParams;
 
     fn build(

@@ -157,7 +157,7 @@ pub use splat::{Composite, Splat};
 pub use trace::{GpuWaterPhoton, PhotonCounts, Trace, GUARD_PHOTONS, GUARD_WORD};
 pub use view::WaterView;
 
-use super::{Technique, TechniqueBuild};
+use super::{CausticSources, Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::gpu::GpuFrame;
 use crate::params::{ParamSet, Params};
@@ -441,6 +441,7 @@ impl TechniqueBuild for WaterPhotons {
         Component::SurfaceCaustics,
         Component::Emitted,
     ];
+    const CAUSTIC_SOURCES: CausticSources = CausticSources::Water;
     type Params = WaterPhotonsParams;
 
     fn build(
