@@ -39,6 +39,24 @@ pub struct ParamSpec {
     pub apply: Apply,
 }
 
+impl ParamSpec {
+    /// Whether `v` is a value of this parameter: finite, in [min, max],
+    /// whole when `integer`.
+    pub fn accepts(&self, v: f32) -> bool {
+        v.is_finite() && v >= self.min && v <= self.max && !(self.integer && v.fract() != 0.0)
+    }
+
+    /// What `accepts` asks, for error messages.
+    fn range_text(&self) -> String {
+        let kind = if self.integer {
+            "a whole number"
+        } else {
+            "a number"
+        };
+        format!("must be {kind} in [{}, {}]", self.min, self.max)
+    }
+}
+
 /// Parameter values by name, validated against a technique's specs: the
 /// untyped form the CLI and the overlay edit. A technique turns them into
 /// its typed struct with [`ParamSet::from_params`].
@@ -85,22 +103,30 @@ impl Params {
                 .trim()
                 .parse()
                 .map_err(|_| anyhow::anyhow!("--param {name}: {value:?} is not a number"))?;
-            if !v.is_finite() || v < spec.min || v > spec.max || (spec.integer && v.fract() != 0.0)
-            {
-                anyhow::bail!(
-                    "--param {name}={value}: must be {} in [{}, {}]",
-                    if spec.integer {
-                        "a whole number"
-                    } else {
-                        "a number"
-                    },
-                    spec.min,
-                    spec.max
-                );
+            if !spec.accepts(v) {
+                anyhow::bail!("--param {name}={value}: {}", spec.range_text());
             }
             values.insert(name.to_string(), v);
         }
         Ok(Params { values })
+    }
+
+    /// Sets the value of `spec`'s parameter (the overlay's sliders: a
+    /// typed value, validated as `resolve` validates, no "name=value"
+    /// string on the way); an error when these values were resolved
+    /// against other specs or `value` is out of its range.
+    pub fn set(&mut self, spec: &ParamSpec, value: f32) -> anyhow::Result<()> {
+        let slot = self.values.get_mut(spec.name).ok_or_else(|| {
+            anyhow::anyhow!(
+                "parameter `{}` has no value (resolved for another technique?)",
+                spec.name
+            )
+        })?;
+        if !spec.accepts(value) {
+            anyhow::bail!("parameter {} = {value}: {}", spec.name, spec.range_text());
+        }
+        *slot = value;
+        Ok(())
     }
 
     /// The value of `name`; an error (not a panic) when these values were
@@ -298,6 +324,24 @@ mod tests {
             "parameter `size` has no value (resolved for another technique?)"
         );
         assert_eq!(Outer::default(), Outer::parse("t", &[]).unwrap());
+    }
+
+    /// `set` takes a typed value with `resolve`'s checks.
+    #[test]
+    fn set_validates_like_resolve() {
+        let specs = Outer::specs();
+        let mut p = Params::resolve("t", specs, &[]).unwrap();
+        p.set(&specs[1], 1.5).unwrap();
+        assert_eq!(
+            p,
+            Params::resolve("t", specs, &["scale=1.5".into()]).unwrap()
+        );
+        let e = p.set(&specs[0], 2.5).unwrap_err().to_string();
+        assert_eq!(e, "parameter size = 2.5: must be a whole number in [1, 64]");
+        assert!(p.set(&specs[1], f32::NAN).is_err());
+        assert!(p.set(&specs[1], 3.0).is_err());
+        assert!(Params::default().set(&specs[1], 1.0).is_err());
+        assert_eq!(p.value("scale").unwrap(), 1.5);
     }
 
     #[test]

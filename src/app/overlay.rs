@@ -332,8 +332,9 @@ mod enabled {
         }
         if let Some(info) = TECHNIQUES.iter().find(|t| t.name == data.technique) {
             let current = pending.clone().unwrap_or_else(|| data.params.clone());
+            // The sliders edit typed values in a copy (`Params::set`).
+            let mut next = current.clone();
             let mut edited = false;
-            let mut values = Vec::new();
             for spec in info.params() {
                 // The values belong to this technique's specs; a
                 // missing one shows its default.
@@ -345,13 +346,12 @@ mod enabled {
                 if spec.integer {
                     slider = slider.integer();
                 }
-                edited |= ui.add(slider).on_hover_text(spec.description).changed();
-                values.push(format!("{}={}", spec.name, v));
+                if ui.add(slider).on_hover_text(spec.description).changed() {
+                    edited |= next.set(spec, v).is_ok();
+                }
             }
             if edited {
-                if let Ok(p) = Params::resolve(info.name, info.params(), &values) {
-                    *pending = Some(p);
-                }
+                *pending = Some(next);
             }
         }
         components(ui, data, actions);

@@ -394,16 +394,18 @@ pub fn create_named(
 mod auto_tests {
     use super::*;
 
+    /// A canonical scene of assets/scenes by file name.
+    fn load(name: &str) -> Scene {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("assets/scenes")
+            .join(name);
+        Scene::load(&path).unwrap()
+    }
+
     /// `--technique auto` on the canonical scenes: a medium, sunlit water,
     /// glass over a floor, reflectors under what only pinhole maps.
     #[test]
     fn auto_picks_by_what_the_scene_has() {
-        let load = |name: &str| {
-            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("assets/scenes")
-                .join(name);
-            Scene::load(&path).unwrap()
-        };
         assert_eq!(auto(&load("smoke.toml")), "volume_lines");
         assert_eq!(auto(&load("volume_cone.toml")), "volume_lines");
         assert_eq!(auto(&load("water_pool.toml")), "water_photons");
@@ -438,12 +440,6 @@ mod auto_tests {
     /// refraction, water_photons every specular object but the water.
     #[test]
     fn caustic_components_a_technique_does_not_model() {
-        let load = |name: &str| {
-            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("assets/scenes")
-                .join(name);
-            Scene::load(&path).unwrap()
-        };
         let info = |name| find(name).unwrap();
         let ball = load("ball_lens.toml");
         let reason = info("pinhole").not_modelled(&ball, Component::SurfaceCaustics);
