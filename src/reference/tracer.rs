@@ -290,8 +290,8 @@ impl Reference {
     /// Clears the sums and the aim guide (first pass); records it through the recorder.
     pub fn record_clear(&mut self, rec: &mut FrameRecorder) {
         rec.pass("reference clear").record(|c| {
-            for sums in [&self.total, &self.pass_sums, &self.moments, &self.aim_guide] {
-                c.fill(sums, 0);
+            for buffer in [&self.total, &self.pass_sums, &self.moments, &self.aim_guide] {
+                c.fill(buffer, 0);
             }
         });
         self.photons = 0;
