@@ -29,6 +29,14 @@ uint guide_photon_cell = 0u;
 float guide_photon_density = 1.0;
 bool photon_useful = false;
 
+// The point of the unit square an aimed photon of light l maps onto the
+// aimed region: drawn by the light's guide (and noted for its count), or u.
+vec2 aimed_square_point(uint l, bool guided, vec2 u) {
+    if (!guided) return u;
+    guide_light = l;
+    return guide_sample(l, u, guide_photon_cell, guide_photon_density);
+}
+
 // Adds a photon's contribution to pixel `pixel` of this pass's image
 // `component`, divided by the photons emitted this pass.
 void splat(ivec2 pixel, uint component, vec3 value) {
@@ -173,11 +181,6 @@ void emit(uint l, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) 
     vec3 aim_center = pc.aim.xyz;
     float aim_radius = pc.aim.w;
     bool guided = pc.aim_guide != 0u;
-    // An aimed photon's point of the square, drawn by the guide.
-    vec2 aimed_u = u;
-    if (guided && choice < pc.aim_share && aim_radius > 0.0) {
-        aimed_u = guide_sample(l, u, guide_photon_cell, guide_photon_density);
-    }
     if (kind == LIGHT_POINT || kind == LIGHT_SPOT) {
         origin = light.position.xyz;
         vec3 to_aim = aim_center - origin;
@@ -188,7 +191,7 @@ void emit(uint l, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) 
         float cos_aim = q > 0.0 ? sqrt(max(0.0, 1.0 - aim_radius * aim_radius / (d * d))) : 1.0;
         float cos_outer = light.direction.w;
         bool aimed = choice < q;
-        if (aimed) dir = uniform_cone(aimed_u, axis, cos_aim);
+        if (aimed) dir = uniform_cone(aimed_square_point(l, guided, u), axis, cos_aim);
         else if (kind == LIGHT_POINT) dir = uniform_sphere(u);
         else dir = uniform_cone(u, light.direction.xyz, cos_outer);
         float base_pdf = kind == LIGHT_POINT ? 1.0 / (4.0 * PI)
@@ -200,7 +203,6 @@ void emit(uint l, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) 
                 : guide_density(l, uniform_cone_coords(dir, axis, cos_aim));
             aim_pdf = g / (2.0 * PI * (1.0 - cos_aim));
         }
-        if (aimed && guided) guide_light = l;
         float pdf = (1.0 - q) * base_pdf + q * aim_pdf;
         float falloff = kind == LIGHT_POINT ? 1.0
             : spot_falloff(dot(dir, light.direction.xyz), cos_outer, light.intensity.w);
@@ -219,7 +221,7 @@ void emit(uint l, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) 
         bool aimed = choice < q;
         vec2 center = aimed ? aim_offset : vec2(0.0);
         float radius = aimed ? aim_radius : r;
-        vec2 v = aimed ? aimed_u : u;
+        vec2 v = aimed ? aimed_square_point(l, guided, u) : u;
         float rr = radius * sqrt(v.x);
         float phi = 2.0 * PI * v.y;
         vec2 p = center + vec2(rr * cos(phi), rr * sin(phi));
@@ -234,7 +236,6 @@ void emit(uint l, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) 
             float g = !guided ? 1.0 : aimed ? guide_photon_density : guide_density(l, disk_u);
             aim_pdf = g / (PI * aim_radius * aim_radius);
         }
-        if (aimed && guided) guide_light = l;
         float pdf = (1.0 - q) * base_pdf + q * aim_pdf;
         // Beyond the scene's disk nothing is reached: such a photon is wasted.
         flux = (pdf > 0.0 && base_pdf > 0.0) ? light.intensity.rgb / pdf : vec3(0.0);
