@@ -141,6 +141,11 @@ pub const SPECULAR_VIEW_CAMERA: u32 = 2;
 pub const TIR_SINGLE_REFRACTION: u32 = 0;
 pub const TIR_CLAMP_CRITICAL: u32 = 1;
 pub const TIR_REFLECT: u32 = 2;
+/// The second interface of what the camera sees through a closed
+/// dielectric (`camera_exit` parameter): traced through the BVH, or
+/// Wyman's two-sided image-space approximation.
+pub const CAMERA_EXIT_TRACED: u32 = 0;
+pub const CAMERA_EXIT_TWO_SIDED: u32 = 1;
 
 // Camera refraction (src/passes/camera_refraction.rs,
 // glsl/passes/camera_refraction.comp), descriptor set 1.

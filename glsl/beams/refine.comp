@@ -41,6 +41,7 @@
 #include "random.glsl"
 #include "medium.glsl"
 #include "beam.glsl"
+#include "traced_refraction.glsl"
 
 layout(local_size_x = BEAMS_REFINE_GROUP) in;
 
@@ -301,42 +302,6 @@ bool make_beam(vec3 p[3], vec3 d[3], float stop[3], vec3 flux, vec3 incident, fl
     beam.flux = vec4(flux, 0.0);
     beam.incident = vec4(incident, 0.0);
     return true;
-}
-
-// Two-sided refraction exactly through the BVH (BEAMS_REFRACTION_TRACED,
-// the issue's alternative to the light view's back faces): Snell into the
-// glass at p, then the ray inside to the next surface, refracted out, or
-// reflected where it meets total internal reflection (up to 8 times, the
-// light staying in the beam); Beer-Lambert over the path inside. The
-// Fresnel reflections inside are not followed (their light is lost, as
-// with the image-space exit). False where the ray does not leave.
-bool traced_refraction(vec3 d, vec3 p, vec3 n, float ior, vec3 absorption,
-                       out vec3 exit_p, out vec3 exit_d, out vec3 factor) {
-    exit_p = p;
-    exit_d = d;
-    factor = vec3(1.0);
-    vec3 dir;
-    if (!refract_dir(d, n, 1.0 / ior, dir)) return false;
-    vec3 x = p;
-    for (int i = 0; i < 8; ++i) {
-        float eps = 1e-4 * max(1.0, bvh_max_abs(x));
-        vec3 o = x + dir * eps;
-        Hit h;
-        if (!trace_closest(o, dir, 0.0, 1e30, h)) return false;
-        x = hit_position(h, o, dir);
-        factor *= exp(-absorption * (h.t + eps));
-        vec3 nn = hit_normal(h);
-        if (dot(nn, dir) > 0.0) nn = -nn;
-        vec3 out_dir;
-        if (refract_dir(dir, nn, ior, out_dir)) {
-            factor *= 1.0 - fresnel_dielectric(-dot(dir, nn), ior);
-            exit_p = x;
-            exit_d = out_dir;
-            return true;
-        }
-        dir = reflect(dir, nn);
-    }
-    return false;
 }
 
 // Criterion (b): the smallest |A(y)| over [0, y_max] against |A(0)|.

@@ -25,6 +25,13 @@
 // Beer-Lambert attenuates it over the path t inside the medium. The
 // opaque frame holds L(x) as radiance of the surface (albedo/pi E), the
 // medium around the receiver being the refractor's.
+// With `camera_exit` 0 (CAMERA_EXIT_TRACED, the default) p2, T2, the path
+// inside and T2 = 1 - F2 come from the refracted ray traced through the
+// BVH instead (glsl/common/traced_refraction.glsl, the exact interface
+// that the approximation stands in for; total internal reflections
+// followed): near a sphere's silhouette Wyman's d~ and back-face normal
+// send the rim's rays to the wrong floor (+23% of the direct light seen
+// through `ball_lens_top`'s ball, BENCHMARKS.md "Where users look").
 // Mirror at p1: L = reflectance * L(p1, R).
 // L(o, d): the image-space search of the opaque frame (below), the fast
 // path; where it finds nothing (the ray leaves the view, or passes only
@@ -38,6 +45,7 @@
 #include "bvh.glsl"
 #include "lights.glsl"
 #include "random.glsl"
+#include "traced_refraction.glsl"
 #include "medium.glsl"
 #include "traced_direct.glsl"
 
@@ -55,7 +63,7 @@ layout(push_constant) uniform Push {
     uint tir_remedy;   // TIR_*
     uint use_eq632;    // 1: Eq. 6.3.2 where the back-face texel is empty
     uint search_steps; // linear steps of the image-space search
-    uint pad;
+    uint exit;         // CAMERA_EXIT_*: the second interface traced or Wyman's
 } pc;
 
 const int BISECTIONS = 10;
@@ -289,11 +297,18 @@ void main() {
                 rays[count++] = SecondaryRay(p1, t1, vec3((1.0 - f1) / (ior * ior)), true);
             }
         } else {
-            float d_v = bp.w >= 0.0 ? max(length(bp.xyz - p1), 0.0) : 0.0;
-            TwoSidedExit e;
-            if (two_sided_refraction(v, p1, n1, ior, d_v, fp.w, pc.tir_remedy, pc.use_eq632 != 0u, e)) {
-                vec3 absorbed = exp(-sigma_a * e.dist);
-                rays[count++] = SecondaryRay(e.p2, e.dir, (1.0 - f1) * e.transmit * absorbed, false);
+            vec3 exit_p, exit_d, through;
+            if (pc.exit == CAMERA_EXIT_TRACED) {
+                if (traced_refraction(v, p1, n1, ior, sigma_a, exit_p, exit_d, through)) {
+                    rays[count++] = SecondaryRay(exit_p, exit_d, (1.0 - f1) * through, false);
+                }
+            } else {
+                float d_v = bp.w >= 0.0 ? max(length(bp.xyz - p1), 0.0) : 0.0;
+                TwoSidedExit e;
+                if (two_sided_refraction(v, p1, n1, ior, d_v, fp.w, pc.tir_remedy, pc.use_eq632 != 0u, e)) {
+                    vec3 absorbed = exp(-sigma_a * e.dist);
+                    rays[count++] = SecondaryRay(e.p2, e.dir, (1.0 - f1) * e.transmit * absorbed, false);
+                }
             }
         }
     }

@@ -4,8 +4,10 @@
 //! "refractor gbuffer": the camera's specular G-buffer
 //! (`passes::specular_gbuffer`: nearest front faces with d_N, farthest back
 //! faces); "refraction" (glsl/passes/camera_refraction.comp): per pixel,
-//! Fresnel-weighted reflection plus the twice-refracted ray, each found in
-//! the opaque frame by an image-space search, into the frame's radiance.
+//! Fresnel-weighted reflection plus the twice-refracted ray (its exit traced
+//! through the BVH, or Wyman's approximation: `RefractionPush::exit`), each
+//! found in the opaque frame by an image-space search, into the frame's
+//! radiance.
 
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::passes::gbuffer::GBuffer;
@@ -28,7 +30,8 @@ pub struct RefractionPush {
     pub use_eq632: u32,
     /// Linear steps of the image-space search.
     pub search_steps: u32,
-    pub pad: u32,
+    /// `CAMERA_EXIT_*`: the second interface of a closed dielectric.
+    pub exit: u32,
 }
 
 pub struct CameraRefraction {

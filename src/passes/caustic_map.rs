@@ -143,6 +143,8 @@ crate::declare_params! {
             "total internal reflection at the approximated exit (Wyman 2006's ad hoc remedies; camera and photon_mode 1): 0 single refraction (T2 = T1), 1 clamp to the critical angle (T2 tangent to the back face), 2 reflect and ignore the refractor. Default 1, of the two Wyman recommends (the first 'behaves poorly in dynamic scenes'): a reflected ray heads back toward the camera or the light, where the image-space search has no data and photons fly up past the light, while the clamped ray goes on through, as the light does on average";
         eq_6_3_2: u32 [0, 1] = 1, rebuild,
             "1: where d~ overshoots and the back-face texel holds no normal, use Wyman's Eq. 6.3.2 (N2 = T1 - (V.T1) V, the exit through the side); 0: drop the transmitted light there";
+        camera_exit: u32 [0, 1] = 0, rebuild,
+            "what the camera sees through closed glass: 0 the refracted ray traced through the BVH to its exit (exact, total internal reflections followed); 1 Wyman's two-sided image-space exit (Eq. 6.3.1 distance, back-face normals; approximate, it sends rays near the silhouette to the wrong place)";
         search_steps: u32 [4, 256] = 32, live,
             "linear steps of the image-space search of refracted and reflected camera rays against the opaque frame (then 10 bisections)";
         caustics_on_change: bool [0, 1] = 0, live,
@@ -157,7 +159,7 @@ impl ImageSpaceParams {
             tir_remedy: self.tir_remedy,
             use_eq632: self.eq_6_3_2,
             search_steps: self.search_steps,
-            pad: 0,
+            exit: self.camera_exit,
         }
     }
 

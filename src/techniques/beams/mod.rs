@@ -155,6 +155,8 @@ crate::declare_params! {
             "total internal reflection at the approximated exit of two-sided refraction (as image_space's): 0 single refraction, 1 clamp to the critical angle, 2 reflect";
         eq_6_3_2: u32 [0, 1] = 1, rebuild,
             "1: a missing back-face normal at the exit is replaced by Wyman's Eq. 6.3.2";
+        camera_exit: u32 [0, 1] = 0, rebuild,
+            "what the camera sees through closed glass: 0 the refracted ray traced through the BVH to its exit (exact, total internal reflections followed); 1 Wyman's two-sided image-space exit (Eq. 6.3.1 distance, back-face normals; approximate, it sends rays near the silhouette to the wrong place)";
         search_steps: u32 [4, 256] = 32, rebuild,
             "linear steps of the camera refraction's image-space search (what the camera sees through glass)";
         beam_capacity: u32 [1024, 4194304] = 262144, rebuild,
@@ -221,7 +223,7 @@ impl TechniqueBuild for Beams {
                 tir_remedy: params.tir_remedy,
                 use_eq632: params.eq_6_3_2,
                 search_steps: params.search_steps,
-                pad: 0,
+                exit: params.camera_exit,
             },
         )?;
         let light_views = LightViews::new(ctx, scene, scene_gpu, params.light_view_size)?;

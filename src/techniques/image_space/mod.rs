@@ -11,7 +11,11 @@
 //!    (`passes::specular_gbuffer`: nearest front faces with the per-vertex
 //!    d_N interpolated, farthest back faces: Wyman's preferred second
 //!    interface for non-convex refractors); per pixel, Snell at the front
-//!    (T1), d_V from the back-face depth, d~ by Eq. 6.3.1, p2 = p1 + d~ T1,
+//!    (T1), then the exit: by default (`camera_exit` 0) T1 traced through
+//!    the BVH to the true second interface (a hybrid: Wyman's exit errs
+//!    near silhouettes, docs/architecture/techniques.md); with
+//!    `camera_exit` 1 Wyman's: d_V from the back-face depth, d~ by Eq.
+//!    6.3.1, p2 = p1 + d~ T1,
 //!    N2 from the back-face normal texture at p2's projection (Eq. 6.3.2
 //!    where the texel is empty), Snell again (T2) with the selected TIR
 //!    remedy; T2 and the Fresnel reflection ray are searched in the opaque

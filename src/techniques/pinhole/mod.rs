@@ -170,7 +170,7 @@ impl Pinhole {
                 tir_remedy: sb::TIR_CLAMP_CRITICAL,
                 use_eq632: 1,
                 search_steps: params.search_steps,
-                pad: 0,
+                exit: sb::CAMERA_EXIT_TRACED,
             },
         )?;
         let n = params.samples;

@@ -311,7 +311,7 @@ impl WaterPhotons {
                 tir_remedy: b::TIR_CLAMP_CRITICAL,
                 use_eq632: 1,
                 search_steps: params.search_steps,
-                pad: 0,
+                exit: b::CAMERA_EXIT_TRACED,
             },
         )?;
         let params_buffer = WpParamsBuffer(Buffer::new(
