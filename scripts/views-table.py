@@ -15,12 +15,13 @@ change to a technique traces nothing.
 
 A cell is `energy / FLIP` (energy: relative total, FLIP: LDR-FLIP mean);
 `n/a` where the technique does not model the component on this scene
-(`compare`'s "not applicable": its full frame is then marked `partial`,
-scored against a reference that holds light the technique leaves out);
-`-` where neither image holds any light (a scene without media has no
-airlight). The frame cell is bold where it meets issue #28's goal: FLIP
-at most 0.10 and energy within 5%. The table goes to stdout and to
-OUT/table.md.
+(`compare`'s "not applicable": it renders the component only in part, or
+not at all while the reference has light there); `-` where neither image
+holds any light (a scene without media has no airlight). `frame`: the
+full frame against the reference's; `modelled`: with components not
+applicable, both frames without them (`=`: the same as the frame), bold
+where it meets issue #28's goal, FLIP at most 0.10 and energy within 5%.
+The table goes to stdout and to OUT/table.md.
 """
 import argparse
 import json
@@ -96,13 +97,13 @@ def rows(label, report):
                 cells.append("-")
             else:
                 cells.append(cell(comps[c]))
-        full = cell(t["full"])
-        if na:
-            full += " (partial)"
-        elif t["full"]["flip"] <= GOAL_FLIP and abs(t["full"]["energy"]) <= GOAL_ENERGY:
-            full = f"**{full}**"
+        modelled = t.get("modelled") or t["full"]
+        claimed = cell(modelled) if t.get("modelled") else "="
+        if modelled["flip"] <= GOAL_FLIP and abs(modelled["energy"]) <= GOAL_ENERGY:
+            claimed = f"**{claimed}**"
         ms = t["timing"]["frame_ms"]
-        yield f"| `{label}` | {t['technique']} | " + " | ".join(cells) + f" | {full} | {noise} | {ms:.0f} |"
+        yield (f"| `{label}` | {t['technique']} | " + " | ".join(cells)
+               + f" | {cell(t['full'])} | {claimed} | {noise} | {ms:.0f} |")
 
 
 def main():
@@ -120,8 +121,8 @@ def main():
     header = [
         f"{args.size}², reference {args.photons} photons; cells: energy / FLIP against the reference's matching component",
         "",
-        "| view | technique | direct | surface caustics | airlight | volume caustics | frame | reference noise (FLIP) | ms/frame |",
-        "| --- | --- | --- | --- | --- | --- | --- | ---: | ---: |",
+        "| view | technique | direct | surface caustics | airlight | volume caustics | frame | modelled | reference noise (FLIP) | ms/frame |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | ---: | ---: |",
     ]
     lines = list(header)
     for label, scene, camera in VIEWS:

@@ -24,7 +24,11 @@
 // index n; crossing into air (index 1) it becomes (1 - F1) L (1/n)^2, and
 // Beer-Lambert attenuates it over the path t inside the medium. The
 // opaque frame holds L(x) as radiance of the surface (albedo/pi E), the
-// medium around the receiver being the refractor's.
+// medium around the receiver being the refractor's. A camera under the
+// sheet (its outward normal facing away; the specular G-buffer keeps the
+// face for the camera) sees L = F1 exp(-sigma_a t) L(x_R) + (1 - F1) n^2
+// L(x, T1), F1 and T1 for light entering the medium (total reflection past
+// the critical angle: Snell's window), the reflected leg inside it.
 // With `camera_exit` 0 (CAMERA_EXIT_TRACED, the default) p2, T2, the path
 // inside and T2 = 1 - F2 come from the refracted ray traced through the
 // BVH instead (glsl/common/traced_refraction.glsl, the exact interface
@@ -273,7 +277,12 @@ void main() {
     vec3 p1 = fp.xyz;
     vec3 v = normalize(p1 - frame.eye.xyz);
     vec3 n1 = normalize(fn.xyz);
-    if (dot(n1, v) > 0.0) n1 = -n1;
+    // The camera on the inside of an open sheet (under the water): its
+    // outward normal faces away. (Where the smooth normal's facing
+    // disagrees with the face's, at grazing angles, both sides reflect
+    // almost everything: F1 -> 1 outside, total reflection inside.)
+    bool inside = dot(n1, v) > 0.0;
+    if (inside) n1 = -n1;
     // The reflected ray starts on the surface; the opaque frame holds no
     // specular surface, so only the start's own pixel could be met early,
     // and its opaque surface lies behind p1.
@@ -283,20 +292,28 @@ void main() {
     vec3 sigma_a = materials[m].absorption_ior.rgb;
     if (material_kind(m) != MATERIAL_MIRROR) {
         float ior = materials[m].absorption_ior.w;
-        float f1 = fresnel_dielectric(-dot(v, n1), 1.0 / ior);
-        rays[0].weight = vec3(f1);
         // d_V: front to the farthest back face along this pixel's ray; a
         // sheet with no back face here has no thickness.
         vec4 bp = imageLoad(back_position, p);
         if (bp.w < 0.0 && fp.w <= 0.0) {
             // One interface (no back face here and no d_N: an open sheet,
             // see the header). Eq. 6.3.2 stays for closed objects whose
-            // back-face texel at p2 is empty (d_N > 0 there).
+            // back-face texel at p2 is empty (d_N > 0 there). From the
+            // inside the light enters the medium: eta = n, total
+            // reflection past the critical angle, and radiance gains n^2
+            // (L/n^2 conserved); the reflected ray stays in the medium
+            // (absorbing), the refracted one leaves it.
+            float eta = inside ? ior : 1.0 / ior;
+            float f1 = fresnel_dielectric(-dot(v, n1), eta);
+            rays[0].weight = vec3(f1);
+            rays[0].absorbing = inside;
             vec3 t1;
-            if (refract_dir(v, n1, 1.0 / ior, t1)) {
-                rays[count++] = SecondaryRay(p1, t1, vec3((1.0 - f1) / (ior * ior)), true);
+            if (refract_dir(v, n1, eta, t1)) {
+                rays[count++] = SecondaryRay(p1, t1, vec3((1.0 - f1) * eta * eta), !inside);
             }
         } else {
+            float f1 = fresnel_dielectric(-dot(v, n1), 1.0 / ior);
+            rays[0].weight = vec3(f1);
             vec3 exit_p, exit_d, through;
             if (pc.exit == CAMERA_EXIT_TRACED) {
                 if (traced_refraction(v, p1, n1, ior, sigma_a, exit_p, exit_d, through)) {

@@ -1,8 +1,9 @@
 #version 460
 // Specular G-buffer, fragment stage. Front pass: the nearest specular
 // surface (dielectric faces whose winding normal faces the viewer; mirrors
-// from either side). Back pass: the farthest dielectric face turned away
-// from the viewer (reversed depth, see the vertex stage). Stores world
+// and, in the camera's view, open sheets from either side). Back pass: the
+// farthest dielectric face turned away from the viewer (reversed depth,
+// see the vertex stage; not an open sheet's in the camera's view). Stores world
 // position with the interpolated d_N in w (clear value -1: not covered) and
 // the smooth outward normal with the material index in w.
 // Diffuse geometry occludes in the front pass: it writes its depth and
@@ -42,9 +43,15 @@ void main() {
     vec3 ray = view == SHADOW_PLANAR ? pc.forward.xyz
              : v_position - (view == SPECULAR_VIEW_CAMERA ? frame.eye.xyz : pc.origin.xyz);
     bool facing_viewer = dot(v_geometric, ray) < 0.0;
+    // An open sheet (a water surface: d_N = 0 at its corners, the
+    // thickness ray met nothing of the object) has one interface, and the
+    // camera may be on either side of it: seen from below, its face turned
+    // away is the camera's nearest specular surface (camera_refraction.comp
+    // refracts it from the inside), never a second interface.
+    bool camera_sheet = view == SPECULAR_VIEW_CAMERA && v_normal.w <= 0.0;
     if (back_pass) {
-        if (kind != MATERIAL_DIELECTRIC || facing_viewer) discard;
-    } else if (kind == MATERIAL_DIELECTRIC && !facing_viewer) {
+        if (kind != MATERIAL_DIELECTRIC || facing_viewer || camera_sheet) discard;
+    } else if (kind == MATERIAL_DIELECTRIC && !facing_viewer && !camera_sheet) {
         discard;
     }
     out_position = vec4(v_position, back_pass ? 0.0 : max(v_normal.w, 0.0));

@@ -6,6 +6,9 @@
 // other specular surfaces and every other pixel; here the water's pixels
 // are recomputed:
 //   L = F1 L(x_R) + (1 − F1)/n² exp(−σ_a t) L(x_T)
+// (from under the water: F1 exp(−σ_a t) L(x_R) + (1 − F1) n² L(x_T), F1
+// and x_T for light entering the water, total reflection outside Snell's
+// window)
 // (GUIDE §2: radiance leaving the water keeps L/n², times the Fresnel
 // transmittance; glsl/passes/camera_refraction.comp derives it), with x_R and
 // x_T the first hits of the reflected and refracted camera rays in the BVH
@@ -204,16 +207,23 @@ void main() {
     vec3 p1 = fp.xyz;
     vec3 v = normalize(p1 - frame.eye.xyz);
     vec3 n1 = normalize(fn.xyz);
-    if (dot(n1, v) > 0.0) n1 = -n1;
+    // Under the water the camera sees the surface's face turned away
+    // (camera_refraction.comp): light enters the water, eta = n, Snell's
+    // window and total reflection outside it, radiance times n^2; the
+    // reflected leg runs in the water, the refracted one in air.
+    bool inside = dot(n1, v) > 0.0;
+    if (inside) n1 = -n1;
     float ior = materials[m].absorption_ior.w;
+    float eta = inside ? ior : 1.0 / ior;
     vec3 sigma_a = materials[m].absorption_ior.rgb;
-    float f1 = fresnel_dielectric(-dot(v, n1), 1.0 / ior);
+    float f1 = fresnel_dielectric(-dot(v, n1), eta);
     float t;
     vec3 l = f1 * radiance_along(offset_along(p1, n1), reflect(v, n1), t);
+    if (inside) l *= exp(-sigma_a * t);
     vec3 t1;
-    if (refract_dir(v, n1, 1.0 / ior, t1)) {
+    if (refract_dir(v, n1, eta, t1)) {
         vec3 behind = radiance_along(offset_along(p1, -n1), t1, t);
-        l += (1.0 - f1) / (ior * ior) * exp(-sigma_a * t) * behind;
+        l += (1.0 - f1) * eta * eta * (inside ? vec3(1.0) : exp(-sigma_a * t)) * behind;
     }
     imageStore(radiance, p, vec4(l, 1.0));
 }

@@ -193,6 +193,14 @@ pub fn compare(args: CompareArgs) -> anyhow::Result<()> {
         for n in &t.not_applicable {
             println!("{:<16} {}: not applicable ({})", "", n.component, n.reason);
         }
+        if let Some(m) = &t.modelled {
+            println!(
+                "{:<16} modelled components: FLIP {:.4}  energy {}",
+                "",
+                m.flip,
+                signed_percent(m.energy)
+            );
+        }
     }
     for s in &report.skipped {
         println!("{:<16} skipped: {}", s.technique, s.reason);

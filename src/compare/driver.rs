@@ -302,6 +302,9 @@ pub fn judge_technique(
     // the timed frames need; a separate warm-up frame only without them.
     let mut components = Vec::new();
     let mut not_applicable = Vec::new();
+    // The technique's own images of the components it is not scored on,
+    // taken out of its frame for the `modelled` comparison.
+    let mut unscored_images = Vec::new();
     for &c in info.components {
         r.scene_gpu.components = c.mask();
         r.render_frame(time)?;
@@ -315,6 +318,7 @@ pub fn judge_technique(
                 component: c.name().into(),
                 reason,
             });
+            unscored_images.push(img);
             continue;
         }
         let (m, cmap) = metrics::compare(&img, truth, width, height, exposure);
@@ -323,6 +327,17 @@ pub fn judge_technique(
             component: c.name().into(),
             metrics: m,
         });
+    }
+    // Light of the reference in components the technique has no image of
+    // (image_space's airlight in fog, every technique's `other`: multiple
+    // scattering in media).
+    for (c, truth) in &reference.components {
+        if !info.components.contains(c) && holds_light(truth, &reference.all) {
+            not_applicable.push(NotApplicable {
+                component: c.name().into(),
+                reason: format!("{name} does not render {}", c.name()),
+            });
+        }
     }
     r.scene_gpu.components = Component::All.mask();
     if info.components.is_empty() {
@@ -342,6 +357,17 @@ pub fn judge_technique(
     let image = r.radiance()?;
     drop(r);
     let (full, map) = metrics::compare(&image, &reference.all, width, height, exposure);
+    // Both frames without the components not scored: what the technique
+    // claims to render, against the reference's matching components.
+    let modelled = (!not_applicable.is_empty()).then(|| {
+        let unscored_truth = not_applicable.iter().filter_map(|n| {
+            let c = Component::parse(&n.component).ok()?;
+            reference.component(c)
+        });
+        let ours = without(&image, unscored_images.iter().map(Vec::as_slice));
+        let truth = without(&reference.all, unscored_truth);
+        metrics::compare(&ours, &truth, width, height, exposure).0
+    });
     sink.radiance(name, &image)?;
     sink.flip_map(&format!("{name}_flip"), &map)?;
     let result = TechniqueResult {
@@ -349,6 +375,7 @@ pub fn judge_technique(
         params: params.iter().map(|(k, v)| (k.clone(), *v)).collect(),
         timing,
         full,
+        modelled,
         components,
         not_applicable,
     };
@@ -358,6 +385,26 @@ pub fn judge_technique(
         map,
         timing_source,
     }))
+}
+
+/// Whether a reference component holds more than 0.1% of the frame's
+/// light (a scene without media has exactly none in airlight; the noise
+/// of a few stray paths is not a component to claim).
+fn holds_light(component: &[f32], all: &[f32]) -> bool {
+    metrics::energy(component) > 1e-3 * metrics::energy(all)
+}
+
+/// `frame` less each of `parts` (RGBA, the rgb channels; alpha kept).
+fn without<'a>(frame: &[f32], parts: impl Iterator<Item = &'a [f32]>) -> Vec<f32> {
+    let mut out = frame.to_vec();
+    for part in parts {
+        for (i, (o, p)) in out.iter_mut().zip(part).enumerate() {
+            if i % 4 != 3 {
+                *o -= p;
+            }
+        }
+    }
+    out
 }
 
 /// The component a live frame shows when it draws the components `mask`:

@@ -75,11 +75,19 @@ pub struct TechniqueResult {
     pub timing: Timing,
     /// The full frame against the reference's full frame.
     pub full: Metrics,
+    /// With components not applicable: the frame less the technique's own
+    /// images of them, against the reference's frame less its images of
+    /// them (what the technique claims to render against the matching
+    /// components). None where every component is scored.
+    #[serde(default)]
+    pub modelled: Option<Metrics>,
     /// Each component the technique renders against the reference's
     /// matching path-type component (none with a `--reference` file).
     pub components: Vec<ComponentResult>,
-    /// Its components the scene has more of than the technique models
-    /// (`TechniqueInfo::not_modelled`), not scored.
+    /// Components not scored: those the scene has more of than the
+    /// technique models (`TechniqueInfo::not_modelled`; their images are
+    /// written), and those of the reference's that hold light and the
+    /// technique does not render at all.
     #[serde(default)]
     pub not_applicable: Vec<NotApplicable>,
 }
@@ -162,6 +170,9 @@ impl CompareReport {
                 )
             };
             md += &row("full frame", &t.full);
+            if let Some(m) = &t.modelled {
+                md += &row("modelled components", m);
+            }
             for c in &t.components {
                 md += &row(&c.component, &c.metrics);
             }

@@ -129,6 +129,9 @@ pub enum CausticSources {
     Reflection,
     /// The surfaces of `water` objects only.
     Water,
+    /// Mirrors and closed dielectrics, reflected and refracted; not the
+    /// single interface of an open water surface.
+    Solids,
     /// Every mirror and dielectric, reflected and refracted.
     All,
 }
@@ -198,6 +201,9 @@ impl TechniqueInfo {
                     }
                     CausticSources::Water if specular && o.water.is_none() => {
                         Some("renders the water's caustics only".to_string())
+                    }
+                    CausticSources::Solids if o.water.is_some() => {
+                        Some("renders no caustics of open water surfaces".to_string())
                     }
                     _ => None,
                 };
@@ -463,8 +469,16 @@ mod auto_tests {
             info("pinhole").not_modelled(&ring, Component::SurfaceCaustics),
             None
         );
-        // The pool's water is water_photons' own; a glass ball beside it is not.
+        // The pool's water is water_photons' own; a glass ball beside it is
+        // not. beams' two-sided beams have no open surface's caustics.
         let pool = load("water_pool.toml");
+        let reason = info("beams").not_modelled(&pool, Component::SurfaceCaustics);
+        assert!(
+            reason
+                .as_deref()
+                .is_some_and(|r| r.contains("open water") && r.contains("`water`")),
+            "{reason:?}"
+        );
         assert_eq!(
             info("water_photons").not_modelled(&pool, Component::SurfaceCaustics),
             None

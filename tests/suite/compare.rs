@@ -9,6 +9,7 @@
 use caustics::compare::metrics;
 use caustics::compare::report::CompareReport;
 use caustics::output::read_exr;
+use caustics::reference::Component;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -113,10 +114,14 @@ fn compare_writes_every_file_with_the_tests_numbers() {
                 format!("{n}_{c}_flip.png"),
             ]);
         }
-        // Rendered and written, not scored: no FLIP map.
+        // Rendered and written, not scored: no FLIP map (a component the
+        // technique does not render has no image).
+        let renders = caustics::techniques::find(n).unwrap().components;
         for c in &t.not_applicable {
-            let c = &c.component;
-            expected.extend([format!("{n}_{c}.exr"), format!("{n}_{c}.png")]);
+            if renders.contains(&Component::parse(&c.component).unwrap()) {
+                let c = &c.component;
+                expected.extend([format!("{n}_{c}.exr"), format!("{n}_{c}.png")]);
+            }
         }
         assert!(t.timing.frame_ms > 0.0 && !t.timing.passes_ms.is_empty());
     }
@@ -148,6 +153,16 @@ fn compare_writes_every_file_with_the_tests_numbers() {
     );
     let image_space_na = &r.techniques[1].not_applicable;
     assert!(image_space_na.is_empty(), "{image_space_na:?}");
+    assert!(r.techniques[1].modelled.is_none(), "every component scored");
+    // `direct` renders no caustics, and the reference has them.
+    let direct = &r.techniques[0];
+    let na: Vec<&str> = direct
+        .not_applicable
+        .iter()
+        .map(|n| n.component.as_str())
+        .collect();
+    assert_eq!(na, ["surface_caustics"]);
+    assert!(direct.not_applicable[0].reason.contains("does not render"));
     let mut found: Vec<String> = std::fs::read_dir(&out)
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())
@@ -178,6 +193,23 @@ fn compare_writes_every_file_with_the_tests_numbers() {
     assert_eq!(m, caustics_result.metrics);
     let (m, _) = metrics::compare(&exr("image_space"), &exr("reference"), 64, 64, r.exposure);
     assert_eq!(m, image_space.full);
+    // pinhole's modelled components: its frame less its surface caustics
+    // against the reference's less its own.
+    let less = |a: Vec<f32>, b: Vec<f32>| -> Vec<f32> {
+        a.iter()
+            .zip(&b)
+            .enumerate()
+            .map(|(i, (x, y))| if i % 4 == 3 { *x } else { x - y })
+            .collect()
+    };
+    let (m, _) = metrics::compare(
+        &less(exr("pinhole"), exr("pinhole_surface_caustics")),
+        &less(exr("reference"), exr("reference_surface_caustics")),
+        64,
+        64,
+        r.exposure,
+    );
+    assert_eq!(Some(m), pinhole.modelled);
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(
         md.contains(&format!("{:.4}", image_space.full.flip)),
@@ -187,6 +219,7 @@ fn compare_writes_every_file_with_the_tests_numbers() {
         md.contains("| pinhole | surface_caustics | not applicable: pinhole renders reflection caustics only"),
         "{md}"
     );
+    assert!(md.contains("| pinhole | modelled components |"), "{md}");
 
     // The same reference again comes from the cache, bit for bit.
     let again = root.join("again");

@@ -190,7 +190,10 @@ impl TechniqueBuild for Beams {
         Component::VolumeCaustics,
         Component::Emitted,
     ];
-    const CAUSTIC_SOURCES: CausticSources = CausticSources::All;
+    /// On `water_pool` it draws 0.1% of the water's surface caustics
+    /// (BENCHMARKS.md, "Where users look"): its beams are the light view's
+    /// closed refractors' (two-sided refraction, Sect. 6).
+    const CAUSTIC_SOURCES: CausticSources = CausticSources::Solids;
     type Params = BeamsParams;
 
     /// Thin sheets and emissive surfaces are outside its model. Area lights
