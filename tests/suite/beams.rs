@@ -1200,13 +1200,6 @@ fn hit_on_object(
     None
 }
 
-/// Snell refraction of unit d at unit n (facing d), eta = n_i / n_t.
-fn refract(d: DVec3, n: DVec3, eta: f64) -> Option<DVec3> {
-    let c = -d.dot(n);
-    let k = 1.0 - eta * eta * (1.0 - c * c);
-    (k >= 0.0).then(|| eta * d + (eta * c - k.sqrt()) * n)
-}
-
 /// Multiple bounces (Sect. 6) on the periscope with absorbing glass (0.3
 /// /m): every child beam carries its parent's flux (no medium: what
 /// arrives is what the parent carries) times what the surface it came off

@@ -242,22 +242,14 @@ fn slab_head_on_transmits_fresnel_and_beer_lambert() {
 
 // --- (b') a sphere lens: the exit traced --------------------------------------
 
-/// Snell's refraction of the unit direction `d` at a surface whose unit
-/// normal `n` faces against `d`, `eta` = n_incident / n_transmitted; None
-/// under total internal reflection.
-fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
-    let cos_i = -d.dot(n);
-    let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-    (k >= 0.0).then(|| eta * d + (eta * cos_i - k.sqrt()) * n)
-}
-
 /// A glass ball (IOR 1.5, 64-segment mesh) over a floor lit straight down,
 /// against the analytic sphere: each pixel's ray refracts into the sphere,
 /// crosses it and refracts out with the same angle (so F2 = F1), and
 ///   L = F1 L(R) + (1 - F1)^2 L(T2 from p2),
 /// L(ray) the floor's radiance where the ray meets it (the opaque frame
-/// there, as the slab's L_behind), 0 where it misses (black environment). With the exit traced
-/// (`camera_exit=0`, the default) the view through the ball follows these
+/// there, as the slab's L_behind), 0 where it misses (black environment).
+/// With the exit traced (`camera_exit=0`, the default) the view through
+/// the ball follows these
 /// paths; Wyman's two-sided exit (`camera_exit=1`) approximates them and
 /// is printed beside it. Left out: rays within 3% of R of the silhouette
 /// (the mesh against the analytic sphere), and rays meeting the floor
@@ -310,6 +302,11 @@ fn traced_exit_follows_the_sphere_lens() {
         }
         Some(behind[4 * (q.y as u32 * SIZE + q.x as u32) as usize])
     };
+    let snell = |d: Vec3, n: Vec3, eta: f32| {
+        refract(d.as_dvec3(), n.as_dvec3(), eta as f64)
+            .unwrap()
+            .as_vec3()
+    };
     let mut lines = Vec::new();
     for (exit, f) in &frames {
         let (mut n, mut within, mut got_sum, mut expected_sum) = (0, 0, 0.0f64, 0.0f64);
@@ -325,10 +322,10 @@ fn traced_exit_follows_the_sphere_lens() {
                 let p1 = o + t1 * d;
                 let n1 = (p1 - CENTRE) / RADIUS;
                 let f1 = fresnel_dielectric(-d.dot(n1), 1.0 / IOR);
-                let inside = refract(d, n1, 1.0 / IOR).unwrap();
+                let inside = snell(d, n1, 1.0 / IOR);
                 let p2 = p1 - 2.0 * (p1 - CENTRE).dot(inside) * inside;
                 let n2 = (p2 - CENTRE) / RADIUS;
-                let out = refract(inside, -n2, IOR).unwrap();
+                let out = snell(inside, -n2, IOR);
                 let (Some(reflected), Some(through)) =
                     (floor(p1, d - 2.0 * d.dot(n1) * n1), floor(p2, out))
                 else {

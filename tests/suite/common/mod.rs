@@ -418,6 +418,15 @@ pub fn hg_phase(cos: f64, g: f64) -> f64 {
     (1.0 - g * g) / (4.0 * std::f64::consts::PI * denom * denom.sqrt())
 }
 
+/// Snell refraction of the unit direction `d` at a surface whose unit
+/// normal `n` faces against `d`, `eta` = n_incident / n_transmitted; None
+/// under total internal reflection.
+pub fn refract(d: glam::DVec3, n: glam::DVec3, eta: f64) -> Option<glam::DVec3> {
+    let c = -d.dot(n);
+    let k = 1.0 - eta * eta * (1.0 - c * c);
+    (k >= 0.0).then(|| eta * d + (eta * c - k.sqrt()) * n)
+}
+
 /// Length of the segment a -> b inside the axis-aligned box [lo, hi].
 pub fn length_in_box(a: glam::DVec3, b: glam::DVec3, lo: glam::DVec3, hi: glam::DVec3) -> f64 {
     let d = b - a;
