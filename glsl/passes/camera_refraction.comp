@@ -72,18 +72,7 @@ layout(push_constant) uniform Push {
 
 const int BISECTIONS = 10;
 
-// The pixel x projects to and its view depth (clip w); false behind the
-// camera or outside the image.
-bool project(vec3 x, out ivec2 q, out float depth) {
-    vec4 c = frame.view_proj * vec4(x, 1.0);
-    depth = c.w;
-    q = ivec2(-1);
-    if (c.w <= 1e-6) return false;
-    vec2 pixel = (c.xy / c.w * 0.5 + 0.5) * frame.viewport.xy;
-    if (any(lessThan(pixel, vec2(0.0))) || any(greaterThanEqual(pixel, frame.viewport.xy))) return false;
-    q = ivec2(pixel);
-    return true;
-}
+#include "camera_pixels.glsl"
 
 float view_depth(vec3 x) { return (frame.view_proj * vec4(x, 1.0)).w; }
 
@@ -92,7 +81,7 @@ bool back_face_normal(vec3 x, out vec3 n) {
     n = vec3(0.0);
     ivec2 q;
     float z;
-    if (!project(x, q, z) || imageLoad(back_position, q).w < 0.0) return false;
+    if (!camera_pixel(x, q, z) || imageLoad(back_position, q).w < 0.0) return false;
     n = imageLoad(back_normal, q).xyz;
     return true;
 }
@@ -104,7 +93,7 @@ bool back_face_normal(vec3 x, out vec3 n) {
 bool behind_opaque(vec3 x, out ivec2 q, out float gap) {
     float z;
     gap = 0.0;
-    if (!project(x, q, z)) return false;
+    if (!camera_pixel(x, q, z)) return false;
     vec4 s = imageLoad(opaque_position, q);
     if (s.w == 0.0) return false; // background: nothing to meet there
     gap = z - view_depth(s.xyz);
@@ -153,18 +142,13 @@ const uint FALLBACK_MEDIUM_STEPS = 16u;
 // does what stands in for it).
 const uint FALLBACK_SPECULAR_SKIPS = 4u;
 
-// The opaque frame's radiance `l` where the camera sees x itself: x inside
-// the view, and the opaque surface at its pixel on x's plane (normal n)
-// within two pixel footprints; an occluder (a wall's top, a column) or a
-// silhouette's far side lies off the plane (as water_photons' view tells).
+// The opaque frame's radiance `l` where the camera sees x itself
+// (`seen_by_camera` within two pixel footprints at x's depth).
 bool seen_in_opaque_frame(vec3 x, vec3 n, out vec3 l) {
     l = vec3(0.0);
+    float footprint = 2.0 * view_depth(x) * frame.eye.w / frame.viewport.y;
     ivec2 q;
-    float z;
-    if (!project(x, q, z)) return false;
-    vec4 g = imageLoad(opaque_position, q);
-    float footprint = 2.0 * z * frame.eye.w / frame.viewport.y;
-    if (g.w == 0.0 || abs(dot(g.xyz - x, n)) > 2.0 * footprint) return false;
+    if (!seen_by_camera(x, n, 2.0 * footprint, q)) return false;
     l = imageLoad(opaque_radiance, q).rgb;
     return true;
 }
@@ -251,7 +235,7 @@ bool search_opaque(vec3 o, vec3 d, out vec3 l, out float t_hit) {
         float t = step * float(i);
         ivec2 q;
         float gap, z;
-        if (!project(o + t * d, q, z)) return false;
+        if (!camera_pixel(o + t * d, q, z)) return false;
         if (behind_opaque(o + t * d, q, gap)) {
             float lo = t_prev, hi = t;
             for (int k = 0; k < BISECTIONS; ++k) {

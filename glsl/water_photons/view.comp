@@ -79,22 +79,12 @@ vec3 offset_along(vec3 x, vec3 n) {
     return x + n * (1e-4 * max(1.0, bvh_max_abs(x)));
 }
 
-// The pixel that sees x (on the plane of normal n) directly, if the camera
-// does: inside the view, and the opaque frame's surface at that pixel lies
-// on x's plane. That surface and x lie on one camera ray (the pixel's
-// footprint aside), which meets the plane once, so it is x itself; an
-// occluder (a wall's top, a column) or a silhouette's other side lies off
-// the plane. Tolerance: the splat's relative depth bias.
+#include "camera_pixels.glsl"
+
+// The pixel that sees x (on the plane of normal n) itself, if the camera
+// does (`seen_by_camera`); tolerance: the splat's relative depth bias.
 bool seen_directly(vec3 x, vec3 n, out ivec2 q) {
-    q = ivec2(-1);
-    vec4 c = frame.view_proj * vec4(x, 1.0);
-    if (c.w <= 1e-6) return false;
-    vec2 pixel = (c.xy / c.w * 0.5 + 0.5) * frame.viewport.xy;
-    if (any(lessThan(pixel, vec2(0.0))) || any(greaterThanEqual(pixel, frame.viewport.xy))) return false;
-    q = ivec2(pixel);
-    vec4 g = imageLoad(opaque_position, q);
-    float tol = max(wp.paper.w, 1e-3) * length(x - frame.eye.xyz);
-    return g.w != 0.0 && abs(dot(g.xyz - x, n)) <= tol;
+    return seen_by_camera(x, n, max(wp.paper.w, 1e-3) * length(x - frame.eye.xyz), q);
 }
 
 vec3 direct_irradiance(vec3 x, vec3 n) {
