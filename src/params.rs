@@ -2,13 +2,14 @@
 //! declares its parameters once, as a typed struct, with [`declare_params!`]:
 //! the macro generates the spec list that the CLI (`--param NAME=VALUE`,
 //! `caustics info`), the demo overlay and the benchmarks read, and the
-//! conversion from validated values ([`Params`]) to the struct, so code reads
-//! `params.pcf_radius`, never a name string. Groups compose: a technique's
+//! conversion from validated values ([`Params`], one per spec, by position)
+//! to the struct, so code reads `params.pcf_radius`, never a name string;
+//! names are read only where a user types them (`Params::resolve`). Groups compose: a technique's
 //! struct holds `direct: DirectParams` and its specs list the group's first.
 //!
 //! Each parameter says how a change takes effect ([`Apply`]): `Live` ones are
 //! push constants or uniforms that the running technique takes in place
-//! (`Technique::update_live`), `Rebuild` ones size resources or change
+//! (`TechniqueBuild::update_live`, typed), `Rebuild` ones size resources or change
 //! pipelines and rebuild the technique.
 //!
 //! This module sits below `passes` (which declare their own groups, e.g.
@@ -27,7 +28,7 @@ pub enum Apply {
 }
 
 /// One tunable parameter of a technique.
-#[derive(Clone, Copy, Debug, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct ParamSpec {
     pub name: &'static str,
     pub description: &'static str,
@@ -57,12 +58,15 @@ impl ParamSpec {
     }
 }
 
-/// Parameter values by name, validated against a technique's specs: the
-/// untyped form the CLI and the overlay edit. A technique turns them into
-/// its typed struct with [`ParamSet::from_params`].
+/// Parameter values validated against a technique's specs, one per spec in
+/// the specs' order: the untyped form the CLI (`resolve`, the one place a
+/// name is read) and the overlay (`set`, by position) edit. A technique
+/// turns them into its typed struct with [`ParamSet::from_params`], which
+/// reads them by position, never by name.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Params {
-    values: BTreeMap<String, f32>,
+    specs: &'static [ParamSpec],
+    values: Vec<f32>,
 }
 
 impl Params {
@@ -70,14 +74,10 @@ impl Params {
     /// Unknown names and out-of-range values are errors naming the parameter.
     pub fn resolve(
         technique: &str,
-        specs: &[ParamSpec],
+        specs: &'static [ParamSpec],
         overrides: &[String],
     ) -> anyhow::Result<Params> {
-        let by_name: BTreeMap<&str, &ParamSpec> = specs.iter().map(|s| (s.name, s)).collect();
-        let mut values: BTreeMap<String, f32> = specs
-            .iter()
-            .map(|s| (s.name.to_string(), s.default))
-            .collect();
+        let mut values: Vec<f32> = specs.iter().map(|s| s.default).collect();
         let mut given: BTreeMap<&str, &str> = BTreeMap::new();
         for o in overrides {
             let (name, value) = o
@@ -88,7 +88,7 @@ impl Params {
                     "--param {name}: given twice ({name}={first} and {name}={value}); give it once"
                 );
             }
-            let spec = by_name.get(name).ok_or_else(|| {
+            let index = specs.iter().position(|s| s.name == name).ok_or_else(|| {
                 let known: Vec<_> = specs.iter().map(|s| s.name).collect();
                 anyhow::anyhow!(
                     "--param {name}: technique `{technique}` has no such parameter (it has: {})",
@@ -103,55 +103,55 @@ impl Params {
                 .trim()
                 .parse()
                 .map_err(|_| anyhow::anyhow!("--param {name}: {value:?} is not a number"))?;
-            if !spec.accepts(v) {
-                anyhow::bail!("--param {name}={value}: {}", spec.range_text());
+            if !specs[index].accepts(v) {
+                anyhow::bail!("--param {name}={value}: {}", specs[index].range_text());
             }
-            values.insert(name.to_string(), v);
+            values[index] = v;
         }
-        Ok(Params { values })
+        Ok(Params { specs, values })
     }
 
-    /// Sets the value of `spec`'s parameter (the overlay's sliders: a
+    /// The specs these values belong to, in their order.
+    pub fn specs(&self) -> &'static [ParamSpec] {
+        self.specs
+    }
+
+    /// The values, one per spec, in the specs' order.
+    pub fn values(&self) -> &[f32] {
+        &self.values
+    }
+
+    /// Sets the value of the `index`-th spec (the overlay's sliders: a
     /// typed value, validated as `resolve` validates, no "name=value"
-    /// string on the way); an error when these values were resolved
-    /// against other specs or `value` is out of its range.
-    pub fn set(&mut self, spec: &ParamSpec, value: f32) -> anyhow::Result<()> {
-        let slot = self.values.get_mut(spec.name).ok_or_else(|| {
-            anyhow::anyhow!(
-                "parameter `{}` has no value (resolved for another technique?)",
-                spec.name
-            )
+    /// string on the way); an error when `index` is past the specs or
+    /// `value` is out of its range.
+    pub fn set(&mut self, index: usize, value: f32) -> anyhow::Result<()> {
+        let spec = self.specs.get(index).ok_or_else(|| {
+            anyhow::anyhow!("parameter #{index}: these values have {}", self.specs.len())
         })?;
         if !spec.accepts(value) {
             anyhow::bail!("parameter {} = {value}: {}", spec.name, spec.range_text());
         }
-        *slot = value;
+        self.values[index] = value;
         Ok(())
     }
 
-    /// The value of `name`; an error (not a panic) when these values were
-    /// resolved against specs that do not declare it.
-    pub fn value(&self, name: &str) -> anyhow::Result<f32> {
-        self.values.get(name).copied().ok_or_else(|| {
-            anyhow::anyhow!("parameter `{name}` has no value (resolved for another technique?)")
-        })
+    /// Each spec with its value, in the specs' order.
+    pub fn iter(&self) -> impl Iterator<Item = (&'static ParamSpec, f32)> + '_ {
+        self.specs.iter().zip(self.values.iter().copied())
     }
 
-    pub fn iter(&self) -> impl Iterator<Item = (&String, &f32)> {
-        self.values.iter()
-    }
-
-    /// The names whose values differ between `self` and `other`.
-    pub fn changed<'a>(&'a self, other: &'a Params) -> impl Iterator<Item = &'a str> + 'a {
-        let names: std::collections::BTreeSet<&str> = self
-            .values
-            .keys()
-            .chain(other.values.keys())
-            .map(String::as_str)
-            .collect();
-        names
-            .into_iter()
-            .filter(|n| self.values.get(*n) != other.values.get(*n))
+    /// The specs whose values differ between `self` and `other`; every
+    /// spec of both when they were resolved against different specs.
+    pub fn changed(&self, other: &Params) -> Vec<&'static ParamSpec> {
+        if self.specs != other.specs {
+            return self.specs.iter().chain(other.specs).collect();
+        }
+        self.iter()
+            .zip(&other.values)
+            .filter(|((_, a), b)| a != *b)
+            .map(|((s, _), _)| s)
+            .collect()
     }
 }
 
@@ -159,13 +159,37 @@ impl Params {
 pub trait ParamSet: Sized {
     /// Every parameter, groups first, in declaration order.
     fn specs() -> &'static [ParamSpec];
-    /// The typed values of validated `params`.
-    fn from_params(params: &Params) -> anyhow::Result<Self>;
+    /// The typed values of validated `values`, one per spec of `specs()`
+    /// in its order (groups read their own run of it).
+    fn from_values(values: &[f32]) -> Self;
+
+    /// The typed values of validated `params`; an error when they were
+    /// resolved against other specs (another technique's).
+    fn from_params(params: &Params) -> anyhow::Result<Self> {
+        if params.specs() != Self::specs() {
+            anyhow::bail!(
+                "parameters resolved against other specs ({}) than this set's ({})",
+                names(params.specs()),
+                names(Self::specs())
+            );
+        }
+        Ok(Self::from_values(params.values()))
+    }
 
     /// Defaults overridden by `overrides` ("name=value" each), validated as
     /// the CLI does; `technique` names the owner in error messages.
     fn parse(technique: &str, overrides: &[String]) -> anyhow::Result<Self> {
         Self::from_params(&Params::resolve(technique, Self::specs(), overrides)?)
+    }
+}
+
+/// `specs`' names, comma-separated (error messages).
+fn names(specs: &[ParamSpec]) -> String {
+    let names: Vec<_> = specs.iter().map(|s| s.name).collect();
+    if names.is_empty() {
+        "none".into()
+    } else {
+        names.join(", ")
     }
 }
 
@@ -265,13 +289,23 @@ macro_rules! declare_params {
                 })
             }
 
-            fn from_params(_params: &$crate::params::Params) -> anyhow::Result<Self> {
-                Ok(Self {
-                    $($group: <$gty as $crate::params::ParamSet>::from_params(_params)?,)*
-                    $($field: <$ty as $crate::params::ParamValue>::from_f32(
-                        _params.value(stringify!($field))?,
-                    ),)*
-                })
+            // Fields in declaration order, as `specs` lists them: a struct
+            // expression evaluates its fields in the order written.
+            #[allow(unused_assignments, unused_mut, unused_variables)]
+            fn from_values(values: &[f32]) -> Self {
+                let mut at = 0usize;
+                Self {
+                    $($group: {
+                        let group = <$gty as $crate::params::ParamSet>::from_values(&values[at..]);
+                        at += <$gty as $crate::params::ParamSet>::specs().len();
+                        group
+                    },)*
+                    $($field: {
+                        let v = <$ty as $crate::params::ParamValue>::from_f32(values[at]);
+                        at += 1;
+                        v
+                    },)*
+                }
             }
         }
 
@@ -316,32 +350,38 @@ mod tests {
         assert_eq!(o.inner.size, 16);
         assert_eq!(o.scale, 1.0);
         assert!(!o.on);
+        let e = Outer::from_params(&Params::default())
+            .err()
+            .unwrap()
+            .to_string();
         assert_eq!(
-            Outer::from_params(&Params::default())
-                .err()
-                .unwrap()
-                .to_string(),
-            "parameter `size` has no value (resolved for another technique?)"
+            e,
+            "parameters resolved against other specs (none) than this set's (size, scale, on)"
         );
+        let inner = Params::resolve("t", Inner::specs(), &["size=3".into()]).unwrap();
+        assert!(Outer::from_params(&inner).is_err());
+        assert_eq!(Inner::from_params(&inner).unwrap().size, 3);
         assert_eq!(Outer::default(), Outer::parse("t", &[]).unwrap());
     }
 
-    /// `set` takes a typed value with `resolve`'s checks.
+    /// `set` takes a typed value by position with `resolve`'s checks.
     #[test]
     fn set_validates_like_resolve() {
         let specs = Outer::specs();
         let mut p = Params::resolve("t", specs, &[]).unwrap();
-        p.set(&specs[1], 1.5).unwrap();
+        p.set(1, 1.5).unwrap();
         assert_eq!(
             p,
             Params::resolve("t", specs, &["scale=1.5".into()]).unwrap()
         );
-        let e = p.set(&specs[0], 2.5).unwrap_err().to_string();
+        let e = p.set(0, 2.5).unwrap_err().to_string();
         assert_eq!(e, "parameter size = 2.5: must be a whole number in [1, 64]");
-        assert!(p.set(&specs[1], f32::NAN).is_err());
-        assert!(p.set(&specs[1], 3.0).is_err());
-        assert!(Params::default().set(&specs[1], 1.0).is_err());
-        assert_eq!(p.value("scale").unwrap(), 1.5);
+        assert!(p.set(1, f32::NAN).is_err());
+        assert!(p.set(1, 3.0).is_err());
+        assert!(p.set(3, 1.0).is_err());
+        assert!(Params::default().set(0, 1.0).is_err());
+        assert_eq!(p.values(), [8.0, 1.5, 1.0]);
+        assert_eq!(Outer::from_params(&p).unwrap().scale, 1.5);
     }
 
     #[test]
@@ -359,6 +399,7 @@ mod tests {
         );
         let a = Params::resolve("t", Outer::specs(), &["scale=2".into()]).unwrap();
         let b = Params::resolve("t", Outer::specs(), &[]).unwrap();
-        assert_eq!(a.changed(&b).collect::<Vec<_>>(), ["scale"]);
+        let changed: Vec<_> = a.changed(&b).iter().map(|s| s.name).collect();
+        assert_eq!(changed, ["scale"]);
     }
 }

@@ -330,29 +330,30 @@ mod enabled {
         if chosen != data.technique {
             actions.push(Action::Technique(chosen));
         }
-        if let Some(info) = TECHNIQUES.iter().find(|t| t.name == data.technique) {
-            let current = pending.clone().unwrap_or_else(|| data.params.clone());
-            // The sliders edit typed values in a copy (`Params::set`).
-            let mut next = current.clone();
-            let mut edited = false;
-            for spec in info.params() {
-                // The values belong to this technique's specs; a
-                // missing one shows its default.
-                let mut v = current.value(spec.name).unwrap_or(spec.default);
-                let mut slider = egui::Slider::new(&mut v, spec.min..=spec.max).text(spec.name);
-                if spec.apply == Apply::Live {
-                    slider = slider.suffix(" (live)");
-                }
-                if spec.integer {
-                    slider = slider.integer();
-                }
-                if ui.add(slider).on_hover_text(spec.description).changed() {
-                    edited |= next.set(spec, v).is_ok();
-                }
+        // The current technique's values, by position in its specs (a
+        // pending edit of another technique's is dropped).
+        let current = pending
+            .clone()
+            .filter(|p| p.specs() == data.params.specs())
+            .unwrap_or_else(|| data.params.clone());
+        // The sliders edit typed values in a copy (`Params::set`).
+        let mut next = current.clone();
+        let mut edited = false;
+        for (index, (spec, value)) in current.iter().enumerate() {
+            let mut v = value;
+            let mut slider = egui::Slider::new(&mut v, spec.min..=spec.max).text(spec.name);
+            if spec.apply == Apply::Live {
+                slider = slider.suffix(" (live)");
             }
-            if edited {
-                *pending = Some(next);
+            if spec.integer {
+                slider = slider.integer();
             }
+            if ui.add(slider).on_hover_text(spec.description).changed() {
+                edited |= next.set(index, v).is_ok();
+            }
+        }
+        if edited {
+            *pending = Some(next);
         }
         components(ui, data, actions);
         medium(ui, data, actions);

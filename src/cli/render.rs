@@ -289,7 +289,10 @@ pub fn bench(args: BenchArgs) -> anyhow::Result<()> {
                 time: scene.time,
             },
             technique: technique.clone(),
-            params: params.iter().map(|(k, v)| (k.clone(), *v)).collect(),
+            params: params
+                .iter()
+                .map(|(s, v)| (s.name.to_string(), v))
+                .collect(),
             warmup,
             frames_in_flight: in_flight,
             timing: Timing {

@@ -372,7 +372,10 @@ pub fn judge_technique(
     sink.flip_map(&format!("{name}_flip"), &map)?;
     let result = TechniqueResult {
         technique: name.into(),
-        params: params.iter().map(|(k, v)| (k.clone(), *v)).collect(),
+        params: params
+            .iter()
+            .map(|(s, v)| (s.name.to_string(), v))
+            .collect(),
         timing,
         full,
         modelled,

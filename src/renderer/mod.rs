@@ -258,19 +258,18 @@ impl Renderer {
 
     /// New parameter values for the current technique. When every changed
     /// parameter is live (`params::Apply::Live`) and the technique takes
-    /// them in place (`Technique::update_live`), nothing is rebuilt;
+    /// them in place (`TechniqueBuild::update_live`), nothing is rebuilt;
     /// otherwise the technique is rebuilt (keeping the current one on
     /// error; the old one is released after the frames in flight). Returns
     /// whether it was rebuilt. Live values are read at record time, so
     /// frames in flight keep theirs.
     pub fn set_params(&mut self, params: &Params) -> anyhow::Result<bool> {
-        let specs = self.technique_info().params();
-        let live = self.params.changed(params).all(|name| {
-            specs
-                .iter()
-                .any(|s| s.name == name && s.apply == Apply::Live)
-        });
-        if live && self.technique.update_live(params)? {
+        let live = self
+            .params
+            .changed(params)
+            .iter()
+            .all(|s| s.apply == Apply::Live);
+        if live && (self.technique_info().update_live)(self.technique.as_mut(), params)? {
             self.params = params.clone();
             self.restart_accumulation();
             return Ok(false);

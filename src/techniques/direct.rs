@@ -4,7 +4,6 @@
 
 use super::{CausticSources, Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
-use crate::params::{ParamSet, Params};
 use crate::passes::direct_light::DirectLight;
 pub use crate::passes::direct_light::DirectParams;
 use crate::radiometry::Component;
@@ -36,16 +35,16 @@ impl TechniqueBuild for Direct {
             light: DirectLight::new(ctx, params, scene, scene_gpu, width, height)?,
         })
     }
+
+    fn update_live(&mut self, params: &DirectParams) -> bool {
+        self.light.set_live(params);
+        true
+    }
 }
 
 impl Technique for Direct {
     fn name(&self) -> &'static str {
         Self::NAME
-    }
-
-    fn update_live(&mut self, params: &Params) -> anyhow::Result<bool> {
-        self.light.set_live(&DirectParams::from_params(params)?);
-        Ok(true)
     }
 
     fn record(

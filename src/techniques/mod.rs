@@ -14,7 +14,9 @@ use crate::scene::Scene;
 use crate::vk::{Context, FrameRecorder, VkResult};
 use std::sync::Arc;
 
-pub trait Technique {
+/// A technique as the renderer holds it (`Box<dyn Technique>`); its typed
+/// side (parameters, constructor) is `TechniqueBuild`.
+pub trait Technique: AsAny {
     fn name(&self) -> &'static str;
     /// Records this frame's passes; every pass goes through `rec.pass`.
     fn record(
@@ -39,17 +41,6 @@ pub trait Technique {
     /// it. Called with no frame in flight.
     fn environment_changed(&mut self) -> bool {
         false
-    }
-
-    /// Takes new values of `Live` parameters (`params::Apply`) in place:
-    /// push constants and switches read at record time. Called by
-    /// `Renderer::set_params` only when every changed parameter is live,
-    /// possibly with frames in flight: change only host state read at
-    /// record time, never a buffer or descriptor set a submitted frame may
-    /// read. Returns false (the default) when the technique cannot, and the
-    /// renderer rebuilds it.
-    fn update_live(&mut self, _params: &Params) -> anyhow::Result<bool> {
-        Ok(false)
     }
 
     /// Called once a frame recorded by `record` has completed (its fence
@@ -97,6 +88,30 @@ pub trait TechniqueBuild: Technique + Sized + 'static {
     fn check_scene(_scene: &Scene) -> anyhow::Result<()> {
         Ok(())
     }
+
+    /// Takes new values of its `Live` parameters (`params::Apply`) in
+    /// place, typed: push constants and switches read at record time.
+    /// Called (through `TechniqueInfo::update_live`) by
+    /// `Renderer::set_params` only when every changed parameter is live,
+    /// possibly with frames in flight: change only host state read at
+    /// record time, never a buffer or descriptor set a submitted frame may
+    /// read. Returns false (the default) when the technique cannot, and the
+    /// renderer rebuilds it.
+    fn update_live(&mut self, _params: &Self::Params) -> bool {
+        false
+    }
+}
+
+/// The concrete type behind a `dyn Technique`, for the registry's typed
+/// calls (`TechniqueInfo::update_live`).
+pub trait AsAny: std::any::Any {
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any;
+}
+
+impl<T: std::any::Any> AsAny for T {
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any {
+        self
+    }
 }
 
 /// Builds a `T` from validated values (`TechniqueInfo::create`).
@@ -113,6 +128,20 @@ fn create<T: TechniqueBuild>(
     Ok(Box::new(T::build(
         ctx, &params, scene, scene_gpu, width, height,
     )?))
+}
+
+/// Hands `T` its typed live parameters (`TechniqueBuild::update_live`):
+/// the values become `T::Params` here, once, by position.
+fn update_live<T: TechniqueBuild>(
+    technique: &mut dyn Technique,
+    params: &Params,
+) -> anyhow::Result<bool> {
+    let name = technique.name();
+    let typed = T::Params::from_params(params)?;
+    let Some(technique) = technique.as_any_mut().downcast_mut::<T>() else {
+        anyhow::bail!("live parameters of `{}` given to `{name}`", T::NAME);
+    };
+    Ok(technique.update_live(&typed))
 }
 
 /// The constructor of a registered technique.
@@ -150,6 +179,10 @@ pub struct TechniqueInfo {
     /// What it needs of the scene, checked without a device
     /// (`TechniqueBuild::check_scene`).
     pub check_scene: fn(&Scene) -> anyhow::Result<()>,
+    /// Gives a technique built by `create` new values of its live
+    /// parameters (`TechniqueBuild::update_live`); Ok(false) when it
+    /// cannot take them in place.
+    pub update_live: fn(&mut dyn Technique, &Params) -> anyhow::Result<bool>,
 }
 
 impl TechniqueInfo {
@@ -162,6 +195,7 @@ impl TechniqueInfo {
             specs: <T::Params as ParamSet>::specs,
             create: create::<T>,
             check_scene: T::check_scene,
+            update_live: update_live::<T>,
         }
     }
 

@@ -24,7 +24,7 @@
 use crate::common;
 
 use caustics::frame::{FrameTargets, SceneGpu};
-use caustics::params::{ParamSet, ParamSpec, Params};
+use caustics::params::ParamSet;
 use caustics::passes::airlight::{Airlight, AirlightParams};
 use caustics::passes::direct_light::{DirectLight, DirectParams};
 use caustics::radiometry::spot_falloff;
@@ -45,6 +45,15 @@ const BOUNDS: f32 = 3.0;
 const BOX_MIN: Vec3 = Vec3::new(0.5, -0.5, -0.5);
 const BOX_MAX: Vec3 = Vec3::new(0.7, 0.5, 0.5);
 
+caustics::declare_params! {
+    /// The surface frame's and the airlight pass's parameters, as a
+    /// technique with both groups resolves them.
+    struct AirlightPassParams {
+        @group direct: DirectParams;
+        @group airlight: AirlightParams;
+    }
+}
+
 /// One frame of `direct` (its shadow maps; it writes 0 under the airlight
 /// mask) plus the airlight pass; returns the radiance and the airlight
 /// pass's milliseconds.
@@ -58,17 +67,16 @@ fn render_airlight_at(
     overrides: &[&str],
     size: u32,
 ) -> (Vec<f32>, f64) {
-    let specs: Vec<ParamSpec> = [DirectParams::specs(), AirlightParams::specs()].concat();
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let params = Params::resolve("airlight", &specs, &overrides).unwrap();
+    let params = AirlightPassParams::parse("airlight", &overrides).unwrap();
     let mut scene_gpu = SceneGpu::new(ctx, scene, 0.0).unwrap();
     scene_gpu.components = Component::Airlight.mask();
     let targets = FrameTargets::new(ctx, size, size).unwrap();
-    let direct_params = DirectParams::from_params(&params).unwrap();
+    let direct_params = params.direct;
     let mut direct = DirectLight::new(ctx, &direct_params, scene, &scene_gpu, size, size).unwrap();
     let mut air = Airlight::new(
         ctx,
-        &AirlightParams::from_params(&params).unwrap(),
+        &params.airlight,
         direct_params.medium_steps,
         scene,
         &scene_gpu,

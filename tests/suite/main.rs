@@ -31,6 +31,7 @@ mod image_space;
 mod image_space_refraction;
 mod interrupt;
 mod lights_scene;
+mod live_params;
 mod medium_attenuation;
 mod mixed_material;
 mod moving_lights;

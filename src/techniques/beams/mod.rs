@@ -105,7 +105,6 @@ pub use tracer::{BeamCounts, BeamTracer, GpuBeam};
 
 use super::{CausticSources, Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
-use crate::params::{ParamSet, Params};
 use crate::passes::airlight::{Airlight, AirlightParams};
 use crate::passes::camera_refraction::RefractionPush;
 use crate::passes::direct_light::DirectParams;
@@ -115,7 +114,6 @@ use crate::radiometry::Component;
 use crate::scene::{Light, Scene};
 use crate::vk::{Context, FrameRecorder};
 use std::sync::Arc;
-use tracer::TracerSettings;
 
 crate::declare_params! {
     /// `beams`' parameters: the surface frame's and the airlight's, then
@@ -238,33 +236,7 @@ impl TechniqueBuild for Beams {
             scene_gpu,
             surface.shadows(),
         )?;
-        let tracer = BeamTracer::new(
-            ctx,
-            &TracerSettings {
-                grid_size: params.grid_size,
-                levels: params.levels,
-                split_depth: params.split_depth,
-                split_normal_deg: params.split_normal,
-                split_focus: params.split_focus,
-                split_energy: params.split_energy,
-                split_camera: params.split_camera,
-                volume: params.volume,
-                quadrature: params.quadrature,
-                beam_capacity: params.beam_capacity,
-                tir_remedy: params.tir_remedy,
-                eq_6_3_2: params.eq_6_3_2,
-                refraction: params.refraction,
-                bounces: params.bounces,
-                extrusion_cutoff: params.extrusion_cutoff,
-                surface_filter: params.surface_filter,
-                medium_steps: params.direct.medium_steps,
-            },
-            scene,
-            scene_gpu,
-            params.light_view_size,
-            width,
-            height,
-        )?;
+        let tracer = BeamTracer::new(ctx, params, scene, scene_gpu, width, height)?;
         Ok(Self {
             surface,
             light_views,
@@ -273,6 +245,12 @@ impl TechniqueBuild for Beams {
             last_counts: None,
             traced: Vec::new(),
         })
+    }
+
+    fn update_live(&mut self, params: &BeamsParams) -> bool {
+        self.surface.set_live(&params.direct, params.search_steps);
+        self.airlight.set_live(&params.airlight);
+        true
     }
 }
 
@@ -287,13 +265,6 @@ impl Beams {
 impl Technique for Beams {
     fn name(&self) -> &'static str {
         Self::NAME
-    }
-
-    fn update_live(&mut self, params: &Params) -> anyhow::Result<bool> {
-        let params = BeamsParams::from_params(params)?;
-        self.surface.set_live(&params.direct, params.search_steps);
-        self.airlight.set_live(&params.airlight);
-        Ok(true)
     }
 
     fn record(

@@ -9,6 +9,7 @@
 //! The module doc of `beams` has the method.
 
 use super::bindings as bb;
+use super::BeamsParams;
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::passes::light_views::photon_view;
 use crate::passes::light_views::{LightView, LightViewConsumer};
@@ -178,32 +179,6 @@ struct VolumePush {
     pad: u32,
 }
 
-/// What `BeamTracer` takes from the technique's parameters.
-pub struct TracerSettings {
-    pub grid_size: u32,
-    pub levels: u32,
-    pub split_depth: f32,
-    pub split_normal_deg: f32,
-    pub split_focus: f32,
-    /// Fraction of the light view's flux above which a beam is split.
-    pub split_energy: f32,
-    pub split_camera: f32,
-    pub volume: u32,
-    pub quadrature: u32,
-    pub beam_capacity: u32,
-    pub tir_remedy: u32,
-    pub eq_6_3_2: u32,
-    /// `BEAMS_REFRACTION_*`.
-    pub refraction: u32,
-    /// Specular events per beam path (Sect. 6), 1 to 3.
-    pub bounces: u32,
-    /// Extrusion cut-off (fraction of the base's flux density; 0: none).
-    pub extrusion_cutoff: f32,
-    /// Low-pass filter radius of the surface caustics in pixels (0: none).
-    pub surface_filter: u32,
-    pub medium_steps: u32,
-}
-
 /// The layouts of `BeamSets`.
 struct BeamLayouts {
     receivers: DescriptorSetLayout,
@@ -295,25 +270,25 @@ impl BeamTracer {
         self.view_flux = view_fluxes(lights, specular, self.light_view_size);
     }
 
-    /// Frames of `width` x `height`; `light_view` is the light views'
-    /// G-buffer, `surface` the frame the caustics add to.
-    #[allow(clippy::too_many_arguments)]
+    /// Frames of `width` x `height`, with the technique's parameters
+    /// (the light views' size, the grid, the split criteria, the volumes).
     pub fn new(
         ctx: &Arc<Context>,
-        settings: &TracerSettings,
+        params: &BeamsParams,
         scene: &Scene,
         scene_gpu: &SceneGpu,
-        light_view_size: u32,
         width: u32,
         height: u32,
     ) -> anyhow::Result<Self> {
-        let base = settings.grid_size;
+        let light_view_size = params.light_view_size;
+        let medium_steps = params.direct.medium_steps;
+        let base = params.grid_size;
         // Each level holds at most 4x the previous one's; the lists are
         // sized for the deepest level (bounded by the beam capacity: a
         // level with more triangles than beams fits cannot be drawn anyway).
-        let full = 2 * (base as u64).pow(2) * 4u64.pow(settings.levels);
+        let full = 2 * (base as u64).pow(2) * 4u64.pow(params.levels);
         let triangle_capacity = full
-            .min(settings.beam_capacity as u64)
+            .min(params.beam_capacity as u64)
             .max(2 * (base as u64).pow(2)) as u32;
         let triangles = [
             Buffer::new(
@@ -332,7 +307,7 @@ impl BeamTracer {
         let beams = Buffer::new(
             ctx,
             "beams",
-            settings.beam_capacity as u64 * size_of::<GpuBeam>() as u64,
+            params.beam_capacity as u64 * size_of::<GpuBeam>() as u64,
             BufferUsage::Storage,
         )?;
         let counters = Buffer::new(
@@ -515,13 +490,13 @@ impl BeamTracer {
             crate::passes::light_views::specular_bounds(scene),
             light_view_size,
         );
-        let cos_normal = settings.split_normal_deg.to_radians().cos();
+        let cos_normal = params.split_normal.to_radians().cos();
         Ok(Self {
             beams,
             volume,
             surface: surface_target,
             surface_filtered,
-            surface_filter: settings.surface_filter,
+            surface_filter: params.surface_filter,
             triangles,
             counters,
             indirect,
@@ -532,33 +507,33 @@ impl BeamTracer {
                 right: [0.0; 4],
                 up: [0.0; 4],
                 forward: [0.0; 4],
-                grid: [0, settings.levels, base, triangle_capacity],
+                grid: [0, params.levels, base, triangle_capacity],
                 config: [
-                    settings.beam_capacity,
-                    settings.tir_remedy,
-                    settings.eq_6_3_2,
-                    settings.medium_steps,
+                    params.beam_capacity,
+                    params.tir_remedy,
+                    params.eq_6_3_2,
+                    medium_steps,
                 ],
-                split: [settings.split_depth, cos_normal, settings.split_focus, 0.0],
+                split: [params.split_depth, cos_normal, params.split_focus, 0.0],
                 split2: [
-                    settings.split_camera,
-                    f32::from_bits(settings.refraction),
-                    settings.extrusion_cutoff,
-                    f32::from_bits(settings.bounces),
+                    params.split_camera,
+                    f32::from_bits(params.refraction),
+                    params.extrusion_cutoff,
+                    f32::from_bits(params.bounces),
                 ],
             },
             args: ArgsPush {
                 triangle_capacity,
-                beam_capacity: settings.beam_capacity,
+                beam_capacity: params.beam_capacity,
             },
             volume_push: VolumePush {
-                volume_kind: settings.volume,
-                quadrature: settings.quadrature,
-                medium_steps: settings.medium_steps,
+                volume_kind: params.volume,
+                quadrature: params.quadrature,
+                medium_steps,
                 pad: 0,
             },
             view_flux,
-            split_energy: settings.split_energy,
+            split_energy: params.split_energy,
             light_view_size,
             refine_pipeline,
             args_pipeline,

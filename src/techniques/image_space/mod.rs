@@ -61,7 +61,6 @@
 
 use super::{CausticSources, Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
-use crate::params::{ParamSet, Params};
 use crate::passes::caustic_map::CausticMap;
 pub use crate::passes::caustic_map::ImageSpaceParams;
 use crate::passes::light_views::LightViews;
@@ -137,6 +136,11 @@ impl TechniqueBuild for ImageSpace {
         super::check_no_mixed(scene, Self::NAME)?;
         crate::frame::check_stand_ins(scene, Self::NAME).map_err(anyhow::Error::msg)
     }
+
+    fn update_live(&mut self, params: &ImageSpaceParams) -> bool {
+        self.set_live(params);
+        true
+    }
 }
 
 impl ImageSpace {
@@ -150,11 +154,6 @@ impl ImageSpace {
 impl Technique for ImageSpace {
     fn name(&self) -> &'static str {
         Self::NAME
-    }
-
-    fn update_live(&mut self, params: &Params) -> anyhow::Result<bool> {
-        self.set_live(&ImageSpaceParams::from_params(params)?);
-        Ok(true)
     }
 
     fn record(

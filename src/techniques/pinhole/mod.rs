@@ -58,7 +58,6 @@ pub mod params;
 
 use super::{CausticSources, Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
-use crate::params::{ParamSet, Params};
 use crate::passes::camera_refraction::RefractionPush;
 use crate::passes::surface_frame::SurfaceFrame;
 use crate::radiometry::Component;
@@ -527,16 +526,16 @@ impl TechniqueBuild for Pinhole {
         }
         Ok(Self::new(ctx, params, scene, scene_gpu, width, height)?)
     }
+
+    fn update_live(&mut self, params: &PinholeParams) -> bool {
+        self.set_live(params);
+        true
+    }
 }
 
 impl Technique for Pinhole {
     fn name(&self) -> &'static str {
         Self::NAME
-    }
-
-    fn update_live(&mut self, params: &Params) -> anyhow::Result<bool> {
-        self.set_live(&PinholeParams::from_params(params)?);
-        Ok(true)
     }
 
     fn record(

@@ -92,7 +92,6 @@ pub use lines::{GpuSegment, VolumeRays};
 
 use super::{CausticSources, Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
-use crate::params::{ParamSet, Params};
 use crate::passes::airlight::{Airlight, AirlightParams};
 use crate::passes::caustic_map::{CausticMap, ImageSpaceParams};
 use crate::passes::light_views::{LightViewConsumer, LightViews};
@@ -249,20 +248,19 @@ impl TechniqueBuild for VolumeLines {
         super::check_no_mixed(scene, Self::NAME)?;
         crate::frame::check_stand_ins(scene, Self::NAME).map_err(anyhow::Error::msg)
     }
+
+    fn update_live(&mut self, params: &VolumeLinesParams) -> bool {
+        let c = &params.image_space;
+        self.surface.set_live(&c.direct, c.search_steps);
+        self.caustics.set_on_change(c.caustics_on_change);
+        self.airlight.set_live(&params.airlight);
+        true
+    }
 }
 
 impl Technique for VolumeLines {
     fn name(&self) -> &'static str {
         Self::NAME
-    }
-
-    fn update_live(&mut self, params: &Params) -> anyhow::Result<bool> {
-        let params = VolumeLinesParams::from_params(params)?;
-        let c = &params.image_space;
-        self.surface.set_live(&c.direct, c.search_steps);
-        self.caustics.set_on_change(c.caustics_on_change);
-        self.airlight.set_live(&params.airlight);
-        Ok(true)
     }
 
     fn record(

@@ -160,7 +160,6 @@ pub use view::WaterView;
 use super::{CausticSources, Technique, TechniqueBuild};
 use crate::frame::{FrameTargets, SceneGpu};
 use crate::gpu::GpuFrame;
-use crate::params::{ParamSet, Params};
 use crate::passes::camera_refraction::RefractionPush;
 use crate::passes::surface_frame::SurfaceFrame;
 use crate::radiometry::Component;
@@ -473,17 +472,16 @@ impl TechniqueBuild for WaterPhotons {
         }
         Ok(())
     }
+
+    fn update_live(&mut self, params: &WaterPhotonsParams) -> bool {
+        self.surface.set_live(&params.direct, params.search_steps);
+        true
+    }
 }
 
 impl Technique for WaterPhotons {
     fn name(&self) -> &'static str {
         Self::NAME
-    }
-
-    fn update_live(&mut self, params: &Params) -> anyhow::Result<bool> {
-        let params = WaterPhotonsParams::from_params(params)?;
-        self.surface.set_live(&params.direct, params.search_steps);
-        Ok(true)
     }
 
     fn record(
