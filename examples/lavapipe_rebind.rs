@@ -17,8 +17,8 @@
 
 use caustics::shader_bindings as b;
 use caustics::vk::{
-    bytes, host_rss, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, ContextOptions,
-    DescriptorSet, DescriptorSetLayout, Specialization,
+    bytes, host_rss, Buffer, BufferUsage, ComputePipeline, Context, ContextOptions, DescriptorSet,
+    SetResource, Specialization,
 };
 use std::sync::Arc;
 use std::time::Instant;
@@ -51,19 +51,16 @@ fn main() -> anyhow::Result<()> {
 /// Host RSS growth (bytes) over `binds` binds of one pipeline after a
 /// warm-up of 10, and the mean milliseconds a bind and dispatch takes.
 fn run(ctx: &Arc<Context>, from_constants: bool, binds: u32) -> anyhow::Result<(i64, f64)> {
-    let layout = DescriptorSetLayout::new(
-        ctx,
-        &[
-            (b::PROBE_BINDING_PARAMS, BindingKind::Uniform),
-            (b::PROBE_BINDING_RESULTS, BindingKind::Storage),
-        ],
-    )?;
     // Trip count 2 and branch 0 either way.
     let params = Buffer::with_data(ctx, "params", &[2u32, 0, 0, 0], BufferUsage::Uniform)?;
     let results = Buffer::with_data(ctx, "results", &[0.5f32; 4 * THREADS], BufferUsage::Storage)?;
-    let set = DescriptorSet::new(ctx, &layout)?;
-    set.write_buffer(b::PROBE_BINDING_PARAMS, &params)
-        .write_buffer(b::PROBE_BINDING_RESULTS, &results);
+    let (layout, set) = DescriptorSet::of_resources(
+        ctx,
+        &[
+            (b::PROBE_BINDING_PARAMS, SetResource::Buffer(&params)),
+            (b::PROBE_BINDING_RESULTS, SetResource::Buffer(&results)),
+        ],
+    )?;
     let pipeline = ComputePipeline::specialized(
         ctx,
         "tests/uniform_branch.comp",

@@ -11,7 +11,7 @@ use crate::radiometry::Component;
 use crate::scene::{Camera, Density, MaterialKind, Scene, Triangle};
 use crate::shader_bindings as b;
 use crate::vk::{
-    BindingKind, Buffer, BufferUsage, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder,
+    Buffer, BufferUsage, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, SetResource,
     VkError, VkResult,
 };
 use glam::{Mat4, Vec3};
@@ -114,26 +114,6 @@ pub fn camera_matrices(camera: &Camera, aspect: f32) -> (Mat4, Mat4) {
 }
 
 impl SceneGpu {
-    pub fn set_layout(ctx: &Arc<Context>) -> VkResult<DescriptorSetLayout> {
-        DescriptorSetLayout::new(
-            ctx,
-            &[
-                (b::BINDING_FRAME, BindingKind::Uniform),
-                (b::BINDING_TRIANGLES, BindingKind::Storage),
-                (b::BINDING_BVH_NODES, BindingKind::Storage),
-                (b::BINDING_MATERIALS, BindingKind::Storage),
-                (b::BINDING_LIGHTS, BindingKind::Storage),
-                (b::BINDING_MEDIUM, BindingKind::Storage),
-                (b::BINDING_DENSITY_GRID, BindingKind::Storage),
-                (b::BINDING_TRIANGLE_UVS, BindingKind::Storage),
-                (b::BINDING_ALBEDO_TEXTURES, BindingKind::Sampled),
-                (b::BINDING_EMITTERS, BindingKind::Storage),
-                (b::BINDING_ENVIRONMENT, BindingKind::Sampled),
-                (b::BINDING_ENVIRONMENT_DATA, BindingKind::Storage),
-            ],
-        )
-    }
-
     pub fn new(ctx: &Arc<Context>, scene: &Scene, time: f32) -> VkResult<SceneGpu> {
         let start = std::time::Instant::now();
         let triangles = scene.triangles(time);
@@ -218,28 +198,30 @@ impl SceneGpu {
             std::mem::size_of::<GpuFrame>() as u64,
             BufferUsage::Uniform,
         )?;
-        let layout = Self::set_layout(ctx)?;
-        let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_buffer(b::BINDING_FRAME, &frame_buf)
-            .write_buffer(b::BINDING_TRIANGLES, &triangles_buf)
-            .write_buffer(b::BINDING_BVH_NODES, &nodes_buf)
-            .write_buffer(b::BINDING_MATERIALS, &materials_buf)
-            .write_buffer(b::BINDING_LIGHTS, &lights_buf)
-            .write_buffer(b::BINDING_MEDIUM, &medium_buf)
-            .write_buffer(b::BINDING_DENSITY_GRID, &grid_buf)
-            .write_buffer(b::BINDING_TRIANGLE_UVS, &uvs_buf)
-            .write_static_texture(
-                b::BINDING_ALBEDO_TEXTURES,
-                &albedo_textures.image,
-                &albedo_textures.sampler,
-            )
-            .write_buffer(b::BINDING_EMITTERS, &emitters_buf)
-            .write_static_texture(
-                b::BINDING_ENVIRONMENT,
-                &environment.image,
-                &environment.sampler,
-            )
-            .write_buffer(b::BINDING_ENVIRONMENT_DATA, &environment.data);
+        use SetResource::{Buffer as Buf, Texture};
+        let (layout, set) = DescriptorSet::of_resources(
+            ctx,
+            &[
+                (b::BINDING_FRAME, Buf(&frame_buf)),
+                (b::BINDING_TRIANGLES, Buf(&triangles_buf)),
+                (b::BINDING_BVH_NODES, Buf(&nodes_buf)),
+                (b::BINDING_MATERIALS, Buf(&materials_buf)),
+                (b::BINDING_LIGHTS, Buf(&lights_buf)),
+                (b::BINDING_MEDIUM, Buf(&medium_buf)),
+                (b::BINDING_DENSITY_GRID, Buf(&grid_buf)),
+                (b::BINDING_TRIANGLE_UVS, Buf(&uvs_buf)),
+                (
+                    b::BINDING_ALBEDO_TEXTURES,
+                    Texture(&albedo_textures.image, &albedo_textures.sampler),
+                ),
+                (b::BINDING_EMITTERS, Buf(&emitters_buf)),
+                (
+                    b::BINDING_ENVIRONMENT,
+                    Texture(&environment.image, &environment.sampler),
+                ),
+                (b::BINDING_ENVIRONMENT_DATA, Buf(&environment.data)),
+            ],
+        )?;
         // The load phases' costs (RUST_LOG=info): scripts/gltf-bench.sh reads them.
         log::info!(
             "scene on the device: world-space triangles {world_ms:.1} ms, BVH build {:.1} ms, upload {:.1} ms",

@@ -16,7 +16,7 @@ pub struct Accumulate {
 impl Accumulate {
     /// A history for frames the size of `radiance`.
     pub fn new(ctx: &Arc<Context>, radiance: &Image) -> VkResult<Self> {
-        let pass = ImageCompute::new(ctx, "passes/accumulate.comp", 2, 4)?;
+        let pass = ImageCompute::new(ctx, "passes/accumulate.comp", 4)?;
         let history = Image::new(
             ctx,
             "accumulated radiance",

@@ -41,7 +41,7 @@ use crate::passes::shadow::ShadowMaps;
 use crate::scene::Scene;
 use crate::shader_bindings as b;
 use crate::vk::{
-    groups_8x8, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    groups_8x8, Access, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
     FrameRecorder, Image, Sampler, VkResult,
 };
 use ash::vk;
@@ -90,14 +90,7 @@ impl Airlight {
         scene_gpu: &SceneGpu,
         shadows: &ShadowMaps,
     ) -> VkResult<Self> {
-        let layout = DescriptorSetLayout::new(
-            ctx,
-            &[
-                (b::AIRLIGHT_BINDING_RADIANCE, BindingKind::StorageImage),
-                (b::AIRLIGHT_BINDING_SHADOW_MAP, BindingKind::Sampled),
-                (b::AIRLIGHT_BINDING_SHADOW_LIGHTS, BindingKind::Uniform),
-            ],
-        )?;
+        let layout = DescriptorSetLayout::of_shaders(ctx, 1, &["passes/airlight.comp"])?;
         // Nearest: shadow.glsl fetches single texels and compares them itself.
         let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
         let set = DescriptorSet::new(ctx, &layout)?;

@@ -14,7 +14,7 @@ use crate::passes::gbuffer::GBuffer;
 use crate::passes::specular_gbuffer::{SpecularGBuffer, Viewpoint};
 use crate::shader_bindings as b;
 use crate::vk::{
-    groups_8x8, Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    groups_8x8, Access, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
     FrameRecorder, Image, VkResult,
 };
 use bytemuck::{Pod, Zeroable};
@@ -56,33 +56,7 @@ impl CameraRefraction {
         push: RefractionPush,
     ) -> VkResult<Self> {
         let gbuffer = SpecularGBuffer::new(ctx, &scene_gpu.layout, extent.width, extent.height)?;
-        let layout = DescriptorSetLayout::new(
-            ctx,
-            &[
-                (
-                    b::REFRACTION_BINDING_OPAQUE_RADIANCE,
-                    BindingKind::StorageImage,
-                ),
-                (
-                    b::REFRACTION_BINDING_OPAQUE_POSITION,
-                    BindingKind::StorageImage,
-                ),
-                (
-                    b::REFRACTION_BINDING_FRONT_POSITION,
-                    BindingKind::StorageImage,
-                ),
-                (
-                    b::REFRACTION_BINDING_FRONT_NORMAL,
-                    BindingKind::StorageImage,
-                ),
-                (
-                    b::REFRACTION_BINDING_BACK_POSITION,
-                    BindingKind::StorageImage,
-                ),
-                (b::REFRACTION_BINDING_BACK_NORMAL, BindingKind::StorageImage),
-                (b::REFRACTION_BINDING_RADIANCE, BindingKind::StorageImage),
-            ],
-        )?;
+        let layout = DescriptorSetLayout::of_shaders(ctx, 1, &["passes/camera_refraction.comp"])?;
         let set = DescriptorSet::new(ctx, &layout)?;
         let pipeline = ComputePipeline::new(
             ctx,

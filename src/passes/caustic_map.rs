@@ -76,7 +76,7 @@ use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::scene::{Light, LightKind};
 use crate::shader_bindings as b;
 use crate::vk::{
-    groups_8x8, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    groups_8x8, Access, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
     DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
     Sampler, Specialization, VkResult,
 };
@@ -281,15 +281,13 @@ impl CausticMap {
             (size_of::<GpuShadowLight>() * b::MAX_LIGHTS as usize) as u64,
             BufferUsage::Uniform,
         )?;
-        let layout = DescriptorSetLayout::new(
+        let layout = DescriptorSetLayout::of_shaders(
             ctx,
+            1,
             &[
-                (b::CAUSTIC_BINDING_PHOTONS, BindingKind::Storage),
-                (b::CAUSTIC_BINDING_VIEWS, BindingKind::Uniform),
-                (b::CAUSTIC_BINDING_FRONT_POSITION, BindingKind::StorageImage),
-                (b::CAUSTIC_BINDING_FRONT_NORMAL, BindingKind::StorageImage),
-                (b::CAUSTIC_BINDING_BACK_POSITION, BindingKind::StorageImage),
-                (b::CAUSTIC_BINDING_BACK_NORMAL, BindingKind::StorageImage),
+                "caustic_map/photons.comp",
+                "caustic_map/splat.vert",
+                "caustic_map/splat.frag",
             ],
         )?;
         let set = DescriptorSet::new(ctx, &layout)?;
@@ -311,17 +309,7 @@ impl CausticMap {
         desc.topology = vk::PrimitiveTopology::POINT_LIST;
         desc.push_size = size_of::<SplatPush>() as u32;
         let splat_pipeline = GraphicsPipeline::new(ctx, &desc, &[&scene_gpu.layout, &layout])?;
-        let apply_layout = DescriptorSetLayout::new(
-            ctx,
-            &[
-                (b::CAUSTIC_BINDING_VIEWS, BindingKind::Uniform),
-                (b::CAUSTIC_BINDING_MAP, BindingKind::Sampled),
-                (b::CAUSTIC_BINDING_POSITION, BindingKind::StorageImage),
-                (b::CAUSTIC_BINDING_NORMAL, BindingKind::StorageImage),
-                (b::CAUSTIC_BINDING_ALBEDO, BindingKind::StorageImage),
-                (b::CAUSTIC_BINDING_RADIANCE, BindingKind::StorageImage),
-            ],
-        )?;
+        let apply_layout = DescriptorSetLayout::of_shaders(ctx, 1, &["caustic_map/apply.comp"])?;
         let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
         let apply_set = DescriptorSet::new(ctx, &apply_layout)?;
         apply_set.write_buffer(b::CAUSTIC_BINDING_VIEWS, &views);

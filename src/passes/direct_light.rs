@@ -38,7 +38,7 @@ use crate::passes::shadow::ShadowMaps;
 use crate::scene::Scene;
 use crate::shader_bindings as b;
 use crate::vk::{
-    groups_8x8, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    groups_8x8, Access, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
     DescriptorSetLayout, FrameRecorder, Sampler, VkResult,
 };
 use ash::vk;
@@ -130,21 +130,11 @@ impl DirectLight {
             params.shadow_map_size,
         )?;
         let gbuffer = GBuffer::new(ctx, &scene_gpu.layout, width, height, contents)?;
-        let bindings = [
-            (b::DIRECT_BINDING_POSITION, BindingKind::StorageImage),
-            (b::DIRECT_BINDING_NORMAL, BindingKind::StorageImage),
-            (b::DIRECT_BINDING_ALBEDO, BindingKind::StorageImage),
-            (b::DIRECT_BINDING_RADIANCE, BindingKind::StorageImage),
-            (b::DIRECT_BINDING_SHADOW_MAP, BindingKind::Sampled),
-            (b::DIRECT_BINDING_SHADOW_LIGHTS, BindingKind::Uniform),
-            (b::DIRECT_BINDING_ENVIRONMENT_SH, BindingKind::Storage),
-        ];
-        let layout = DescriptorSetLayout::new(ctx, &bindings)?;
+        let layout = DescriptorSetLayout::of_shaders(ctx, 1, &["direct/lighting.comp"])?;
         // The environment projection's own set: the lighting set's image
         // bindings are declared by the lighting pass, which must be the
         // first to bind it in a frame.
-        let sh_layout =
-            DescriptorSetLayout::of(ctx, &bindings, &[b::DIRECT_BINDING_ENVIRONMENT_SH])?;
+        let sh_layout = DescriptorSetLayout::of_shaders(ctx, 1, &["direct/environment_sh.comp"])?;
         let sh = Buffer::new(
             ctx,
             "environment irradiance SH",

@@ -1,10 +1,8 @@
 //! A compute pass over storage images only (the tonemap, the still-view
-//! accumulation): its layout of `images` storage images at bindings
-//! 0..images, its pipeline and one set.
+//! accumulation): its layout (set 0, what its shader uses), its pipeline
+//! and one set.
 
-use crate::vk::{
-    BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, VkResult,
-};
+use crate::vk::{ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, VkResult};
 use std::sync::Arc;
 
 pub struct ImageCompute {
@@ -14,11 +12,8 @@ pub struct ImageCompute {
 }
 
 impl ImageCompute {
-    pub fn new(ctx: &Arc<Context>, shader: &str, images: u32, push_size: u32) -> VkResult<Self> {
-        let bindings: Vec<_> = (0..images)
-            .map(|b| (b, BindingKind::StorageImage))
-            .collect();
-        let layout = DescriptorSetLayout::new(ctx, &bindings)?;
+    pub fn new(ctx: &Arc<Context>, shader: &str, push_size: u32) -> VkResult<Self> {
+        let layout = DescriptorSetLayout::of_shaders(ctx, 0, &[shader])?;
         let pipeline = ComputePipeline::new(ctx, shader, &[&layout], push_size)?;
         let set = DescriptorSet::new(ctx, &layout)?;
         Ok(Self {

@@ -12,7 +12,7 @@ pub struct Tonemap {
 
 impl Tonemap {
     pub fn new(ctx: &Arc<Context>, radiance: &Image) -> VkResult<Self> {
-        let pass = ImageCompute::new(ctx, "passes/tonemap.comp", 2, 4)?;
+        let pass = ImageCompute::new(ctx, "passes/tonemap.comp", 4)?;
         let display = Image::new(
             ctx,
             "display (sRGB 8-bit)",

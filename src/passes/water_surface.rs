@@ -11,8 +11,8 @@ use crate::gpu::{GpuWaterVertex, GpuWave};
 use crate::scene::Water;
 use crate::shader_bindings as b;
 use crate::vk::{
-    Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
-    DescriptorSetLayout, FrameRecorder, VkResult,
+    Access, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    FrameRecorder, VkResult,
 };
 use bytemuck::{Pod, Zeroable};
 use std::mem::size_of;
@@ -46,13 +46,7 @@ pub struct WaterSurface {
 
 impl WaterSurface {
     pub fn new(ctx: &Arc<Context>, water: &Water) -> VkResult<Self> {
-        let layout = DescriptorSetLayout::new(
-            ctx,
-            &[
-                (b::WATER_SURFACE_BINDING_WAVES, BindingKind::Storage),
-                (b::WATER_SURFACE_BINDING_VERTICES, BindingKind::Storage),
-            ],
-        )?;
+        let layout = DescriptorSetLayout::of_shaders(ctx, 0, &["passes/water_surface.comp"])?;
         let pipeline = ComputePipeline::new(
             ctx,
             "passes/water_surface.comp",

@@ -7,7 +7,7 @@ use crate::frame::{FrameTargets, SceneGpu};
 use crate::radiometry::Component;
 use crate::shader_bindings as b;
 use crate::vk::{
-    groups_8x8, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    groups_8x8, Access, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
     DescriptorSetLayout, FrameRecorder, VkResult,
 };
 use bytemuck::{Pod, Zeroable};
@@ -135,23 +135,20 @@ impl Reference {
             anyhow::bail!("alpha must lie in (0, 1), got {}", settings.alpha);
         }
         let pixels = targets.width as u64 * targets.height as u64;
-        let storage = |binding| (binding, BindingKind::Storage);
-        let layout = DescriptorSetLayout::new(
+        // Every pass binds the one set: its layout is what the passes'
+        // shaders use.
+        let layout = DescriptorSetLayout::of_shaders(
             ctx,
+            1,
             &[
-                storage(b::REFERENCE_BINDING_TOTAL),
-                storage(b::REFERENCE_BINDING_PASS),
-                (b::REFERENCE_BINDING_RADIANCE, BindingKind::StorageImage),
-                storage(b::REFERENCE_BINDING_MOMENTS),
-                storage(b::REFERENCE_BINDING_VISIBLE_POINTS),
-                storage(b::REFERENCE_BINDING_SURFACE_HEADS),
-                storage(b::REFERENCE_BINDING_SURFACE_NEXT),
-                storage(b::REFERENCE_BINDING_VOLUME_PHOTONS),
-                storage(b::REFERENCE_BINDING_VOLUME_HEADS),
-                storage(b::REFERENCE_BINDING_VOLUME_NEXT),
-                storage(b::REFERENCE_BINDING_STATS),
-                storage(b::REFERENCE_BINDING_GATHER_POINTS),
-                storage(b::REFERENCE_BINDING_AIM_GUIDE),
+                "reference/trace.comp",
+                "reference/camera.comp",
+                "reference/volume_points.comp",
+                "reference/volume_gather.comp",
+                "reference/aim_guide.comp",
+                "reference/fold.comp",
+                "reference/noise.comp",
+                "reference/resolve.comp",
             ],
         )?;
         let sets = [&scene_gpu.layout, &layout];

@@ -17,7 +17,7 @@
 //!   such by the next) declares the difference with `step()`, and the
 //!   declaration goes with the one command that follows.
 
-use super::pass::Accesses;
+use super::sync::Accesses;
 use super::sync::{barrier, BufferAccess, ImageAccess};
 use super::{Access, Buffer, ComputePipeline, Context, DescriptorSet, GraphicsPipeline, Image};
 use ash::vk;

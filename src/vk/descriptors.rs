@@ -1,32 +1,17 @@
 //! Descriptor set layouts and sets, and samplers. Bindings are declared by
 //! number (constants shared with GLSL through `shader_bindings.rs` or a
 //! technique's `bindings.rs`), never by call order; image bindings are
-//! written by the passes' declarations (`pass.rs`).
+//! written by the passes' declarations (`pass.rs`). No caller lists a
+//! layout's bindings: a layout is what its shaders use
+//! (`DescriptorSetLayout::of_shaders`, reflected by `reflect.rs`) or what a
+//! set made whole is given (`DescriptorSet::of_resources`).
 
+use super::reflect::BindingKind;
 use super::{Buffer, Context, Image, VkResult};
 use ash::vk;
 use std::cell::{Cell, RefCell};
+use std::collections::BTreeMap;
 use std::sync::Arc;
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BindingKind {
-    Uniform,
-    Storage,
-    StorageImage,
-    /// Combined image sampler.
-    Sampled,
-}
-
-impl BindingKind {
-    pub(super) fn descriptor_type(self) -> vk::DescriptorType {
-        match self {
-            BindingKind::Uniform => vk::DescriptorType::UNIFORM_BUFFER,
-            BindingKind::Storage => vk::DescriptorType::STORAGE_BUFFER,
-            BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
-            BindingKind::Sampled => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-        }
-    }
-}
 
 pub struct DescriptorSetLayout {
     ctx: Arc<Context>,
@@ -37,7 +22,7 @@ pub struct DescriptorSetLayout {
 impl DescriptorSetLayout {
     /// Every binding is visible to all stages: sets are shared between compute
     /// and graphics passes, and the cost of wide stage masks is nil.
-    pub fn new(ctx: &Arc<Context>, bindings: &[(u32, BindingKind)]) -> VkResult<Self> {
+    fn new(ctx: &Arc<Context>, bindings: &[(u32, BindingKind)]) -> VkResult<Self> {
         let raw_bindings: Vec<_> = bindings
             .iter()
             .map(|&(binding, kind)| {
@@ -59,20 +44,27 @@ impl DescriptorSetLayout {
 }
 
 impl DescriptorSetLayout {
-    /// A layout of the bindings of `all` that `used` names: one pass's set.
-    /// A set's layout holds exactly what its pass's shaders use and its
-    /// declaration binds (lavapipe reads every binding of a bound set, so
-    /// an unwritten one would crash it).
-    pub fn of(ctx: &Arc<Context>, all: &[(u32, BindingKind)], used: &[u32]) -> VkResult<Self> {
-        let picked: Vec<_> = used
-            .iter()
-            .map(|&u| {
-                *all.iter()
-                    .find(|(b, _)| *b == u)
-                    .unwrap_or_else(|| panic!("binding {u} is not in the list"))
-            })
-            .collect();
-        Self::new(ctx, &picked)
+    /// The layout of descriptor set `set` as `shaders` (paths under
+    /// `glsl/`) use it: the union of the bindings their SPIR-V uses
+    /// (`reflect.rs`), so the shaders are the one list of a set's bindings.
+    /// The shaders that share a set must agree on each binding's kind.
+    pub fn of_shaders(ctx: &Arc<Context>, set: u32, shaders: &[&str]) -> VkResult<Self> {
+        let mut union: BTreeMap<u32, (BindingKind, &str)> = BTreeMap::new();
+        for &name in shaders {
+            let used = super::reflect::bindings(&crate::shaders::spirv(name))
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            for b in used.into_iter().filter(|b| b.set == set) {
+                let (kind, first) = *union.entry(b.binding).or_insert((b.kind, name));
+                assert!(
+                    kind == b.kind,
+                    "set {set} binding {}: {kind:?} in {first} but {:?} in {name}",
+                    b.binding,
+                    b.kind
+                );
+            }
+        }
+        let bindings: Vec<_> = union.into_iter().map(|(b, (k, _))| (b, k)).collect();
+        Self::new(ctx, &bindings)
     }
 }
 
@@ -138,7 +130,52 @@ pub struct DescriptorSet {
     pub(super) bound_in: Cell<u64>,
 }
 
+/// What a binding of a set made whole by `DescriptorSet::of_resources`
+/// points at.
+pub enum SetResource<'a> {
+    /// A uniform or storage buffer: its kind is its usage's.
+    Buffer(&'a Buffer),
+    /// An uploaded texture and its sampler (`write_static_texture`).
+    Texture(&'a Image, &'a Sampler),
+}
+
 impl DescriptorSet {
+    /// A set whose every binding is fixed when it is made (the scene's),
+    /// with its layout: the bindings are `resources`, each named once, on
+    /// the line that gives its resource.
+    pub fn of_resources(
+        ctx: &Arc<Context>,
+        resources: &[(u32, SetResource)],
+    ) -> VkResult<(DescriptorSetLayout, DescriptorSet)> {
+        let bindings: Vec<_> = resources
+            .iter()
+            .map(|(binding, resource)| {
+                let kind = match resource {
+                    SetResource::Buffer(buffer) => match buffer.usage {
+                        super::BufferUsage::Uniform => BindingKind::Uniform,
+                        super::BufferUsage::Storage | super::BufferUsage::StorageIndirect => {
+                            BindingKind::Storage
+                        }
+                        other => panic!("binding {binding}: a {other:?} buffer cannot be bound"),
+                    },
+                    SetResource::Texture(..) => BindingKind::Sampled,
+                };
+                (*binding, kind)
+            })
+            .collect();
+        let layout = DescriptorSetLayout::new(ctx, &bindings)?;
+        let set = DescriptorSet::new(ctx, &layout)?;
+        for (binding, resource) in resources {
+            match resource {
+                SetResource::Buffer(buffer) => set.write_buffer(*binding, buffer),
+                SetResource::Texture(image, sampler) => {
+                    set.write_static_texture(*binding, image, sampler)
+                }
+            };
+        }
+        Ok((layout, set))
+    }
+
     pub fn new(ctx: &Arc<Context>, layout: &DescriptorSetLayout) -> VkResult<Self> {
         let sizes: Vec<_> = layout
             .bindings

@@ -28,6 +28,7 @@ mod pipeline;
 mod pipeline_create;
 mod pipeline_store;
 mod profiler;
+mod reflect;
 mod resources;
 mod ring;
 mod swapchain;
@@ -35,7 +36,7 @@ mod sync;
 
 pub use commands::{Commands, Rendering, Step};
 pub use context::{Context, ContextOptions, ValidationCounts};
-pub use descriptors::{BindingKind, DescriptorSet, DescriptorSetLayout, Sampler};
+pub use descriptors::{DescriptorSet, DescriptorSetLayout, Sampler, SetResource};
 pub use device::{DeviceInfo, RequiredFeature};
 pub use frame::{
     FrameOptions, FrameRecorder, FrameSync, FrameTiming, Frames, PassTiming, TimingSource,
@@ -45,7 +46,7 @@ pub use host_memory::{rust_heap, vulkan_host_memory, CountingAllocator, HostCoun
 pub use image::{Image, ImageDesc};
 pub use limits::{bytes, host_rss, trim_host_heap, MemoryHeaps, MemoryReport};
 pub use objects::{CommandPool, Semaphores};
-pub use pass::{Pass, Resource};
+pub use pass::Pass;
 pub use pipeline::{groups_8x8, ComputePipeline, GraphicsPipeline};
 pub use pipeline_store::{
     CacheLoad, GraphicsPipelineDesc, PipelineCounts, PipelineStore, Specialization,
@@ -53,7 +54,7 @@ pub use pipeline_store::{
 pub use profiler::Profiler;
 pub use resources::{Buffer, BufferUsage};
 pub use swapchain::{Acquired, Surface, Swapchain};
-pub use sync::Access;
+pub use sync::{Access, Resource};
 use sync::{BufferAccess, ImageAccess};
 
 pub use ash::vk;

@@ -270,3 +270,109 @@ pub fn barrier(
         .buffer_memory_barriers(&buffer_barriers);
     unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
 }
+
+/// An image or a buffer, as a pass declares it.
+#[derive(Clone, Copy)]
+pub enum Resource<'a> {
+    Image(&'a Image),
+    Buffer(&'a Buffer),
+}
+
+impl<'a> From<&'a Image> for Resource<'a> {
+    fn from(image: &'a Image) -> Self {
+        Resource::Image(image)
+    }
+}
+
+impl<'a> From<&'a Buffer> for Resource<'a> {
+    fn from(buffer: &'a Buffer) -> Self {
+        Resource::Buffer(buffer)
+    }
+}
+
+/// The accesses one step declares, turned into one barrier.
+#[derive(Default)]
+pub struct Accesses<'a> {
+    images: Vec<ImageAccess<'a>>,
+    buffers: Vec<BufferAccess<'a>>,
+}
+
+impl<'a> Accesses<'a> {
+    /// Adds one access; the same access to the same resource again (one
+    /// image bound through several views, as a mip chain's levels are)
+    /// adds nothing, so the barrier, emitted again before each later
+    /// command of the pass, holds each resource once.
+    fn add(&mut self, resource: Resource<'a>, access: Access, discard: bool) {
+        match resource {
+            Resource::Image(image) => {
+                let same = |a: &ImageAccess| {
+                    a.image.raw == image.raw && a.next == access && a.discard == discard
+                };
+                if !self.images.iter().any(same) {
+                    self.images.push(if discard {
+                        ImageAccess::discard(image, access)
+                    } else {
+                        ImageAccess::new(image, access)
+                    });
+                }
+            }
+            Resource::Buffer(buffer) => {
+                assert!(!discard, "only an image's contents can be discarded");
+                let same = |a: &BufferAccess| a.buffer.raw == buffer.raw && a.next == access;
+                if !self.buffers.iter().any(same) {
+                    self.buffers.push(BufferAccess::new(buffer, access));
+                }
+            }
+        }
+    }
+
+    pub(super) fn read(&mut self, resource: Resource<'a>, access: Access) {
+        assert!(
+            !access.is_write(),
+            "read declared with the writing access {access:?}"
+        );
+        self.add(resource, access, false);
+    }
+
+    pub(super) fn write(&mut self, resource: Resource<'a>, access: Access, discard: bool) {
+        assert!(
+            access.is_write(),
+            "write declared with the read-only access {access:?}"
+        );
+        self.add(resource, access, discard);
+    }
+
+    pub(super) fn emit(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        barrier(ctx, cmd, &self.images, &self.buffers);
+    }
+
+    /// The declaration again, keeping every image's contents, with `step`'s
+    /// accesses in place of it for the resources `step` names.
+    pub(super) fn emit_kept(&self, ctx: &Context, cmd: vk::CommandBuffer, step: Option<&Accesses>) {
+        let step_images = step.map_or(&[][..], |s| &s.images[..]);
+        let step_buffers = step.map_or(&[][..], |s| &s.buffers[..]);
+        let images: Vec<ImageAccess> = self
+            .images
+            .iter()
+            .filter(|a| step_images.iter().all(|s| s.image.raw != a.image.raw))
+            .map(|a| ImageAccess::new(a.image, a.next))
+            .chain(
+                step_images
+                    .iter()
+                    .map(|s| ImageAccess::new(s.image, s.next)),
+            )
+            .collect();
+        let buffers: Vec<BufferAccess> = self
+            .buffers
+            .iter()
+            .filter(|a| step_buffers.iter().all(|s| s.buffer.raw != a.buffer.raw))
+            .map(|a| BufferAccess::new(a.buffer, a.next))
+            .chain(
+                step_buffers
+                    .iter()
+                    .map(|s| BufferAccess::new(s.buffer, s.next)),
+            )
+            .collect();
+        barrier(ctx, cmd, &images, &buffers);
+    }
+}

@@ -25,7 +25,7 @@ use caustics::gpu::GpuTriangle;
 use caustics::scene::Scene;
 use caustics::shader_bindings as b;
 use caustics::vk::{
-    Access, BindingKind, Buffer, BufferUsage, ComputePipeline, DescriptorSet, DescriptorSetLayout,
+    Access, Buffer, BufferUsage, ComputePipeline, DescriptorSet, DescriptorSetLayout,
 };
 use common::*;
 use glam::Vec3;
@@ -134,15 +134,7 @@ fn check(path: &str, scene: Scene, seed: u64) {
     let (lo, hi) = scene.bounds(0.0);
     let rays = make_rays(&tris, lo, hi, seed);
 
-    let layout = DescriptorSetLayout::new(
-        &ctx,
-        &[
-            (b::PROBE_BINDING_RAYS, BindingKind::Storage),
-            (b::PROBE_BINDING_RESULTS, BindingKind::Storage),
-            (b::PROBE_BINDING_ANY, BindingKind::Storage),
-        ],
-    )
-    .unwrap();
+    let layout = DescriptorSetLayout::of_shaders(&ctx, 1, &["tests/bvh_probe.comp"]).unwrap();
     let pipeline = ComputePipeline::new(
         &ctx,
         "tests/bvh_probe.comp",

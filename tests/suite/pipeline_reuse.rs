@@ -12,8 +12,8 @@ use caustics::scene::Scene;
 use caustics::shader_bindings as b;
 use caustics::techniques;
 use caustics::vk::{
-    BindingKind, Buffer, BufferUsage, CacheLoad, ComputePipeline, Context, DescriptorSet,
-    DescriptorSetLayout, Specialization,
+    Buffer, BufferUsage, CacheLoad, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    Specialization,
 };
 use std::path::Path;
 use std::sync::Arc;
@@ -164,9 +164,12 @@ struct Probe {
 impl Probe {
     fn new(ctx: &Arc<Context>, factor: u32) -> Probe {
         // A new set layout each time, as a rebuilt technique makes.
-        let layout =
-            DescriptorSetLayout::new(ctx, &[(b::PROBE_BINDING_RESULTS, BindingKind::Storage)])
-                .unwrap();
+        let layout = DescriptorSetLayout::of_shaders(
+            ctx,
+            0,
+            &["tests/specialization.comp", "tests/ccm_distribution.comp"],
+        )
+        .unwrap();
         let scaled = ComputePipeline::specialized(
             ctx,
             "tests/specialization.comp",

@@ -18,7 +18,7 @@ use crate::passes::surface_frame::SurfaceFrame;
 use crate::radiometry::luminance;
 use crate::scene::{Density, Light, LightKind, Scene};
 use crate::vk::{
-    groups_8x8, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    groups_8x8, Access, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
     DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
     VkResult, MAX_FRAMES_IN_FLIGHT,
 };
@@ -355,64 +355,26 @@ impl BeamTracer {
         let volume = target("beam volume caustics")?;
         let surface_target = target("beam surface flux")?;
         let surface_filtered = target("beam surface flux, filtered in x")?;
-        use BindingKind::{Storage, StorageImage};
-        let all = [
-            (bb::BEAMS_BINDING_TRIANGLES_A, Storage),
-            (bb::BEAMS_BINDING_TRIANGLES_B, Storage),
-            (bb::BEAMS_BINDING_BEAMS, Storage),
-            (bb::BEAMS_BINDING_COUNTERS, Storage),
-            (bb::BEAMS_BINDING_INDIRECT, Storage),
-            (bb::BEAMS_BINDING_FRONT_POSITION, StorageImage),
-            (bb::BEAMS_BINDING_FRONT_NORMAL, StorageImage),
-            (bb::BEAMS_BINDING_BACK_POSITION, StorageImage),
-            (bb::BEAMS_BINDING_BACK_NORMAL, StorageImage),
-            (bb::BEAMS_BINDING_OPAQUE_POSITION, StorageImage),
-            (bb::BEAMS_BINDING_OPAQUE_NORMAL, StorageImage),
-            (bb::BEAMS_BINDING_OPAQUE_ALBEDO, StorageImage),
-            (bb::BEAMS_BINDING_SPECULAR_POSITION, StorageImage),
-            (bb::BEAMS_BINDING_RECEIVERS, Storage),
-            (bb::BEAMS_BINDING_VOLUME, StorageImage),
-            (bb::BEAMS_BINDING_SURFACE, StorageImage),
-            (bb::BEAMS_BINDING_OPAQUE_RADIANCE, StorageImage),
-            (bb::BEAMS_BINDING_RADIANCE, StorageImage),
-            (bb::BEAMS_BINDING_SURFACE_FILTERED, StorageImage),
-        ];
-        // One set (and layout) per group of passes: each pass declares its
-        // image bindings (`vk/pass.rs`), and a set holds only what its
-        // shaders use; the buffers are written into every set that has them.
-        let layout_of = |used: &[u32]| DescriptorSetLayout::of(ctx, &all, used);
+        // One set (and layout) per group of passes, holding what the
+        // group's shaders use (reflected from their SPIR-V); each pass
+        // declares its image bindings (`vk/pass.rs`), and the buffers are
+        // written into every set that has them.
+        let layout_of = |shaders: &[&str]| DescriptorSetLayout::of_shaders(ctx, 1, shaders);
         let layouts = BeamLayouts {
-            receivers: layout_of(&[
-                bb::BEAMS_BINDING_OPAQUE_NORMAL,
-                bb::BEAMS_BINDING_OPAQUE_POSITION,
-                bb::BEAMS_BINDING_SPECULAR_POSITION,
-                bb::BEAMS_BINDING_RECEIVERS,
-            ])?,
+            receivers: layout_of(&["beams/receivers.comp"])?,
             beams: layout_of(&[
-                bb::BEAMS_BINDING_FRONT_POSITION,
-                bb::BEAMS_BINDING_FRONT_NORMAL,
-                bb::BEAMS_BINDING_BACK_POSITION,
-                bb::BEAMS_BINDING_BACK_NORMAL,
-                bb::BEAMS_BINDING_TRIANGLES_A,
-                bb::BEAMS_BINDING_TRIANGLES_B,
-                bb::BEAMS_BINDING_BEAMS,
-                bb::BEAMS_BINDING_COUNTERS,
-                bb::BEAMS_BINDING_INDIRECT,
-                bb::BEAMS_BINDING_RECEIVERS,
+                "beams/refine.comp",
+                "beams/args.comp",
+                "beams/volume.vert",
+                "beams/volume.geom",
+                "beams/volume.frag",
+                "beams/volume_homogeneous.frag",
+                "beams/caustic.geom",
+                "beams/caustic.frag",
             ])?,
-            filter: layout_of(&[
-                bb::BEAMS_BINDING_RECEIVERS,
-                bb::BEAMS_BINDING_SURFACE,
-                bb::BEAMS_BINDING_SURFACE_FILTERED,
-            ])?,
-            apply: layout_of(&[
-                bb::BEAMS_BINDING_OPAQUE_ALBEDO,
-                bb::BEAMS_BINDING_OPAQUE_NORMAL,
-                bb::BEAMS_BINDING_OPAQUE_POSITION,
-                bb::BEAMS_BINDING_OPAQUE_RADIANCE,
-                bb::BEAMS_BINDING_SURFACE,
-            ])?,
-            composite: layout_of(&[bb::BEAMS_BINDING_VOLUME, bb::BEAMS_BINDING_RADIANCE])?,
+            filter: layout_of(&["beams/filter.comp"])?,
+            apply: layout_of(&["beams/apply.comp"])?,
+            composite: layout_of(&["beams/composite.comp"])?,
         };
         let buffers = [
             (bb::BEAMS_BINDING_TRIANGLES_A, &triangles[0]),

@@ -64,7 +64,7 @@ use crate::radiometry::Component;
 use crate::scene::{EnvironmentKind, Scene};
 use crate::shader_bindings as sb;
 use crate::vk::{
-    groups_8x8, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    groups_8x8, Access, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
     DescriptorSetLayout, FrameRecorder, Image, ImageDesc, Sampler, VkResult,
 };
 use ash::vk;
@@ -223,42 +223,21 @@ impl Pinhole {
             },
             levels,
         )?;
-        use BindingKind::{Sampled, Storage, StorageImage};
-        let all = [
-            (b::PINHOLE_BINDING_SAMPLES, Storage),
-            (b::PINHOLE_BINDING_STATE, Storage),
-            (b::PINHOLE_BINDING_CDF, Storage),
-            (b::PINHOLE_BINDING_CANDIDATES, Storage),
-            (b::PINHOLE_BINDING_HEADS, Storage),
-            (b::PINHOLE_BINDING_NEXT, Storage),
-            (b::PINHOLE_BINDING_LIGHT_MAP_LEVEL0, StorageImage),
-            (b::PINHOLE_BINDING_LIGHT_MAP, Sampled),
-            (b::PINHOLE_BINDING_POSITION, StorageImage),
-            (b::PINHOLE_BINDING_NORMAL, StorageImage),
-            (b::PINHOLE_BINDING_ALBEDO, StorageImage),
-            (b::PINHOLE_BINDING_RADIANCE, StorageImage),
-        ];
-        // One set (and layout) per group of passes: the sampling passes'
-        // buffers (glsl/pinhole/common.glsl) in all of them, plus the images
-        // the light-map and receiver passes declare (`vk/pass.rs`).
-        let buffer_ids = all
-            .iter()
-            .filter(|(_, kind)| *kind == Storage)
-            .map(|&(id, _)| id);
-        let with_images = |images: &[u32]| {
-            let used: Vec<u32> = buffer_ids.clone().chain(images.iter().copied()).collect();
-            DescriptorSetLayout::of(ctx, &all, &used)
-        };
+        // One set (and layout) per group of passes, holding what the
+        // group's shaders use: the sampling passes' buffers
+        // (glsl/pinhole/common.glsl), the images the light-map and receiver
+        // passes declare (`vk/pass.rs`).
+        let layout_of = |shaders: &[&str]| DescriptorSetLayout::of_shaders(ctx, 1, shaders);
         let layouts = [
-            with_images(&[])?,
-            with_images(&[b::PINHOLE_BINDING_LIGHT_MAP_LEVEL0])?,
-            with_images(&[
-                b::PINHOLE_BINDING_LIGHT_MAP,
-                b::PINHOLE_BINDING_POSITION,
-                b::PINHOLE_BINDING_NORMAL,
-                b::PINHOLE_BINDING_ALBEDO,
-                b::PINHOLE_BINDING_RADIANCE,
+            layout_of(&[
+                "pinhole/areas.comp",
+                "pinhole/candidates.comp",
+                "pinhole/select.comp",
+                "pinhole/gradients.comp",
+                "pinhole/clusters.comp",
             ])?,
+            layout_of(&["pinhole/light_maps.comp"])?,
+            layout_of(&["pinhole/receivers.comp"])?,
         ];
         let sampler = Sampler::trilinear_clamp(ctx)?;
         let buffers = [
@@ -279,13 +258,7 @@ impl Pinhole {
             new_set(&layouts[1])?,
             new_set(&layouts[2])?,
         );
-        let mip_layout = DescriptorSetLayout::new(
-            ctx,
-            &[
-                (b::PINHOLE_MIP_BINDING_SRC, BindingKind::StorageImage),
-                (b::PINHOLE_MIP_BINDING_DST, BindingKind::StorageImage),
-            ],
-        )?;
+        let mip_layout = DescriptorSetLayout::of_shaders(ctx, 1, &["pinhole/mips.comp"])?;
         let mip_sets = (1..levels)
             .map(|_| DescriptorSet::new(ctx, &mip_layout))
             .collect::<VkResult<Vec<_>>>()?;

@@ -10,7 +10,7 @@ use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::passes::surface_frame::SurfaceFrame;
 use crate::scene::{Density, Scene};
 use crate::vk::{
-    groups_8x8, Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    groups_8x8, Access, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
     DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
     VkResult,
 };
@@ -134,55 +134,20 @@ impl VolumeRays {
             ),
         )?;
         use bindings as vb;
-        use BindingKind::{Storage, StorageImage};
-        let all = [
-            (vb::VOLUME_LINES_BINDING_SEGMENTS, Storage),
-            (vb::VOLUME_LINES_BINDING_FRONT_POSITION, StorageImage),
-            (vb::VOLUME_LINES_BINDING_FRONT_NORMAL, StorageImage),
-            (vb::VOLUME_LINES_BINDING_BACK_POSITION, StorageImage),
-            (vb::VOLUME_LINES_BINDING_BACK_NORMAL, StorageImage),
-            (vb::VOLUME_LINES_BINDING_VISIBILITY, Storage),
-            (vb::VOLUME_LINES_BINDING_OPAQUE_POSITION, StorageImage),
-            (vb::VOLUME_LINES_BINDING_SPECULAR_POSITION, StorageImage),
-            (vb::VOLUME_LINES_BINDING_VOLUME, StorageImage),
-            (vb::VOLUME_LINES_BINDING_RADIANCE, StorageImage),
-        ];
-        // One set (and layout) per group of passes: each pass declares its
-        // own image bindings (`vk/pass.rs`), and a set holds only what its
-        // shaders use.
+        // One set (and layout) per group of passes, holding what the
+        // group's shaders use: each pass declares its own image bindings
+        // (`vk/pass.rs`).
+        let layout_of = |shaders: &[&str]| DescriptorSetLayout::of_shaders(ctx, 1, shaders);
         let layouts = [
-            // "volume visibility"
-            DescriptorSetLayout::of(
-                ctx,
-                &all,
-                &[
-                    vb::VOLUME_LINES_BINDING_OPAQUE_POSITION,
-                    vb::VOLUME_LINES_BINDING_SPECULAR_POSITION,
-                    vb::VOLUME_LINES_BINDING_VISIBILITY,
-                ],
-            )?,
-            // "volume segments" and "volume lines"
-            DescriptorSetLayout::of(
-                ctx,
-                &all,
-                &[
-                    vb::VOLUME_LINES_BINDING_FRONT_POSITION,
-                    vb::VOLUME_LINES_BINDING_FRONT_NORMAL,
-                    vb::VOLUME_LINES_BINDING_BACK_POSITION,
-                    vb::VOLUME_LINES_BINDING_BACK_NORMAL,
-                    vb::VOLUME_LINES_BINDING_SEGMENTS,
-                    vb::VOLUME_LINES_BINDING_VISIBILITY,
-                ],
-            )?,
-            // "volume composite"
-            DescriptorSetLayout::of(
-                ctx,
-                &all,
-                &[
-                    vb::VOLUME_LINES_BINDING_VOLUME,
-                    vb::VOLUME_LINES_BINDING_RADIANCE,
-                ],
-            )?,
+            layout_of(&["volume_lines/visibility.comp"])?,
+            layout_of(&[
+                "volume_lines/segments.comp",
+                "volume_lines/lines.vert",
+                "volume_lines/lines.geom",
+                "volume_lines/lines.frag",
+                "volume_lines/lines_heterogeneous.frag",
+            ])?,
+            layout_of(&["volume_lines/composite.comp"])?,
         ];
         let buffers = [
             (vb::VOLUME_LINES_BINDING_SEGMENTS, &segments),

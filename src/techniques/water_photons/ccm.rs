@@ -9,8 +9,8 @@ use super::bindings;
 use crate::passes::water_surface::WaterSurface;
 use crate::scene::Water;
 use crate::vk::{
-    Access, BindingKind, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder,
-    GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, VkResult,
+    Access, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
+    GraphicsPipelineDesc, Image, ImageDesc, VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -65,9 +65,10 @@ impl Ccm {
             "ccm depth",
             desc(DEPTH_FORMAT, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT),
         )?;
-        let layout = DescriptorSetLayout::new(
+        let layout = DescriptorSetLayout::of_shaders(
             ctx,
-            &[(bindings::WP_BINDING_WATER_VERTICES, BindingKind::Storage)],
+            0,
+            &["water_photons/ccm.vert", "water_photons/ccm.frag"],
         )?;
         let set = DescriptorSet::new(ctx, &layout)?;
         set.write_buffer(bindings::WP_BINDING_WATER_VERTICES, &surface.vertices);

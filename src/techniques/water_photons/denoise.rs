@@ -49,8 +49,8 @@ use super::bindings;
 use crate::radiometry::luminance;
 use crate::scene::{Camera, Light, LightKind, Scene};
 use crate::vk::{
-    Access, BindingKind, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
-    FrameRecorder, Image, ImageDesc, Profiler, TimingSource,
+    Access, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, Image,
+    ImageDesc, Profiler, TimingSource,
 };
 use anyhow::{bail, ensure, Context as _};
 use ash::vk;
@@ -220,17 +220,7 @@ impl Denoiser {
             position.desc.width,
             position.desc.height
         );
-        let layout = DescriptorSetLayout::new(
-            ctx,
-            &[
-                (bindings::DENOISE_BINDING_INPUT, BindingKind::StorageImage),
-                (bindings::DENOISE_BINDING_OUTPUT, BindingKind::StorageImage),
-                (
-                    bindings::DENOISE_BINDING_POSITION,
-                    BindingKind::StorageImage,
-                ),
-            ],
-        )?;
+        let layout = DescriptorSetLayout::of_shaders(ctx, 0, &["water_photons/denoise.comp"])?;
         let pipeline = ComputePipeline::new(
             ctx,
             "water_photons/denoise.comp",

@@ -17,9 +17,9 @@ use super::WpParamsBuffer;
 use crate::frame::SceneGpu;
 use crate::passes::gbuffer::{GBuffer, DEPTH_FORMAT};
 use crate::vk::{
-    groups_8x8, Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet,
-    DescriptorSetLayout, FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc,
-    Sampler, Specialization, VkResult,
+    groups_8x8, Access, Buffer, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    FrameRecorder, GraphicsPipeline, GraphicsPipelineDesc, Image, ImageDesc, Sampler,
+    Specialization, VkResult,
 };
 use ash::vk;
 use std::sync::Arc;
@@ -57,13 +57,10 @@ impl Splat {
                     | vk::ImageUsageFlags::SAMPLED,
             ),
         )?;
-        let layout = DescriptorSetLayout::new(
+        let layout = DescriptorSetLayout::of_shaders(
             ctx,
-            &[
-                (bindings::WP_BINDING_PARAMS, BindingKind::Uniform),
-                (bindings::WP_BINDING_PHOTONS, BindingKind::Storage),
-                (bindings::WP_BINDING_GBUFFER_NORMAL, BindingKind::Sampled),
-            ],
+            1,
+            &["water_photons/splat.vert", "water_photons/splat.frag"],
         )?;
         // Nearest: splat.frag fetches the G-buffer texel under the fragment.
         let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
@@ -136,25 +133,7 @@ pub struct Composite {
 
 impl Composite {
     pub fn new(ctx: &Arc<Context>, scene_gpu: &SceneGpu) -> VkResult<Self> {
-        let layout = DescriptorSetLayout::new(
-            ctx,
-            &[
-                (bindings::WP_BINDING_CAUSTICS, BindingKind::StorageImage),
-                (
-                    bindings::WP_BINDING_GBUFFER_POSITION,
-                    BindingKind::StorageImage,
-                ),
-                (
-                    bindings::WP_BINDING_GBUFFER_NORMAL,
-                    BindingKind::StorageImage,
-                ),
-                (
-                    bindings::WP_BINDING_GBUFFER_ALBEDO,
-                    BindingKind::StorageImage,
-                ),
-                (bindings::WP_BINDING_RADIANCE, BindingKind::StorageImage),
-            ],
-        )?;
+        let layout = DescriptorSetLayout::of_shaders(ctx, 1, &["water_photons/composite.comp"])?;
         let set = DescriptorSet::new(ctx, &layout)?;
         let pipeline = ComputePipeline::new(
             ctx,

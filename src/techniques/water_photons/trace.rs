@@ -14,8 +14,8 @@ use super::cascades::CascadeLayout;
 use super::WpParamsBuffer;
 use crate::frame::SceneGpu;
 use crate::vk::{
-    Access, BindingKind, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
-    DescriptorSetLayout, FrameRecorder, Image, ImageDesc, VkResult, MAX_FRAMES_IN_FLIGHT,
+    Access, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    FrameRecorder, Image, ImageDesc, VkResult, MAX_FRAMES_IN_FLIGHT,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -139,17 +139,7 @@ impl Trace {
                 usage: vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_DST,
             },
         )?;
-        let layout = DescriptorSetLayout::new(
-            ctx,
-            &[
-                (bindings::WP_BINDING_PARAMS, BindingKind::Uniform),
-                (bindings::WP_BINDING_CCM_POSITION, BindingKind::StorageImage),
-                (bindings::WP_BINDING_CCM_NORMAL, BindingKind::StorageImage),
-                (bindings::WP_BINDING_PHOTONS, BindingKind::Storage),
-                (bindings::WP_BINDING_DRAW, BindingKind::Storage),
-                (bindings::WP_BINDING_PHOTON_SLOTS, BindingKind::StorageImage),
-            ],
-        )?;
+        let layout = DescriptorSetLayout::of_shaders(ctx, 1, &["water_photons/trace.comp"])?;
         let set = DescriptorSet::new(ctx, &layout)?;
         set.write_buffer(bindings::WP_BINDING_PARAMS, &params.0)
             .write_buffer(bindings::WP_BINDING_PHOTONS, &photons)

@@ -16,8 +16,8 @@ use crate::frame::{FrameTargets, SceneGpu};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::vk::{
-    groups_8x8, Access, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet,
-    DescriptorSetLayout, FrameRecorder, Image, Specialization, VkResult,
+    groups_8x8, Access, Buffer, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
+    FrameRecorder, Image, Specialization, VkResult,
 };
 use std::sync::Arc;
 
@@ -35,32 +35,7 @@ impl WaterView {
         photons: &Buffer,
         specialization: &Specialization,
     ) -> VkResult<Self> {
-        let layout = DescriptorSetLayout::new(
-            ctx,
-            &[
-                (bindings::WP_BINDING_PARAMS, BindingKind::Uniform),
-                (bindings::WP_BINDING_PHOTONS, BindingKind::Storage),
-                (bindings::WP_BINDING_PHOTON_SLOTS, BindingKind::StorageImage),
-                (
-                    bindings::WP_BINDING_OPAQUE_RADIANCE,
-                    BindingKind::StorageImage,
-                ),
-                (
-                    bindings::WP_BINDING_GBUFFER_POSITION,
-                    BindingKind::StorageImage,
-                ),
-                (
-                    bindings::WP_BINDING_FRONT_POSITION,
-                    BindingKind::StorageImage,
-                ),
-                (bindings::WP_BINDING_FRONT_NORMAL, BindingKind::StorageImage),
-                (
-                    bindings::WP_BINDING_BACK_POSITION,
-                    BindingKind::StorageImage,
-                ),
-                (bindings::WP_BINDING_RADIANCE, BindingKind::StorageImage),
-            ],
-        )?;
+        let layout = DescriptorSetLayout::of_shaders(ctx, 1, &["water_photons/view.comp"])?;
         let set = DescriptorSet::new(ctx, &layout)?;
         set.write_buffer(bindings::WP_BINDING_PARAMS, &params.0)
             .write_buffer(bindings::WP_BINDING_PHOTONS, photons);
