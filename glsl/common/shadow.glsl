@@ -17,7 +17,10 @@
 // Both scale with the texel, so fully lit surfaces are exactly lit (every
 // tap passes) at any shadow map size, and light leaks only within about one
 // texel of contact points, i.e. well under a pixel at 256² output with the
-// default 1024² maps.
+// default 1024² maps. The bias also lights a receiver whose occluder is
+// nearer the light by less than it (tan theta large: a wall just under the
+// water's surface, bias up to 30 texels); `shadow_visibility_band` reports
+// those taps so that a pass with the BVH can ask a ray (direct lighting).
 #ifndef COMMON_SHADOW_GLSL
 #define COMMON_SHADOW_GLSL
 
@@ -72,7 +75,12 @@ float shadow_texel_world(ShadowLight s, vec3 x) {
 // is lit, 0 exactly where every tap is shadowed. n: unit normal on the lit
 // side, to_light: unit direction toward the light. Points outside the
 // light's maps (outside a spot's cone, outside the scene sphere) count as lit.
-float shadow_visibility(uint l, vec3 x, vec3 n, vec3 to_light, int pcf) {
+// `band`: the fraction of the taps counted lit only by the bias, their
+// occluder nearer the light than x by less than it. The map cannot tell
+// such an occluder (the water's surface just above a wall under it) from
+// x's own surface; one ray can (lighting.comp's shadow_visibility_traced).
+float shadow_visibility_band(uint l, vec3 x, vec3 n, vec3 to_light, int pcf, out float band) {
+    band = 0.0;
     ShadowLight s = shadow_lights[l];
     float cos_t = clamp(dot(n, to_light), 1e-4, 1.0);
     float tan_t = min(sqrt(max(1.0 - cos_t * cos_t, 0.0)) / cos_t, MAX_SLOPE);
@@ -86,17 +94,26 @@ float shadow_visibility(uint l, vec3 x, vec3 n, vec3 to_light, int pcf) {
     ivec2 size = textureSize(shadow_map, 0).xy;
     ivec2 centre = ivec2(floor((ndc * 0.5 + 0.5) * vec2(size)));
     int layer = int(s.info.z + view);
-    float depth = shadow_receiver_depth(s, xs) - w * (DEPTH_BIAS_TEXELS + SLOPE_BIAS * float(pcf + 1) * tan_t);
+    float unbiased = shadow_receiver_depth(s, xs);
+    float depth = unbiased - w * (DEPTH_BIAS_TEXELS + SLOPE_BIAS * float(pcf + 1) * tan_t);
     float lit = 0.0;
+    float biased_lit = 0.0;
     for (int dy = -pcf; dy <= pcf; ++dy) {
         for (int dx = -pcf; dx <= pcf; ++dx) {
             ivec2 q = clamp(centre + ivec2(dx, dy), ivec2(0), size - 1);
             float stored = texelFetch(shadow_map, ivec3(q, layer), 0).r;
             lit += stored >= depth ? 1.0 : 0.0;
+            biased_lit += stored >= depth && stored < unbiased ? 1.0 : 0.0;
         }
     }
     float taps = float((2 * pcf + 1) * (2 * pcf + 1));
+    band = biased_lit / taps;
     return lit / taps;
+}
+
+float shadow_visibility(uint l, vec3 x, vec3 n, vec3 to_light, int pcf) {
+    float band;
+    return shadow_visibility_band(l, x, n, to_light, pcf, band);
 }
 
 #endif // SHADOW_NO_MAP

@@ -125,7 +125,12 @@ void main() {
         float dist;
         vec3 e = light_irradiance(l, x, n, to_light, dist);
         if (all(equal(e, vec3(0.0)))) continue;
-        float v = shadow_visibility(l, x, n, to_light, pc.pcf_radius);
+        // The taps lit only by the bias ask one ray toward the light: the
+        // map's bias would light a band under an occluder just above x
+        // (the waterline on the columns under the water).
+        float band;
+        float v = shadow_visibility_band(l, x, n, to_light, pc.pcf_radius, band);
+        if (band > 0.0 && trace_any(shadow_origin(x, n), to_light, 0.0, dist)) v -= band;
         if (v == 0.0) continue;
         e_sum += e * v * medium_transmittance_steps(x, to_light, light_travel(dist, x), pc.medium_steps);
     }

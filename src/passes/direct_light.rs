@@ -2,7 +2,12 @@
 //! (the `direct` technique is this pass alone). Radiometrically the ground truth's L D component for diffuse
 //! surfaces seen directly: L = albedo / pi * sum over lights of E * V, with
 //! E the light's irradiance (I cos / r^2 with spot falloff, or E cos for a
-//! directional light) and V the shadow-map visibility.
+//! directional light) and V the shadow-map visibility. The taps that the
+//! maps' depth bias alone counts lit (an occluder nearer the light than the
+//! receiver by less than the bias: the water's surface just above a wall
+//! under it, which the bias would light as a band a few texels tall) ask
+//! one BVH shadow ray (`shadow_visibility_band` in glsl/common/shadow.glsl);
+//! everywhere else the maps decide alone.
 //!
 //! Passes (each through `FrameRecorder::pass`):
 //! 1. "shadow maps" (`passes::shadow`): every light's views, linear distance;
