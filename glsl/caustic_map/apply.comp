@@ -13,10 +13,19 @@
 // area it covers on this receiver (flux is conserved: the integral of E over
 // a planar receiver is the sum of the texels' flux).
 //
-// Receivers hidden from the light by a diffuse surface get none of the
-// texel's flux: instead of the light's depth map we trace the straight line
-// to the light through the BVH, skipping specular surfaces (they are what
-// the caustic map accounts for), which is exact.
+// A texel's flux belongs to the receivers where its photons landed. The map
+// is indexed along the light's view, so one texel also covers receivers in
+// front of and behind them; its alpha holds the photons' nearest landing
+// depth (splat.frag). Receivers nearer the light than that (beyond a
+// splat's reach) get none of the flux: the top of the pool's wall, lit
+// directly above the floor that the refracted light reaches behind it.
+// Receivers behind it get none where a diffuse surface lies between them
+// and that depth (the BVH along the straight line toward the light,
+// skipping specular surfaces, which the photons went through): the floor
+// in a column's shadow behind the photons on the column. Nothing farther
+// toward the light is asked: the photons' own paths, traced, already met
+// what occludes them (the floor by the pool's wall, reached by light bent
+// under the wall's straight shadow).
 //
 // In a participating medium the photons' flux already carries the light
 // side's transmittance (photons.comp); the caustic radiance is attenuated
@@ -43,6 +52,7 @@ layout(set = 1, binding = CAUSTIC_BINDING_RADIANCE, rgba32f) uniform image2D rad
 layout(push_constant) uniform Push {
     uint light_count;
     uint medium_steps; // midpoint steps of inhomogeneous transmittance
+    uint splat_size;   // sprite width in texels (splat.frag)
 } pc;
 
 // Solid angle of the tan-plane rectangle [u0,u1] x [v0,v1] (2x2 Gauss-Legendre,
@@ -100,7 +110,8 @@ void main() {
         vec2 ndc = clip.xy / clip.w;
         if (any(greaterThan(abs(ndc), vec2(1.0)))) continue;
         ivec2 texel = clamp(ivec2(floor((ndc * 0.5 + 0.5) * vec2(size))), ivec2(0), size - 1);
-        vec3 flux = texelFetch(caustic_map, ivec3(texel, int(s.info.z + view)), 0).rgb;
+        vec4 stored = texelFetch(caustic_map, ivec3(texel, int(s.info.z + view)), 0);
+        vec3 flux = stored.rgb;
         if (all(equal(flux, vec3(0.0)))) continue;
         vec3 to_light;
         float dist;
@@ -123,7 +134,17 @@ void main() {
         }
         float cos_t = dot(n, to_light);
         if (cos_t <= 0.0) continue;
-        if (!diffuse_visible(x + n * (1e-4 * max(1.0, bvh_max_abs(x))), to_light, dist)) continue;
+        // Where the texel's photons landed (header): the map has no depth
+        // of its own (Wyman 2006, "Rendering the Caustic Map", keeps the
+        // light's depth map beside it); the tolerance covers a splat's
+        // reach across a sloped receiver, as the shadow maps' slope bias
+        // does (shadow.glsl).
+        float tan_t = min(sqrt(max(1.0 - cos_t * cos_t, 0.0)) / max(cos_t, 1e-4), 10.0);
+        float reach = shadow_texel_world(s, x) * (1.0 + (0.5 * float(pc.splat_size) + 1.0) * tan_t);
+        float behind = shadow_receiver_depth(s, x) - stored.a;
+        if (behind < -reach) continue;
+        float segment = min(dist, max(behind, 0.0) + reach);
+        if (!diffuse_visible(x + n * (1e-4 * max(1.0, bvh_max_abs(x))), to_light, segment)) continue;
         e_sum += flux * cos_t / area;
     }
     vec3 albedo = imageLoad(g_albedo, p).rgb;

@@ -6,7 +6,9 @@
 // exactly its flux to the map (additive blending). The sprite is S + 1
 // texels wide, so fragments outside that set are discarded. The map stores
 // flux per texel (W); glsl/caustic_map/apply.comp divides by the texel's
-// receiver area to get irradiance.
+// receiver area to get irradiance. Alpha holds the nearest depth (distance
+// along the light's view, shadow.glsl's measure) at which a photon splatted
+// into the texel landed.
 layout(push_constant) uniform Push {
     uint light;
     uint view;
@@ -16,6 +18,7 @@ layout(push_constant) uniform Push {
 
 layout(location = 0) flat in vec3 v_flux;
 layout(location = 1) flat in vec2 v_centre; // photon position in texel units
+layout(location = 2) flat in float v_depth;
 
 layout(location = 0) out vec4 out_flux;
 
@@ -35,5 +38,7 @@ void main() {
     vec2 o = gl_FragCoord.xy - v_centre;
     vec2 w2 = exp(-o * o * k) / norm;
     float w = w2.x * w2.y;
-    out_flux = vec4(v_flux * w, w);
+    // Alpha keeps the nearest landing depth of the texel's photons (min
+    // blending): apply.comp gives a texel's flux only to receivers there.
+    out_flux = vec4(v_flux * w, v_depth);
 }

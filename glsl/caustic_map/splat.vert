@@ -32,12 +32,14 @@ layout(push_constant) uniform Push {
 
 layout(location = 0) flat out vec3 v_flux;
 layout(location = 1) flat out vec2 v_centre;
+layout(location = 2) flat out float v_depth; // where it landed, as shadow maps measure depth
 
 void main() {
     Photon p = photons[gl_VertexIndex];
     gl_PointSize = float(pc.splat_size + 1u);
     v_flux = p.flux.rgb;
     v_centre = vec2(0.0);
+    v_depth = 0.0;
     gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // outside the clip volume: culled
     if (p.position.w == 0.0) return;
     ShadowLight s = shadow_lights[pc.light];
@@ -48,5 +50,6 @@ void main() {
     vec2 pix = (ndc * 0.5 + 0.5) * float(pc.size);
     if (any(lessThan(pix, vec2(0.0))) || any(greaterThanEqual(pix, vec2(float(pc.size))))) return;
     v_centre = pix;
+    v_depth = shadow_receiver_depth(s, p.position.xyz);
     gl_Position = vec4(ndc, 0.5, 1.0);
 }

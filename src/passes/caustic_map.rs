@@ -25,9 +25,15 @@
 //!    caustic map: a 2D array with the light's shadow-map views
 //!    (`passes::shadow::shadow_views`; a spot light gets a point light's
 //!    cube faces, since caustics land outside its cone) at M x M texels,
-//!    storing flux per texel (W) in rgb and the sum of weights in a.
+//!    storing flux per texel (W) in rgb and, by min blending, the nearest
+//!    depth along the light's view at which a photon in the texel landed
+//!    in a.
 //! 3. "caustic apply" (glsl/caustic_map/apply.comp, `CausticMap::apply`):
-//!    E = Phi_texel / A_texel(x) on each diffuse receiver.
+//!    E = Phi_texel / A_texel(x) on each diffuse receiver where the texel's
+//!    photons landed: not nearer the light than their nearest depth (the
+//!    top of a wall above the floor the refracted light reaches behind
+//!    it), and with no diffuse surface between the receiver and that depth
+//!    (the floor behind a column the photons landed on).
 //!
 //! In a participating medium (Hu et al. 2010 Sect. 5.3) the photons' flux
 //! is attenuated by the medium's transmittance along every segment through
@@ -306,6 +312,8 @@ impl CausticMap {
             GraphicsPipelineDesc::new("caustic_map/splat.vert", "caustic_map/splat.frag");
         desc.color_formats = vec![CAUSTIC_FORMAT];
         desc.additive = true;
+        // Alpha: the nearest landing depth of the texel's photons (apply.comp).
+        desc.alpha_min = true;
         desc.topology = vk::PrimitiveTopology::POINT_LIST;
         desc.push_size = size_of::<SplatPush>() as u32;
         let splat_pipeline = GraphicsPipeline::new(ctx, &desc, &[&scene_gpu.layout, &layout])?;
@@ -317,7 +325,7 @@ impl CausticMap {
             ctx,
             "caustic_map/apply.comp",
             &[&scene_gpu.layout, &apply_layout],
-            size_of::<[u32; 2]>() as u32,
+            size_of::<[u32; 4]>() as u32,
         )?;
         Ok(Self {
             photons,
@@ -421,7 +429,13 @@ impl CausticMap {
             .record(|c| {
                 let extent = self.map.extent();
                 for &view in &self.map.layer_views {
-                    c.render(extent, &[(view, Some([0.0; 4]))], None, |_| {});
+                    // No flux, and no photon landed nearer than anything.
+                    c.render(
+                        extent,
+                        &[(view, Some([0.0, 0.0, 0.0, f32::MAX]))],
+                        None,
+                        |_| {},
+                    );
                 }
             });
         Ok(())
@@ -436,8 +450,8 @@ impl CausticMap {
         gbuffer: &GBuffer,
         radiance: &Image,
     ) {
-        // apply.comp's push constants: light count, medium steps.
-        let push = [self.light_count, self.medium_steps];
+        // apply.comp's push constants: light count, medium steps, splat size.
+        let push = [self.light_count, self.medium_steps, self.splat_size, 0];
         let extent = radiance.extent();
         // The splats' attachment writes and the direct pass's radiance
         // writes must be visible to this read-modify-write.

@@ -148,7 +148,11 @@ pub(super) fn create_graphics(
             .color_blend_op(vk::BlendOp::ADD)
             .src_alpha_blend_factor(vk::BlendFactor::ONE)
             .dst_alpha_blend_factor(vk::BlendFactor::ONE)
-            .alpha_blend_op(vk::BlendOp::ADD)
+            .alpha_blend_op(if desc.alpha_min {
+                vk::BlendOp::MIN
+            } else {
+                vk::BlendOp::ADD
+            })
             .color_write_mask(vk::ColorComponentFlags::RGBA)
     } else {
         vk::PipelineColorBlendAttachmentState::default()

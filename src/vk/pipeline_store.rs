@@ -393,6 +393,9 @@ pub struct GraphicsPipelineDesc<'a> {
     pub depth_write: bool,
     /// Additive blending (one + one) on every colour attachment.
     pub additive: bool,
+    /// With `additive`: the alpha channel keeps the minimum of what is
+    /// written instead of the sum (a nearest depth beside summed colour).
+    pub alpha_min: bool,
     pub cull: vk::CullModeFlags,
     pub topology: vk::PrimitiveTopology,
     pub push_size: u32,
@@ -411,6 +414,7 @@ impl<'a> GraphicsPipelineDesc<'a> {
             depth_test: false,
             depth_write: false,
             additive: false,
+            alpha_min: false,
             cull: vk::CullModeFlags::NONE,
             topology: vk::PrimitiveTopology::TRIANGLE_LIST,
             push_size: 0,
