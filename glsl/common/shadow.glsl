@@ -78,7 +78,7 @@ float shadow_texel_world(ShadowLight s, vec3 x) {
 // `band`: the fraction of the taps counted lit only by the bias, their
 // occluder nearer the light than x by less than it. The map cannot tell
 // such an occluder (the water's surface just above a wall under it) from
-// x's own surface; one ray can (lighting.comp's shadow_visibility_traced).
+// x's own surface; one ray can (glsl/direct/lighting.comp asks it).
 float shadow_visibility_band(uint l, vec3 x, vec3 n, vec3 to_light, int pcf, out float band) {
     band = 0.0;
     ShadowLight s = shadow_lights[l];
