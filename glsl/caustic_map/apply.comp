@@ -139,8 +139,8 @@ void main() {
         // light's depth map beside it); the tolerance covers a splat's
         // reach across a sloped receiver, as the shadow maps' slope bias
         // does (shadow.glsl).
-        float tan_t = min(sqrt(max(1.0 - cos_t * cos_t, 0.0)) / max(cos_t, 1e-4), 10.0);
-        float reach = shadow_texel_world(s, x) * (1.0 + (0.5 * float(pc.splat_size) + 1.0) * tan_t);
+        float reach = shadow_texel_world(s, x)
+            * (1.0 + (0.5 * float(pc.splat_size) + 1.0) * shadow_slope_tan(cos_t));
         float behind = shadow_receiver_depth(s, x) - stored.a;
         if (behind < -reach) continue;
         float segment = min(dist, max(behind, 0.0) + reach);

@@ -47,6 +47,13 @@ const float DEPTH_BIAS_TEXELS = 0.5;
 const float SLOPE_BIAS = 1.5;
 const float MAX_SLOPE = 10.0;
 
+// tan of the angle between a receiver's normal and the light, from its
+// cosine, clamped at MAX_SLOPE: the slope the biases scale with.
+float shadow_slope_tan(float cos_t) {
+    float c = clamp(cos_t, 1e-4, 1.0);
+    return min(sqrt(max(1.0 - c * c, 0.0)) / c, MAX_SLOPE);
+}
+
 // The quantity a shadow texel stores, for world point x.
 float shadow_receiver_depth(ShadowLight s, vec3 x) {
     vec3 d = x - s.origin.xyz;
@@ -82,8 +89,7 @@ float shadow_texel_world(ShadowLight s, vec3 x) {
 float shadow_visibility_band(uint l, vec3 x, vec3 n, vec3 to_light, int pcf, out float band) {
     band = 0.0;
     ShadowLight s = shadow_lights[l];
-    float cos_t = clamp(dot(n, to_light), 1e-4, 1.0);
-    float tan_t = min(sqrt(max(1.0 - cos_t * cos_t, 0.0)) / cos_t, MAX_SLOPE);
+    float tan_t = shadow_slope_tan(dot(n, to_light));
     float w = shadow_texel_world(s, x);
     vec3 xs = x + n * (NORMAL_OFFSET_TEXELS * w);
     uint view = shadow_view(s, xs);
