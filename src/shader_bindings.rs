@@ -200,6 +200,10 @@ pub const REFERENCE_BINDING_AIM_GUIDE: u32 = 12;
 /// the radial coordinate, columns over the angle about the axis.
 pub const REFERENCE_GUIDE_ROWS: u32 = 64;
 pub const REFERENCE_GUIDE_COLUMNS: u32 = 32;
+/// The camera chains split at up to this many of their first Fresnel
+/// choices (glsl/reference/camera.comp, `ReferenceSettings::fresnel_splits`):
+/// 2^splits visible points a pixel and pass, one per branch.
+pub const REFERENCE_MAX_FRESNEL_SPLITS: u32 = 2;
 /// End of a hash-grid chain.
 pub const REFERENCE_GRID_NONE: u32 = 4294967295;
 /// The volume gather stops a cell's chain after this many links (below

@@ -264,31 +264,39 @@ vec3 chain_emission(SpecularState s, inout uint rng) {
 // minutes; a chain is one ray per bounce, cheap beside a pass's photons.
 const uint EMISSION_GRID = 4u;
 
-void main() {
-    uvec2 p = gl_GlobalInvocationID.xy;
-    if (p.x >= image_width() || p.y >= image_height()) return;
-    uint index = p.y * image_width() + p.x;
-    // A stream apart from the photon pass's (same seed, other constant).
-    uint rng = rng_seed(index, pc.seed ^ 0x68bc21ebu);
-    SpecularState s = camera_ray(p, rng);
-    VisiblePoint vp;
+// Fresnel splitting. A camera chain that met glass chose reflection or
+// refraction at random, one visible point a pixel and pass: on
+// `ball_lens_top` the floor reflected in the ball (F = 4% at the centre,
+// towards 1 at the rim) came as one pass in 25 at 25 times its share, and
+// that choice made most of the view's noise. Here a pixel's chain is
+// followed as 2^S branches (S = pc.fresnel_splits): branch b takes, at its
+// j-th Fresnel choice (j < S; 0 < F < 1: dielectrics and thin
+// sheets), reflection when bit j of b is set, weighted by F, else
+// refraction, weighted by 1 - F (under total internal reflection a dead
+// branch); later choices stay random. Every branch starts from the same
+// random stream, so branches agree up to their first differing bit. A path
+// whose chain ended after j < S choices is the same
+// in every branch that differs only in bits j and above: only the branch
+// with those bits clear counts it (`counted`), which keeps the sum over the
+// branches the expectation of the random choices, f x_r + (1 - f) x_t at
+// each split.
+// Follows branch `branch` of the camera chain from s: the direct light of
+// its diffuse point (`direct`, the pass's direct component) and its visible
+// point (`vp`, position.w = 0 for none); returns the Fresnel choices it
+// forced. Branch 0 also adds the first segment's airlight and a diffuse
+// first hit's direct light, which every branch shares.
+uint follow_chain(uint index, uint branch, SpecularState s, inout uint rng, out vec3 direct, out VisiblePoint vp) {
     vp.position = vec4(0.0);
     vp.normal = vec4(0.0);
     vp.weight = vec4(0.0);
-
-    vec3 emitted = vec3(0.0);
-    // Without area lights or an environment nothing is seen emitting.
-    uint emission_samples = frame.components.y > 0u || environment_present() ? EMISSION_GRID * EMISSION_GRID : 0u;
-    for (uint k = 0u; k < emission_samples; ++k) {
-        vec2 cell = vec2(k % EMISSION_GRID, k / EMISSION_GRID);
-        vec2 jitter = (cell + vec2(rng_next(rng), rng_next(rng))) / float(EMISSION_GRID);
-        emitted += chain_emission(camera_ray_through(p, jitter), rng);
-    }
-    if (emission_samples > 0u) add_pass(index, COMPONENT_EMITTED, emitted / float(emission_samples));
+    direct = vec3(0.0);
+    uint forced = 0u;
     for (uint depth = 0u; depth < pc.max_depth; ++depth) {
         Hit hit;
         bool found = trace_closest(s.origin, s.dir, 0.0, 1e30, hit);
-        if (depth == 0u) add_pass(index, COMPONENT_AIRLIGHT, airlight(s.origin, s.dir, found ? hit.t : 1e30, rng));
+        if (depth == 0u && branch == 0u) {
+            add_pass(index, COMPONENT_AIRLIGHT, airlight(s.origin, s.dir, found ? hit.t : 1e30, rng));
+        }
         if (!found) break;
         Material m = materials[hit_material(hit)];
         bool diffuse = floatBitsToUint(m.color.w) == MATERIAL_DIFFUSE;
@@ -308,7 +316,7 @@ void main() {
             // of photons straight from a light sampled here). A mixed
             // material's mirror part goes on below.
             vec3 seen_side = front ? ng : -ng;
-            add_pass(index, COMPONENT_DIRECT, s.weight * direct_light(x, seen_side, hit_albedo(hit), rng));
+            if (branch == 0u) add_pass(index, COMPONENT_DIRECT, s.weight * direct_light(x, seen_side, hit_albedo(hit), rng));
             if (!mixed) break;
         }
         if (diffuse) {
@@ -329,7 +337,7 @@ void main() {
                 continue;
             }
             vec3 seen_side = front ? ng : -ng;
-            add_pass(index, COMPONENT_DIRECT, s.weight * direct_light(x, seen_side, albedo, rng));
+            direct = s.weight * direct_light(x, seen_side, albedo, rng);
             vec3 weight = s.weight * albedo / PI;
             if (pc.gather != 0u && any(greaterThan(weight, vec3(0.0)))) {
                 vp.position = vec4(x, 1.0);
@@ -338,12 +346,75 @@ void main() {
             }
             break;
         }
-        specular_bounce(s, x, ng, hit_normal(hit), front, m, rng_next(rng), true);
+        float u = rng_next(rng);
+        if (forced < pc.fresnel_splits) {
+            SpecularState probe = s;
+            float f = specular_bounce(probe, x, ng, hit_normal(hit), front, m, -1.0, true);
+            if (f > 0.0 && f < 1.0) {
+                bool reflects = ((branch >> forced) & 1u) != 0u;
+                forced += 1u;
+                if (reflects) {
+                    s = probe;
+                    s.weight *= f;
+                } else {
+                    specular_bounce(s, x, ng, hit_normal(hit), front, m, 2.0, true);
+                    s.weight *= 1.0 - f;
+                }
+                if (luminance(s.weight) <= 0.0) break;
+                continue;
+            }
+        }
+        specular_bounce(s, x, ng, hit_normal(hit), front, m, u, true);
     }
-    visible_points[index] = vp;
-    if (vp.position.w != 0.0) {
-        // Push onto the bucket's list (heads were cleared to GRID_NONE).
-        uint bucket = grid_bucket(grid_cell(vp.position.xyz, 2.0 * pc.radius), pc.surface_mask);
-        surface_next[index] = atomicExchange(surface_heads[bucket], index);
+    return forced;
+}
+
+void main() {
+    uvec2 p = gl_GlobalInvocationID.xy;
+    if (p.x >= image_width() || p.y >= image_height()) return;
+    uint index = p.y * image_width() + p.x;
+    // A stream apart from the photon pass's (same seed, other constant).
+    uint rng = rng_seed(index, pc.seed ^ 0x68bc21ebu);
+    SpecularState s = camera_ray(p, rng);
+
+    vec3 emitted = vec3(0.0);
+    // Without area lights or an environment nothing is seen emitting.
+    uint emission_samples = frame.components.y > 0u || environment_present() ? EMISSION_GRID * EMISSION_GRID : 0u;
+    for (uint k = 0u; k < emission_samples; ++k) {
+        vec2 cell = vec2(k % EMISSION_GRID, k / EMISSION_GRID);
+        vec2 jitter = (cell + vec2(rng_next(rng), rng_next(rng))) / float(EMISSION_GRID);
+        emitted += chain_emission(camera_ray_through(p, jitter), rng);
+    }
+    if (emission_samples > 0u) add_pass(index, COMPONENT_EMITTED, emitted / float(emission_samples));
+
+    uint forced[1u << REFERENCE_MAX_FRESNEL_SPLITS];
+    uint branches = visible_points_per_pixel();
+    for (uint branch = 0u; branch < branches; ++branch) {
+        VisiblePoint vp;
+        vp.position = vec4(0.0);
+        vp.normal = vec4(0.0);
+        vp.weight = vec4(0.0);
+        vec3 direct = vec3(0.0);
+        // Branch b agrees with b less its highest bit up to that bit's
+        // choice: when that branch ended sooner, so does this one, the same
+        // path, which only the other counts.
+        uint top = branch == 0u ? 0u : uint(findMSB(branch));
+        uint parent = branch == 0u ? 0u : branch ^ (1u << top);
+        bool repeats = branch != 0u && forced[parent] <= top;
+        forced[branch] = repeats ? forced[parent] : 0u;
+        if (!repeats) {
+            uint branch_rng = rng;
+            forced[branch] = follow_chain(index, branch, s, branch_rng, direct, vp);
+        }
+        bool counted = !repeats && (branch >> forced[branch]) == 0u;
+        if (!counted) vp.position.w = 0.0;
+        if (counted) add_pass(index, COMPONENT_DIRECT, direct);
+        uint point = index * branches + branch;
+        visible_points[point] = vp;
+        if (vp.position.w != 0.0) {
+            // Push onto the bucket's list (heads were cleared to GRID_NONE).
+            uint bucket = grid_bucket(grid_cell(vp.position.xyz, 2.0 * pc.radius), pc.surface_mask);
+            surface_next[point] = atomicExchange(surface_heads[bucket], point);
+        }
     }
 }

@@ -23,10 +23,12 @@ layout(set = 1, binding = REFERENCE_BINDING_PASS, std430) buffer PassAccum { flo
 // Per pixel: sum over passes of the pass estimate's luminance, and of its square.
 layout(set = 1, binding = REFERENCE_BINDING_MOMENTS, std430) buffer Moments { vec2 moments[]; };
 
-// Progressive photon mapping (Knaus & Zwicker 2011): one visible point per
-// pixel and pass, the first diffuse point a camera path reaches through at
-// least one specular bounce (camera.comp), kept in a hash grid of cell side
-// 2 r so that a photon finds every point within r in at most 2x2x2 cells.
+// Progressive photon mapping (Knaus & Zwicker 2011): a visible point is the
+// first diffuse point a camera path reaches through at least one specular
+// bounce (camera.comp), kept in a hash grid of cell side 2 r so that a
+// photon finds every point within r in at most 2x2x2 cells. A pixel has
+// one per branch of its camera chain a pass (camera.comp, "Fresnel
+// splitting"): point i belongs to pixel i >> pc.fresnel_splits.
 struct VisiblePoint {
     vec4 position; // w: 1 when the pixel has a visible point this pass
     vec4 normal;   // the side of the surface the camera path sees
@@ -88,12 +90,14 @@ layout(push_constant) uniform Push {
     float aim_share;       // share of photons aimed at it
     uint gather_capacity;  // gather points stored at most
     uint aim_guide;        // 1: aimed photons follow the aim guide (aim_guide.glsl)
-    uint pad;
+    uint fresnel_splits;   // camera chains split at this many Fresnel choices (camera.comp)
 } pc;
 
 uint image_width() { return uint(frame.viewport.x); }
 uint image_height() { return uint(frame.viewport.y); }
 uint image_pixels() { return image_width() * image_height(); }
+// Visible points a pixel has room for a pass: one per camera chain branch.
+uint visible_points_per_pixel() { return 1u << pc.fresnel_splits; }
 
 // Adds the radiance estimate `value` to pixel `index` of this pass's image `component`.
 void add_pass(uint index, uint component, vec3 value) {

@@ -290,14 +290,14 @@ void gather_surface(vec3 x, vec3 arrival_side, vec3 flux, uint tag) {
     for (int cx = lo.x; cx <= hi.x; ++cx) {
         ivec3 c = ivec3(cx, cy, cz);
         uint i = surface_heads[grid_bucket(c, pc.surface_mask)];
-        // A chain holds at most every pixel once; the bound guards the loop.
-        for (uint guard = 0u; i != REFERENCE_GRID_NONE && guard < image_pixels(); ++guard) {
+        // A chain holds at most every point once; the bound guards the loop.
+        for (uint guard = 0u; i != REFERENCE_GRID_NONE && guard < image_pixels() * visible_points_per_pixel(); ++guard) {
             VisiblePoint vp = visible_points[i];
             // Other cells share this bucket: count each point in its own cell only.
             if (grid_cell(vp.position.xyz, side) == c) {
                 vec3 d = vp.position.xyz - x;
                 if (dot(d, d) < r * r && dot(vp.normal.xyz, arrival_side) > 0.5) {
-                    add_pass(i, tag, scale * vp.weight.rgb);
+                    add_pass(i >> pc.fresnel_splits, tag, scale * vp.weight.rgb);
                     photon_useful = true;
                 }
             }

@@ -177,26 +177,11 @@ impl Bvh {
         let mut stack = [0u32; BVH_STACK_SIZE as usize];
         let mut sp = 0usize;
         let mut node = 0u32;
-        loop {
-            let n = &self.nodes[node as usize];
-            if n.count > 0 {
-                for i in n.left_or_first..n.left_or_first + n.count {
-                    if let Some((t, u, v)) = intersect_triangle(&tris[i as usize], o, d, closest) {
-                        if t > t_min {
-                            closest = t;
-                            best = Some(Hit {
-                                t,
-                                triangle: i,
-                                u,
-                                v,
-                            });
-                            if any {
-                                return best;
-                            }
-                        }
-                    }
-                }
-            } else {
+        // While-while (Aila & Laine 2009): down the inner nodes to a leaf,
+        // then its triangles, then the next node off the stack.
+        'rays: loop {
+            let mut n = &self.nodes[node as usize];
+            while n.count == 0 {
                 let l = n.left_or_first;
                 let r = l + 1;
                 let hl = ray_box(&self.nodes[l as usize], o, inv_d, t_min, closest);
@@ -207,17 +192,33 @@ impl Bvh {
                         stack[sp] = far;
                         sp += 1;
                         node = near;
-                        continue;
                     }
-                    (Some(_), None) => {
-                        node = l;
-                        continue;
+                    (Some(_), None) => node = l,
+                    (None, Some(_)) => node = r,
+                    (None, None) => {
+                        if sp == 0 {
+                            break 'rays;
+                        }
+                        sp -= 1;
+                        node = stack[sp];
                     }
-                    (None, Some(_)) => {
-                        node = r;
-                        continue;
+                }
+                n = &self.nodes[node as usize];
+            }
+            for i in n.left_or_first..n.left_or_first + n.count {
+                if let Some((t, u, v)) = intersect_triangle(&tris[i as usize], o, d, closest) {
+                    if t > t_min {
+                        closest = t;
+                        best = Some(Hit {
+                            t,
+                            triangle: i,
+                            u,
+                            v,
+                        });
+                        if any {
+                            return best;
+                        }
                     }
-                    (None, None) => {}
                 }
             }
             if sp == 0 {

@@ -191,6 +191,12 @@ pub struct ReferenceArgs {
     /// reached the image); for measuring what the guide gains.
     #[arg(long)]
     pub no_aim_guide: bool,
+    /// Camera chains through glass and water follow both branches of their
+    /// first N Fresnel choices (reflected and refracted, each weighted by
+    /// its probability), from 0 (every choice random) to 2: less noise in
+    /// what is seen through and in glass
+    #[arg(long, default_value_t = caustics::shader_bindings::REFERENCE_MAX_FRESNEL_SPLITS)]
+    pub fresnel_splits: u32,
     /// Photons per pass, a multiple of 64 from 64 to 16,777,216: a pass is
     /// the unit of progress (its camera samples, its photons, its radius).
     /// Smaller passes show a first image sooner.

@@ -15,6 +15,7 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
         no_photon_mapping,
         aim_share,
         no_aim_guide,
+        fresnel_splits,
         pass_photons,
         component,
         diffuse_bounces,
@@ -35,6 +36,10 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
             "--pass-photons must be a multiple of 64 from 64 to 16777216, got {pass_photons}"
         );
     }
+    let most = caustics::shader_bindings::REFERENCE_MAX_FRESNEL_SPLITS;
+    if fresnel_splits > most {
+        anyhow::bail!("--fresnel-splits must lie in 0..={most}, got {fresnel_splits}");
+    }
     if let Some(r) = radius {
         if !(r.is_finite() && r > 0.0) {
             anyhow::bail!("--radius must be a positive length in metres, got {r}");
@@ -51,6 +56,7 @@ pub fn reference(args: ReferenceArgs) -> anyhow::Result<()> {
         photon_mapping: !no_photon_mapping,
         aim_share,
         aim_guide: !no_aim_guide,
+        fresnel_splits,
         batch: pass_photons,
         ..Default::default()
     };

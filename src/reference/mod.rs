@@ -51,6 +51,11 @@ pub struct ReferenceSettings {
     /// where earlier passes' aimed photons reached the image. Off: uniform
     /// over the aimed region.
     pub aim_guide: bool,
+    /// Camera chains split at this many of their first Fresnel choices
+    /// (glsl/reference/camera.comp, "Fresnel splitting"), at most
+    /// REFERENCE_MAX_FRESNEL_SPLITS: 2^splits visible points a pixel and
+    /// pass. 0: every choice random, as a path tracer makes it.
+    pub fresnel_splits: u32,
 }
 
 impl ReferenceSettings {
@@ -83,6 +88,7 @@ impl Default for ReferenceSettings {
             volume_capacity: 1 << 21,
             aim_share: 0.5,
             aim_guide: true,
+            fresnel_splits: crate::shader_bindings::REFERENCE_MAX_FRESNEL_SPLITS,
         }
     }
 }
