@@ -86,6 +86,8 @@ pub struct Reference {
     aim_guide: Buffer,
     /// Lights the guide is rebuilt for (0: no guide).
     guided_lights: u32,
+    /// The guide's learning pass is traced (`record_pass`).
+    learned: bool,
     stats: Buffer,
     settings: ReferenceSettings,
     surface_table: u32,
@@ -256,6 +258,7 @@ impl Reference {
             gather_points: buffer("reference gather points", gather_bytes.max(point_bytes))?,
             aim_guide: buffer("reference aim guide", guide_bytes)?,
             guided_lights,
+            learned: false,
             stats: Buffer::new(ctx, "reference counters", 32, BufferUsage::StorageIndirect)?,
             set: DescriptorSet::new(ctx, &layout)?,
             resolve_set: DescriptorSet::new(ctx, &layout)?,
@@ -335,13 +338,63 @@ impl Reference {
         });
         self.photons = 0;
         self.passes = 0;
+        self.learned = false;
     }
 
     /// Records one pass: camera chains and visible points, one batch of
     /// photons (camera connections and surface gathers), the volume gather
     /// along camera chains (scenes with a medium), then the fold into the
     /// sums. Shrinks the radii for the next pass.
+    ///
+    /// With the aim guide, the first call records a learning pass before
+    /// it: the same stages with a quarter of the photons, its estimate
+    /// dropped instead of folded. Its
+    /// photons are aimed uniformly (the guide has seen nothing yet), so on
+    /// `ball_lens_top` 30 times fewer of them reach the image than in a
+    /// guided pass, and as one of the passes the mean weighs equally it was
+    /// most of the image's noise: FLIP 0.052 with it after five passes, 0.038
+    /// without (BENCHMARKS.md "Fresnel splitting, every photon aimed").
+    /// What it leaves is the guide's counts. Every counted pass stays an
+    /// unbiased estimate given the guide it was aimed by.
     pub fn record_pass(&mut self, rec: &mut FrameRecorder, scene_gpu: &SceneGpu) -> PassReport {
+        if self.guided_lights > 0 && !self.learned {
+            self.learned = true;
+            // A quarter of a pass: where the guide gains nothing (every
+            // aimed photon useful), a cheap start.
+            let photons = (self.pass_photons() / 4).max(64) / 64 * 64;
+            self.record_stages(rec, scene_gpu, photons);
+            rec.pass("reference learning pass, dropped")
+                .write(&self.pass_sums, Access::ComputeWrite)
+                .record(|c| c.fill(&self.pass_sums, 0));
+        }
+        self.record_stages(rec, scene_gpu, self.pass_photons());
+        let push = self.push(0, Component::All);
+        let sets = [&scene_gpu.set, &self.set];
+        rec.pass("reference fold")
+            .write(&self.pass_sums, Access::ComputeWrite)
+            .write(&self.total, Access::ComputeWrite)
+            .write(&self.moments, Access::ComputeWrite)
+            .record(|c| {
+                let pixels = self.width * self.height;
+                let groups = [pixels.div_ceil(64), 1, 1];
+                c.dispatch(&self.fold, &sets, bytemuck::bytes_of(&push), groups);
+            });
+        let report = PassReport {
+            radius: self.radius,
+            volume_radius: self.volume_radius,
+            volume_photons: 0,
+        };
+        self.photons += self.pass_photons();
+        self.passes += 1;
+        let alpha = self.settings.alpha;
+        self.radius = next_radius(self.radius, self.passes, alpha, 2);
+        self.volume_radius = next_radius(self.volume_radius, self.passes, alpha, 3);
+        report
+    }
+
+    /// Records a pass's stages up to the fold: camera chains and visible
+    /// points, the guide, `photons` photons, the volume gather.
+    fn record_stages(&mut self, rec: &mut FrameRecorder, scene_gpu: &SceneGpu, photons: u64) {
         self.dispatches = self.dispatches.wrapping_add(1);
         let seed = self
             .dispatches
@@ -383,7 +436,7 @@ impl Reference {
                 c.fill(&self.stats, 0);
                 // The volume gather's dispatch is (x, 1, 1); volume_points.comp raises x.
                 c.update(&self.stats, 20, bytemuck::cast_slice(&[1u32, 1]));
-                let groups = [(self.pass_photons() / 64) as u32, 1, 1];
+                let groups = [(photons / 64) as u32, 1, 1];
                 c.dispatch(&self.trace, &sets, push, groups);
             });
         if self.volume_capacity > 0 {
@@ -401,25 +454,6 @@ impl Reference {
                 .read(&self.stats, Access::IndirectRead)
                 .record(|c| c.dispatch_indirect(&self.volume_gather, &sets, push, &self.stats, 16));
         }
-        rec.pass("reference fold")
-            .write(&self.pass_sums, Access::ComputeWrite)
-            .write(&self.total, Access::ComputeWrite)
-            .write(&self.moments, Access::ComputeWrite)
-            .record(|c| {
-                let pixels = self.width * self.height;
-                c.dispatch(&self.fold, &sets, push, [pixels.div_ceil(64), 1, 1]);
-            });
-        let report = PassReport {
-            radius: self.radius,
-            volume_radius: self.volume_radius,
-            volume_photons: 0,
-        };
-        self.photons += self.pass_photons();
-        self.passes += 1;
-        let alpha = self.settings.alpha;
-        self.radius = next_radius(self.radius, self.passes, alpha, 2);
-        self.volume_radius = next_radius(self.volume_radius, self.passes, alpha, 3);
-        report
     }
 
     /// Records the noise reduction over the image (counters 1 and 2 of `stats`).
