@@ -270,22 +270,24 @@ const uint EMISSION_GRID = 4u;
 // towards 1 at the rim) came as one pass in 25 at 25 times its share, and
 // that choice made most of the view's noise. Here a pixel's chain is
 // followed as 2^S branches (S = pc.fresnel_splits): branch b takes, at its
-// j-th Fresnel choice (j < S; 0 < F < 1: dielectrics and thin
-// sheets), reflection when bit j of b is set, weighted by F, else
-// refraction, weighted by 1 - F (under total internal reflection a dead
-// branch); later choices stay random. Every branch starts from the same
-// random stream, so branches agree up to their first differing bit. A path
-// whose chain ended after j < S choices is the same
-// in every branch that differs only in bits j and above: only the branch
-// with those bits clear counts it (`counted`), which keeps the sum over the
-// branches the expectation of the random choices, f x_r + (1 - f) x_t at
-// each split.
+// j-th Fresnel choice (j < S; 0 < F < 1: dielectrics and thin sheets),
+// reflection when bit j of b is set, weighted by F, else refraction,
+// weighted by 1 - F; later choices stay random. Every branch draws from the
+// same random stream (what only branch 0 samples draws from another), so
+// branches agree up to their first differing bit. A path whose chain ended
+// after j < S choices is the same in every branch that differs only in
+// bits j and above: only the branch with those bits clear counts it
+// (`counted`), which keeps the sum over the branches the expectation of
+// the random choices, F x_r + (1 - F) x_t at each split.
+
 // Follows branch `branch` of the camera chain from s: the direct light of
 // its diffuse point (`direct`, the pass's direct component) and its visible
 // point (`vp`, position.w = 0 for none); returns the Fresnel choices it
 // forced. Branch 0 also adds the first segment's airlight and a diffuse
-// first hit's direct light, which every branch shares.
-uint follow_chain(uint index, uint branch, SpecularState s, inout uint rng, out vec3 direct, out VisiblePoint vp) {
+// first hit's direct light, which every branch shares, sampled with
+// `first_rng` so that `rng` stays the same stream in every branch.
+uint follow_chain(uint index, uint branch, SpecularState s, inout uint rng, inout uint first_rng, out vec3 direct,
+                  out VisiblePoint vp) {
     vp.position = vec4(0.0);
     vp.normal = vec4(0.0);
     vp.weight = vec4(0.0);
@@ -295,7 +297,7 @@ uint follow_chain(uint index, uint branch, SpecularState s, inout uint rng, out 
         Hit hit;
         bool found = trace_closest(s.origin, s.dir, 0.0, 1e30, hit);
         if (depth == 0u && branch == 0u) {
-            add_pass(index, COMPONENT_AIRLIGHT, airlight(s.origin, s.dir, found ? hit.t : 1e30, rng));
+            add_pass(index, COMPONENT_AIRLIGHT, airlight(s.origin, s.dir, found ? hit.t : 1e30, first_rng));
         }
         if (!found) break;
         Material m = materials[hit_material(hit)];
@@ -316,7 +318,9 @@ uint follow_chain(uint index, uint branch, SpecularState s, inout uint rng, out 
             // of photons straight from a light sampled here). A mixed
             // material's mirror part goes on below.
             vec3 seen_side = front ? ng : -ng;
-            if (branch == 0u) add_pass(index, COMPONENT_DIRECT, s.weight * direct_light(x, seen_side, hit_albedo(hit), rng));
+            if (branch == 0u) {
+                add_pass(index, COMPONENT_DIRECT, s.weight * direct_light(x, seen_side, hit_albedo(hit), first_rng));
+            }
             if (!mixed) break;
         }
         if (diffuse) {
@@ -387,6 +391,7 @@ void main() {
     }
     if (emission_samples > 0u) add_pass(index, COMPONENT_EMITTED, emitted / float(emission_samples));
 
+    uint first_rng = rng_seed(index, pc.seed ^ 0x5bd1e995u);
     uint forced[1u << REFERENCE_MAX_FRESNEL_SPLITS];
     uint branches = visible_points_per_pixel();
     for (uint branch = 0u; branch < branches; ++branch) {
@@ -404,7 +409,7 @@ void main() {
         forced[branch] = repeats ? forced[parent] : 0u;
         if (!repeats) {
             uint branch_rng = rng;
-            forced[branch] = follow_chain(index, branch, s, branch_rng, direct, vp);
+            forced[branch] = follow_chain(index, branch, s, branch_rng, first_rng, direct, vp);
         }
         bool counted = !repeats && (branch >> forced[branch]) == 0u;
         if (!counted) vp.position.w = 0.0;
