@@ -167,6 +167,8 @@ pub const WATER_SURFACE_GROUP_SIZE: u32 = 8;
 pub const AIRLIGHT_BINDING_RADIANCE: u32 = 0;
 pub const AIRLIGHT_BINDING_SHADOW_MAP: u32 = 1;
 pub const AIRLIGHT_BINDING_SHADOW_LIGHTS: u32 = 2;
+/// The virtual lights of the approximate multiple scattering (src/passes/scattered_lights.rs).
+pub const AIRLIGHT_BINDING_SCATTERED_LIGHTS: u32 = 3;
 // Ground truth (src/reference/, glsl/reference/), descriptor set 1.
 /// Running sums over passes, COMPONENT_COUNT rgb images.
 pub const REFERENCE_BINDING_TOTAL: u32 = 0;

@@ -31,18 +31,26 @@
 //! per-frame random offset (`airlight_jitter` = 1: shadow edges turn into
 //! noise instead of banding) or the midpoints (0).
 //!
+//! Where the scene's medium asks for it (`multiple_scattering`), the pass
+//! also adds the approximate multiple scattering of
+//! [`super::scattered_lights`]: virtual lights where the light scatters
+//! once, lighting the medium along the same strata (L V V E, unshadowed)
+//! and the camera ray's surface (L V D E, one BVH shadow ray per virtual
+//! light), tagged `other`.
+//!
 //! A technique owns one `Airlight` next to its shadow maps, holds
 //! [`AirlightParams`] as a group of its parameter struct (and passes its
 //! `medium_steps`), and records it after the pass that writes the frame's
 //! radiance.
 
+use super::scattered_lights::{capacity, scattered_lights, GpuScatteredLight};
 use crate::frame::SceneGpu;
 use crate::passes::shadow::ShadowMaps;
 use crate::scene::Scene;
 use crate::shader_bindings as b;
 use crate::vk::{
-    groups_8x8, Access, ComputePipeline, Context, DescriptorSet, DescriptorSetLayout,
-    FrameRecorder, Image, Sampler, VkResult,
+    groups_8x8, Access, Buffer, BufferUsage, ComputePipeline, Context, DescriptorSet,
+    DescriptorSetLayout, FrameRecorder, Image, Sampler, VkResult,
 };
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -68,6 +76,15 @@ struct AirlightPush {
     steps: u32,
     medium_steps: u32,
     jitter: u32,
+    /// Virtual lights of the multiple scattering (0: none).
+    scattered_count: u32,
+}
+
+/// The virtual lights of an animated scene follow its geometry: the scene
+/// (its lights' GPU order) and the time they were placed for.
+struct Moving {
+    scene: Scene,
+    time: f32,
 }
 
 pub struct Airlight {
@@ -76,6 +93,8 @@ pub struct Airlight {
     set: DescriptorSet,
     _layout: DescriptorSetLayout,
     sampler: Sampler,
+    scattered: Buffer,
+    moving: Option<Moving>,
 }
 
 impl Airlight {
@@ -95,6 +114,19 @@ impl Airlight {
         let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
         let set = DescriptorSet::new(ctx, &layout)?;
         set.write_buffer(b::AIRLIGHT_BINDING_SHADOW_LIGHTS, &shadows.lights);
+        let lights = crate::frame::caustic_lights(scene);
+        let virtual_lights = scattered_lights(scene, &lights, scene_gpu.geometry_time);
+        // Room for every light's rays and strata (a buffer is never empty).
+        let capacity = capacity(lights.len()).max(1);
+        let mut records = virtual_lights.clone();
+        records.resize(capacity as usize, GpuScatteredLight::default());
+        let scattered = Buffer::with_data(ctx, "scattered lights", &records, BufferUsage::Storage)?;
+        set.write_buffer(b::AIRLIGHT_BINDING_SCATTERED_LIGHTS, &scattered);
+        let ms = scene.medium.as_ref().is_some_and(|m| m.multiple_scattering);
+        let moving = (ms && scene.is_animated()).then(|| Moving {
+            scene: scene.clone(),
+            time: scene_gpu.geometry_time,
+        });
         let pipeline = ComputePipeline::new(
             ctx,
             "passes/airlight.comp",
@@ -108,11 +140,14 @@ impl Airlight {
                 steps: params.airlight_steps,
                 medium_steps,
                 jitter: params.airlight_jitter,
+                scattered_count: virtual_lights.len() as u32,
             },
             pipeline,
             set,
             _layout: layout,
             sampler,
+            scattered,
+            moving,
         })
     }
 
@@ -122,9 +157,16 @@ impl Airlight {
         self.push.jitter = params.airlight_jitter;
     }
 
+    /// Whether the pass can follow moved lights in place: not with virtual
+    /// lights, which are placed from them (the technique is rebuilt).
+    pub fn follows_lights(&self) -> bool {
+        self.push.scattered_count == 0
+    }
+
     /// Records the "airlight" pass: adds L_A (times the airlight component's
-    /// weight) to `out`, the frame's radiance. `shadows` must be the maps
-    /// given to `new`, already recorded this frame.
+    /// weight) to `out`, the frame's radiance, and the multiple scattering
+    /// (times the `other` component's). `shadows` must be the maps given
+    /// to `new`, already recorded this frame.
     pub fn record(
         &mut self,
         rec: &mut FrameRecorder,
@@ -132,6 +174,21 @@ impl Airlight {
         shadows: &ShadowMaps,
         out: &Image,
     ) {
+        if let Some(m) = self
+            .moving
+            .as_mut()
+            .filter(|m| m.time != scene.geometry_time)
+        {
+            let lights = crate::frame::caustic_lights(&m.scene);
+            let mut records = scattered_lights(&m.scene, &lights, scene.geometry_time);
+            self.push.scattered_count = records.len() as u32;
+            records.resize(
+                (self.scattered.size as usize / std::mem::size_of::<GpuScatteredLight>()).max(1),
+                GpuScatteredLight::default(),
+            );
+            rec.upload(&self.scattered, bytemuck::cast_slice(&records));
+            m.time = scene.geometry_time;
+        }
         let (width, height) = (out.extent().width, out.extent().height);
         // The shadow maps' attachment writes must be visible to the
         // compute reads (GENERAL layout); `out` is read-modify-written

@@ -10,6 +10,7 @@ pub mod direct_light;
 pub mod gbuffer;
 mod image_compute;
 pub mod light_views;
+pub mod scattered_lights;
 pub mod shadow;
 pub mod specular_gbuffer;
 pub mod surface_frame;

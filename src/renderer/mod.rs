@@ -365,11 +365,23 @@ impl Renderer {
     }
 
     /// `scene.medium` was edited in place (same density kind): re-uploads
-    /// it, after the frames in flight that read it.
-    pub fn medium_changed(&mut self) -> VkResult<()> {
+    /// it, after the frames in flight that read it. A medium with
+    /// `multiple_scattering` rebuilds the technique too: its airlight pass
+    /// placed its virtual lights with the old coefficients.
+    pub fn medium_changed(&mut self) -> anyhow::Result<()> {
         self.finish()?;
         self.restart_accumulation();
-        self.scene_gpu.update_medium(&self.scene)
+        self.scene_gpu.update_medium(&self.scene)?;
+        if self
+            .scene
+            .medium
+            .as_ref()
+            .is_some_and(|m| m.multiple_scattering)
+        {
+            let params = self.params.clone();
+            self.set_technique(self.technique.name(), &params)?;
+        }
+        Ok(())
     }
 
     /// Records and submits one frame at animation time `time` without

@@ -314,6 +314,11 @@ pub struct Medium {
     pub bounds_min: Vec3,
     pub bounds_max: Vec3,
     pub density: Density,
+    /// The real-time techniques add an approximate multiple scattering
+    /// (light scattered twice in the medium, or scattered and then
+    /// reflected by a surface: frame/scattered_lights.rs); the reference
+    /// always renders all of it.
+    pub multiple_scattering: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]

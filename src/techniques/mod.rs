@@ -210,6 +210,17 @@ impl TechniqueInfo {
     /// a component as not applicable instead of scoring it.
     pub fn not_modelled(&self, scene: &Scene, component: Component) -> Option<String> {
         use crate::scene::MaterialKind;
+        // `other` holds multiple scattering, which the volume techniques
+        // approximate where the medium asks for it (passes::scattered_lights),
+        // and diffuse interreflection, which none draws.
+        if component == Component::Other
+            && !scene.medium.as_ref().is_some_and(|m| m.multiple_scattering)
+        {
+            return Some(format!(
+                "{} draws multiple scattering only in a medium with `multiple_scattering = true`",
+                self.name
+            ));
+        }
         if !matches!(
             component,
             Component::SurfaceCaustics | Component::VolumeCaustics

@@ -114,6 +114,7 @@ fn medium(sigma_s: Vec3, g: f32) -> Medium {
         bounds_min: Vec3::splat(-BOUNDS),
         bounds_max: Vec3::splat(BOUNDS),
         density: Density::Constant(1.0),
+        multiple_scattering: false,
     }
 }
 

@@ -35,6 +35,7 @@ mod live_params;
 mod medium_attenuation;
 mod mixed_material;
 mod moving_lights;
+mod multiple_scattering;
 mod overlay_layout;
 mod pinhole;
 mod pipeline_reuse;

@@ -60,6 +60,7 @@ fn homogeneous(sigma_s: Vec3, sigma_a: Vec3, min: Vec3, max: Vec3) -> Medium {
         bounds_min: min,
         bounds_max: max,
         density: Density::Constant(1.0),
+        multiple_scattering: false,
     }
 }
 

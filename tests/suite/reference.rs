@@ -354,6 +354,7 @@ impl AirlightSetup {
             bounds_min: self.bounds_min,
             bounds_max: self.bounds_max,
             density,
+            multiple_scattering: false,
         });
         s
     }

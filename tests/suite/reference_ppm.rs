@@ -349,6 +349,7 @@ fn fog_seen_in_a_mirror_matches_the_mirrored_view() {
         bounds_min: Vec3::new(-1.5, 0.0, 0.05),
         bounds_max: Vec3::new(1.5, 0.8, 3.0),
         density: caustics::scene::Density::Constant(1.0),
+        multiple_scattering: false,
     };
     let target = Vec3::new(0.0, 1.0, 0.0);
     let cam_a = camera(Vec3::new(0.0, 3.5, 3.0), target, 30.0);

@@ -533,6 +533,22 @@ fn medium_values_are_checked() {
         "(-1, 1)",
     );
     rejects(
+        &base(&format!(
+            "[medium]\nsigma_s = 0.1\n{bounds}density = {{ noise = {{ scale = 1 }} }}\nmultiple_scattering = true\n"
+        )),
+        "medium.multiple_scattering",
+        "multiple_scattering = true",
+        "constant density",
+    );
+    rejects(
+        &base(&format!(
+            "[medium]\nsigma_s = 0.1\n{bounds}multiple_scattering = 1\n"
+        )),
+        "medium.multiple_scattering",
+        "multiple_scattering = 1",
+        "",
+    );
+    rejects(
         &base("[medium]\nsigma_s = 0.1\n"),
         "medium.bounds",
         "[medium]",

@@ -9,7 +9,14 @@ use glam::Vec3;
 
 pub(super) fn medium(t: &Tbl, within: &Confinement) -> R<Medium> {
     t.check_keys(
-        &["sigma_s", "sigma_a", "g", "bounds", "density"],
+        &[
+            "sigma_s",
+            "sigma_a",
+            "g",
+            "bounds",
+            "density",
+            "multiple_scattering",
+        ],
         "[medium]",
     )?;
     let sigma_s = non_negative_rgb(t, "sigma_s", None)?;
@@ -45,6 +52,15 @@ pub(super) fn medium(t: &Tbl, within: &Confinement) -> R<Medium> {
             Density::Constant(d)
         }
     };
+    let multiple_scattering = t.opt_bool("multiple_scattering")?.unwrap_or(false);
+    // The scattered lights are placed along the lights' rays on the CPU,
+    // which evaluates a constant density only (frame/scattered_lights.rs).
+    if multiple_scattering && !matches!(density, Density::Constant(_)) {
+        return Err(t.err(
+            "multiple_scattering",
+            "needs a constant density (a number), not a noise or grid density",
+        ));
+    }
     Ok(Medium {
         sigma_s,
         sigma_a,
@@ -52,6 +68,7 @@ pub(super) fn medium(t: &Tbl, within: &Confinement) -> R<Medium> {
         bounds_min,
         bounds_max,
         density,
+        multiple_scattering,
     })
 }
 

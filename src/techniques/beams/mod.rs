@@ -186,6 +186,7 @@ impl TechniqueBuild for Beams {
         Component::SurfaceCaustics,
         Component::Airlight,
         Component::VolumeCaustics,
+        Component::Other,
         Component::Emitted,
     ];
     /// On `water_pool` it draws 0.1% of the water's surface caustics
@@ -298,7 +299,10 @@ impl Technique for Beams {
     }
 
     fn set_lights(&mut self, lights: &[Light]) -> bool {
-        if !(self.surface.set_lights(lights) && self.light_views.set_lights(lights)) {
+        if !(self.airlight.follows_lights()
+            && self.surface.set_lights(lights)
+            && self.light_views.set_lights(lights))
+        {
             return false;
         }
         self.tracer

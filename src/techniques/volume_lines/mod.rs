@@ -226,6 +226,7 @@ impl TechniqueBuild for VolumeLines {
         Component::SurfaceCaustics,
         Component::Airlight,
         Component::VolumeCaustics,
+        Component::Other,
         Component::Emitted,
     ];
     const CAUSTIC_SOURCES: CausticSources = CausticSources::All;
@@ -315,7 +316,8 @@ impl Technique for VolumeLines {
 
     fn set_lights(&mut self, lights: &[Light]) -> bool {
         self.caustics.invalidate();
-        self.surface.set_lights(lights)
+        self.airlight.follows_lights()
+            && self.surface.set_lights(lights)
             && self.light_views.set_lights(lights)
             && self
                 .caustic_views
