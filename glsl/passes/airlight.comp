@@ -41,7 +41,8 @@
 // - L V V E, the same discretisation of Hu's Eq. 1 with the virtual lights
 //   as its sources, over MS_STEPS strata (the field is smooth): at x,
 //   sum_v Phi_v p(w_v . w) / max(d^2, r_v^2) exp(-sigma_t d) p(w . -dir),
-//   w = (x - p_v) / d, unshadowed (both ends lie in the convex box);
+//   w = (x - p_v) / d, unshadowed (objects inside the box, glass included,
+//   neither block nor bend it: the approximation);
 // - L V D E at the camera ray's first surface, if diffuse:
 //   albedo / pi sum_v Phi_v p(w_v . w) cos / max(d^2, r_v^2) tau, times
 //   the visible fraction from MS_SHADOW_RAYS BVH shadow rays (below) and
@@ -198,8 +199,9 @@ void main() {
     }
     if (ms_weight > 0.0) ms += multiple_scattering_medium(eye, dir, t0, t1, u);
 
-    uint n = max(pc.steps, 1u);
-    float dt = (t1 - t0) / float(n);
+    // No single-scattering strata when only `other` is drawn.
+    uint n = weight > 0.0 ? max(pc.steps, 1u) : 0u;
+    float dt = (t1 - t0) / float(max(n, 1u));
     vec3 sigma_s = medium.sigma_s.rgb;
     vec3 sigma_t = medium.sigma_s.rgb + medium.sigma_a.rgb;
     float g = medium.sigma_s.w;

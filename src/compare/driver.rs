@@ -313,12 +313,23 @@ pub fn judge_technique(
         let Some(truth) = reference.component(c) else {
             continue;
         };
-        if let Some(reason) = info.not_modelled(scene, c) {
-            not_applicable.push(NotApplicable {
-                component: c.name().into(),
-                reason,
-            });
-            unscored_images.push(img);
+        // `other` also holds diffuse interreflection, which no technique
+        // draws, once the reference's photons bounce off diffuse surfaces.
+        let interreflection = (c == Component::Other && view.diffuse_bounces > 0).then(|| {
+            format!(
+                "{name} draws no diffuse interreflection, which `other` holds with {} diffuse bounces",
+                view.diffuse_bounces
+            )
+        });
+        if let Some(reason) = info.not_modelled(scene, c).or(interreflection) {
+            // Not a gap where the reference has (next to) no light either.
+            if holds_light(truth, &reference.all) {
+                not_applicable.push(NotApplicable {
+                    component: c.name().into(),
+                    reason,
+                });
+                unscored_images.push(img);
+            }
             continue;
         }
         let (m, cmap) = metrics::compare(&img, truth, width, height, exposure);

@@ -94,6 +94,8 @@ pub struct Airlight {
     _layout: DescriptorSetLayout,
     sampler: Sampler,
     scattered: Buffer,
+    /// The medium asks for multiple scattering (`Medium::multiple_scattering`).
+    multiple_scattering: bool,
     moving: Option<Moving>,
 }
 
@@ -136,7 +138,7 @@ impl Airlight {
         Ok(Self {
             push: AirlightPush {
                 light_count: scene.lights.len().min(b::MAX_LIGHTS as usize) as u32,
-                lit_count: crate::frame::caustic_lights(scene).len() as u32,
+                lit_count: lights.len() as u32,
                 steps: params.airlight_steps,
                 medium_steps,
                 jitter: params.airlight_jitter,
@@ -147,6 +149,7 @@ impl Airlight {
             _layout: layout,
             sampler,
             scattered,
+            multiple_scattering: ms,
             moving,
         })
     }
@@ -160,7 +163,7 @@ impl Airlight {
     /// Whether the pass can follow moved lights in place: not with virtual
     /// lights, which are placed from them (the technique is rebuilt).
     pub fn follows_lights(&self) -> bool {
-        self.push.scattered_count == 0
+        !self.multiple_scattering
     }
 
     /// Records the "airlight" pass: adds L_A (times the airlight component's

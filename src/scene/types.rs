@@ -316,7 +316,7 @@ pub struct Medium {
     pub density: Density,
     /// The real-time techniques add an approximate multiple scattering
     /// (light scattered twice in the medium, or scattered and then
-    /// reflected by a surface: frame/scattered_lights.rs); the reference
+    /// reflected by a surface: src/passes/scattered_lights.rs); the reference
     /// always renders all of it.
     pub multiple_scattering: bool,
 }

@@ -54,7 +54,7 @@ pub(super) fn medium(t: &Tbl, within: &Confinement) -> R<Medium> {
     };
     let multiple_scattering = t.opt_bool("multiple_scattering")?.unwrap_or(false);
     // The scattered lights are placed along the lights' rays on the CPU,
-    // which evaluates a constant density only (frame/scattered_lights.rs).
+    // which evaluates a constant density only (src/passes/scattered_lights.rs).
     if multiple_scattering && !matches!(density, Density::Constant(_)) {
         return Err(t.err(
             "multiple_scattering",
