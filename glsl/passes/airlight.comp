@@ -162,7 +162,6 @@ vec3 multiple_scattering_surface(vec3 x, vec3 n, vec3 albedo, float u) {
     return albedo / PI * e * visible;
 }
 
-
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(p, imageSize(radiance)))) return;

@@ -34,9 +34,9 @@
 //! Where the scene's medium asks for it (`multiple_scattering`), the pass
 //! also adds the approximate multiple scattering of
 //! [`super::scattered_lights`]: virtual lights where the light scatters
-//! once, lighting the medium along the same strata (L V V E, unshadowed)
-//! and the camera ray's surface (L V D E, one BVH shadow ray per virtual
-//! light), tagged `other`.
+//! once, lighting the medium along the camera ray (L V V E, unshadowed)
+//! and the camera ray's diffuse surface (L V D E: the unoccluded sum times
+//! the visible fraction of 16 BVH shadow rays), tagged `other`.
 //!
 //! A technique owns one `Airlight` next to its shadow maps, holds
 //! [`AirlightParams`] as a group of its parameter struct (and passes its
