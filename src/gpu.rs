@@ -59,7 +59,9 @@ pub struct GpuBvhNode {
 pub struct GpuMaterial {
     /// rgb albedo / reflectance; w = kind (uint bits).
     pub color: [f32; 4],
-    /// rgb absorption (1/m); w = ior.
+    /// rgb extinction inside a dielectric (1/m): its absorption plus the
+    /// scattering of the medium inside it (`Material::extinction`), which
+    /// takes light out of a ray as surely as absorption does; w = ior.
     pub absorption_ior: [f32; 4],
     /// x = albedo texture layer in bits 0-15 and the wrap modes of u and v
     /// (WRAP_*) in bits 16-17 and 18-19 (int bits, -1: none); yz = uv_scale; w = alpha
@@ -72,6 +74,9 @@ pub struct GpuMaterial {
     /// rgb mirror reflectance of a `mixed` material's specular part (kind
     /// diffuse; 0 otherwise); w unused.
     pub specular: [f32; 4],
+    /// rgb scattering coefficient (1/m) of the medium inside a dielectric
+    /// (`Material::scattering`; 0: none); w = its Henyey-Greenstein g.
+    pub scattering: [f32; 4],
 }
 
 /// An area light (glsl/common/scene.glsl `Emitter`): what the reference
@@ -199,7 +204,7 @@ const _: () = {
     assert!(offset_of!(GpuBvhNode, count) == 28);
     assert!(size_of::<GpuTriangleUv>() == 32);
     assert!(offset_of!(GpuTriangleUv, uv2) == 16);
-    assert!(size_of::<GpuMaterial>() == 80);
+    assert!(size_of::<GpuMaterial>() == 96);
     assert!(offset_of!(GpuMaterial, texture) == 32);
     assert!(offset_of!(GpuMaterial, emission) == 48);
     assert!(offset_of!(GpuMaterial, specular) == 64);
@@ -278,7 +283,7 @@ impl GpuMaterial {
         };
         Self {
             color: v4(m.color, f32::from_bits(kind)),
-            absorption_ior: v4(m.absorption, m.ior),
+            absorption_ior: v4(m.extinction(), m.ior),
             texture: [
                 f32::from_bits(layer as u32),
                 uv_scale.x,
@@ -287,6 +292,10 @@ impl GpuMaterial {
             ],
             emission: v4(m.emission, 0.0),
             specular: v4(m.specular, 0.0),
+            scattering: match m.scattering {
+                Some(s) if m.kind == MaterialKind::Dielectric => v4(s.sigma_s, s.g),
+                _ => [0.0; 4],
+            },
         }
     }
 }

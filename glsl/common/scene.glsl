@@ -34,10 +34,11 @@ struct BvhNode {
 
 struct Material {
     vec4 color;          // rgb albedo/reflectance; w: kind (uint bits)
-    vec4 absorption_ior; // rgb absorption 1/m; w: ior
+    vec4 absorption_ior; // rgb extinction inside a dielectric, 1/m (absorption + the inside's scattering); w: ior
     vec4 albedo_texture; // x: layer in bits 0-15, wrap u/v (WRAP_*) in bits 16-17/18-19 (int bits, -1: none); yz: uv_scale; w: alpha cutoff
     vec4 emission;       // rgb radiance emitted from front faces (area lights)
     vec4 specular;       // rgb mirror reflectance of a `mixed` material (kind diffuse); 0 otherwise
+    vec4 scattering;     // dielectric: rgb sigma_s of the medium inside (1/m, 0: none); w: HG g
 };
 
 // An area light (src/gpu.rs GpuEmitter); its geometry is ordinary

@@ -7,7 +7,9 @@
 // caustics of the scene without its specular surfaces) copied through.
 //
 // Dielectric at p1 (normal N1 toward the viewer, view direction V):
-//   L = F1 L(p1, R) + (1 - F1) T2 exp(-sigma_a d~) L(p2, T2)
+//   L = F1 L(p1, R) + (1 - F1) T2 exp(-sigma_t d~) L(p2, T2)
+// (sigma_t: the material's absorption plus its inside's scattering, the
+// light scattered out of the ray; Material.absorption_ior)
 // F1 the exact unpolarised Fresnel reflectance at p1, R the mirror
 // direction, and p2, T2, d~ and the exit transmittance T2 = 1 - F2 (1 where
 // a TIR remedy applied) from glsl/common/image_space_refraction.glsl
@@ -16,7 +18,7 @@
 // the two interfaces the factors cancel, so no n^2 appears here.
 // One interface (an open sheet such as a water surface: the back-face
 // texel is empty and the pixel's d_N is 0, so the refractor has no back
-// surface at all): L = F1 L(p1, R) + (1 - F1)/n^2 exp(-sigma_a t) L(x, T1),
+// surface at all): L = F1 L(p1, R) + (1 - F1)/n^2 exp(-sigma_t t) L(x, T1),
 // T1 Snell at p1 and x the opaque surface met along it at distance t.
 // Derivation: basic radiance L/n^2 is conserved along a ray and across a
 // smooth interface up to the transmitted fraction 1 - F (F symmetric in
@@ -26,7 +28,7 @@
 // opaque frame holds L(x) as radiance of the surface (albedo/pi E), the
 // medium around the receiver being the refractor's. A camera under the
 // sheet (its outward normal facing away; the specular G-buffer keeps the
-// face for the camera) sees L = F1 exp(-sigma_a t) L(x_R) + (1 - F1) n^2
+// face for the camera) sees L = F1 exp(-sigma_t t) L(x_R) + (1 - F1) n^2
 // L(x, T1), F1 and T1 for light entering the medium (total reflection past
 // the critical angle: Snell's window), the reflected leg inside it.
 // With `camera_exit` 0 (CAMERA_EXIT_TRACED, the default) p2, T2, the path
@@ -258,7 +260,7 @@ bool search_opaque(vec3 o, vec3 d, out vec3 l, out float t_hit) {
 
 // The rays a pixel's specular surface sends on (the reflected one and the
 // refracted one), each with its weight; `absorbing`: the open sheet's
-// refracted ray, weighted by exp(-sigma_a t) over the distance t it
+// refracted ray, weighted by exp(-sigma_t t) over the distance t it
 // travels to what it meets.
 struct SecondaryRay {
     vec3 origin;
@@ -293,7 +295,7 @@ void main() {
     SecondaryRay rays[2];
     uint count = 1u;
     rays[0] = SecondaryRay(p1, reflect(v, n1), materials[m].color.rgb, false, false);
-    vec3 sigma_a = materials[m].absorption_ior.rgb;
+    vec3 sigma_t = materials[m].absorption_ior.rgb;
     if (material_kind(m) != MATERIAL_MIRROR) {
         float ior = materials[m].absorption_ior.w;
         // d_V: front to the farthest back face along this pixel's ray; a
@@ -326,14 +328,14 @@ void main() {
             rays[0].weight = vec3(f1);
             vec3 exit_p, exit_d, through;
             if (pc.exit == CAMERA_EXIT_TRACED) {
-                if (traced_refraction(v, p1, n1, ior, sigma_a, exit_p, exit_d, through)) {
+                if (traced_refraction(v, p1, n1, ior, sigma_t, exit_p, exit_d, through)) {
                     rays[count++] = SecondaryRay(exit_p, exit_d, (1.0 - f1) * through, false, false);
                 }
             } else {
                 float d_v = bp.w >= 0.0 ? max(length(bp.xyz - p1), 0.0) : 0.0;
                 TwoSidedExit e;
                 if (two_sided_refraction(v, p1, n1, ior, d_v, fp.w, pc.tir_remedy, pc.use_eq632 != 0u, e)) {
-                    vec3 absorbed = exp(-sigma_a * e.dist);
+                    vec3 absorbed = exp(-sigma_t * e.dist);
                     rays[count++] = SecondaryRay(e.p2, e.dir, (1.0 - f1) * e.transmit * absorbed, false, false);
                 }
             }
@@ -348,7 +350,7 @@ void main() {
         float t;
         bool found = !rays[k].traced && search_opaque(rays[k].origin, rays[k].dir, seen, t);
         if (!found) seen = traced_radiance(rays[k].origin, rays[k].dir, t);
-        vec3 absorbed = rays[k].absorbing ? exp(-sigma_a * max(t, 0.0)) : vec3(1.0);
+        vec3 absorbed = rays[k].absorbing ? exp(-sigma_t * max(t, 0.0)) : vec3(1.0);
         l += rays[k].weight * absorbed * seen;
     }
     imageStore(radiance, p, vec4(l, 1.0));

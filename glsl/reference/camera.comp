@@ -182,12 +182,13 @@ vec3 emitted_radiance(SpecularState s, bool found, Hit hit) {
 }
 
 // The attenuation of the segment from s.origin along s.dir to the next hit
-// (`found`) or out of the scene: absorption inside glass, the medium outside
-// (one ratio-tracking run: the EMISSION_GRID^2 chains already average).
+// (`found`) or out of the scene: the extinction inside glass or water, the
+// medium outside (one ratio-tracking run: the EMISSION_GRID^2 chains
+// already average).
 vec3 segment_attenuation(SpecularState s, bool found, float t, inout uint rng) {
-    if (s.inside) return found ? exp(-s.inside_absorption * t) : vec3(0.0);
+    if (s.inside && !found) return vec3(0.0);
     float travel = found ? t : 2.0 * frame.scene_sphere.w + length(s.origin - frame.scene_sphere.xyz);
-    return medium_transmittance(s.origin, s.dir, travel, rng);
+    return region_transmittance(s, s.origin, s.dir, travel, rng);
 }
 
 // The emitted component (L S* E): the emitters a camera ray meets directly
@@ -296,7 +297,9 @@ uint follow_chain(uint index, uint branch, SpecularState s, inout uint rng, inou
     for (uint depth = 0u; depth < pc.max_depth; ++depth) {
         Hit hit;
         bool found = trace_closest(s.origin, s.dir, 0.0, 1e30, hit);
-        if (depth == 0u && branch == 0u) {
+        // The scene's medium before any specular bounce; an eye inside a
+        // dielectric sees only light that came in through its surface.
+        if (depth == 0u && branch == 0u && !s.inside) {
             add_pass(index, COMPONENT_AIRLIGHT, airlight(s.origin, s.dir, found ? hit.t : 1e30, first_rng));
         }
         if (!found) break;
@@ -308,8 +311,10 @@ uint follow_chain(uint index, uint branch, SpecularState s, inout uint rng, inou
         vec3 mirror = diffuse ? m.specular.rgb : vec3(0.0);
         bool mixed = any(greaterThan(mirror, vec3(0.0)));
         vec3 x = s.origin + hit.t * s.dir;
-        // Every segment's attenuation: absorption inside glass, the medium outside.
-        if (s.inside) s.weight *= exp(-s.inside_absorption * hit.t);
+        // Every segment's attenuation: the extinction inside glass or water
+        // (what a medium there scatters in is volume_points.comp's), the
+        // medium outside.
+        if (s.inside) s.weight *= exp(-s.inside_extinction * hit.t);
         else s.weight *= mean_transmittance(s.origin, s.dir, hit.t, rng);
         if (diffuse && depth == 0u) {
             // The first hit is diffuse: its direct light (L D E) by shadow
@@ -379,7 +384,8 @@ void main() {
     uint index = p.y * image_width() + p.x;
     // A stream apart from the photon pass's (same seed, other constant).
     uint rng = rng_seed(index, pc.seed ^ 0x68bc21ebu);
-    SpecularState s = camera_ray(p, rng);
+    SpecularState at_eye = eye_state();
+    SpecularState s = camera_ray(p, at_eye, rng);
 
     vec3 emitted = vec3(0.0);
     // Without area lights or an environment nothing is seen emitting.
@@ -387,7 +393,7 @@ void main() {
     for (uint k = 0u; k < emission_samples; ++k) {
         vec2 cell = vec2(k % EMISSION_GRID, k / EMISSION_GRID);
         vec2 jitter = (cell + vec2(rng_next(rng), rng_next(rng))) / float(EMISSION_GRID);
-        emitted += chain_emission(camera_ray_through(p, jitter), rng);
+        emitted += chain_emission(camera_ray_through(p, jitter, at_eye), rng);
     }
     if (emission_samples > 0u) add_pass(index, COMPONENT_EMITTED, emitted / float(emission_samples));
 

@@ -57,7 +57,7 @@ layout(set = 1, binding = REFERENCE_BINDING_VOLUME_NEXT, std430) buffer VolumeNe
 struct GatherPoint {
     vec4 position;  // w: pixel index (uint bits)
     vec4 direction; // the camera ray's direction; w: path-type mask (uint bits)
-    vec4 weight;    // camera path weight times the quadrature step (m)
+    vec4 weight;    // camera path weight times the quadrature step (m); w: HG g there
 };
 layout(set = 1, binding = REFERENCE_BINDING_GATHER_POINTS, std430) buffer GatherPoints { GatherPoint gather_points[]; };
 // Cells a gather point's ball can overlap: one volume_gather.comp invocation each.
@@ -128,9 +128,37 @@ struct SpecularState {
     vec3 origin;
     vec3 dir;
     vec3 weight;
-    bool inside;             // inside a dielectric (no medium there)
-    vec3 inside_absorption;  // that dielectric's absorption, 1/m
+    bool inside;             // inside a dielectric (the scene's [medium] is not there)
+    vec3 inside_extinction;  // that dielectric's sigma_t: absorption + scattering, 1/m
+    vec4 inside_scattering;  // the medium inside it: sigma_s (rgb, 1/m; 0: none), HG g (w)
 };
+
+// Crossing into dielectric m, or out of it (one level: dielectrics do not nest).
+void enter_dielectric(inout SpecularState s, Material m) {
+    s.inside = true;
+    s.inside_scattering = m.scattering;
+    s.inside_extinction = m.absorption_ior.rgb; // absorption + scattering
+}
+void leave_dielectric(inout SpecularState s) {
+    s.inside = false;
+    s.inside_extinction = vec3(0.0);
+    s.inside_scattering = vec4(0.0);
+}
+
+// Inside a dielectric whose medium scatters (turbid water): free-flight
+// sampling there, like the scene's [medium] outside.
+bool scatters_inside(SpecularState s) {
+    return s.inside && any(greaterThan(s.inside_scattering.rgb, vec3(0.0)));
+}
+
+// Transmittance along o + t d, t in [0, dist], a segment free of surfaces
+// that lies where s is: inside its dielectric (homogeneous: Beer-Lambert
+// with the inside's extinction) or outside (the scene's medium,
+// `medium_transmittance`).
+vec3 region_transmittance(SpecularState s, vec3 o, vec3 d, float dist, inout uint rng) {
+    if (s.inside) return exp(-s.inside_extinction * dist);
+    return medium_transmittance(o, d, dist, rng);
+}
 
 // Mirror reflection of reflectance `reflectance` on the side the ray
 // arrives at (a mirror, or a `mixed` material's mirror part), about the
@@ -200,8 +228,8 @@ float specular_bounce(inout SpecularState s, vec3 x, vec3 ng, vec3 ns, bool fron
         if (carries_radiance) s.weight *= eta * eta;
         s.dir = refracted;
         s.origin = offset_origin(x, -ng_in);
-        s.inside = front;
-        s.inside_absorption = m.absorption_ior.rgb;
+        if (front) enter_dielectric(s, m);
+        else leave_dielectric(s);
     } else {
         vec3 r = reflect(s.dir, n);
         s.dir = dot(r, ng_in) > 0.0 ? r : reflect(s.dir, ng_in);
@@ -247,22 +275,38 @@ bool emitter_sampled_by_camera(Emitter em) {
     return kind == EMITTER_RECT || kind == EMITTER_TRIANGLE;
 }
 
-// A camera ray through a uniformly jittered point of pixel p (weight 1).
-SpecularState camera_ray_through(uvec2 p, vec2 jitter) {
-    vec2 ndc = (vec2(p) + jitter) / frame.viewport.xy * 2.0 - 1.0;
-    vec4 far = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
+// The state of a camera path at the eye (weight 1, no direction yet):
+// inside the dielectric whose back face is the first surface straight up
+// from the eye (the eye under water, or in a closed glass object), else
+// outside. Lights are assumed outside every dielectric.
+SpecularState eye_state() {
     SpecularState s;
     s.origin = frame.eye.xyz;
-    s.dir = normalize(far.xyz / far.w - s.origin);
+    s.dir = vec3(0.0, 1.0, 0.0);
     s.weight = vec3(1.0);
-    s.inside = false;
-    s.inside_absorption = vec3(0.0);
+    leave_dielectric(s);
+    Hit hit;
+    if (trace_closest(s.origin, s.dir, 0.0, 1e30, hit)) {
+        Material m = materials[hit_material(hit)];
+        bool from_back = dot(s.dir, hit_geometric_normal(hit)) > 0.0;
+        if (floatBitsToUint(m.color.w) == MATERIAL_DIELECTRIC && from_back) enter_dielectric(s, m);
+    }
+    return s;
+}
+
+// A camera ray through a uniformly jittered point of pixel p, from the
+// eye's state `at_eye` (`eye_state`).
+SpecularState camera_ray_through(uvec2 p, vec2 jitter, SpecularState at_eye) {
+    vec2 ndc = (vec2(p) + jitter) / frame.viewport.xy * 2.0 - 1.0;
+    vec4 far = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
+    SpecularState s = at_eye;
+    s.dir = normalize(far.xyz / far.w - s.origin);
     return s;
 }
 
 // The camera ray through a uniform random point of pixel p.
-SpecularState camera_ray(uvec2 p, inout uint rng) {
-    return camera_ray_through(p, vec2(rng_next(rng), rng_next(rng)));
+SpecularState camera_ray(uvec2 p, SpecularState at_eye, inout uint rng) {
+    return camera_ray_through(p, vec2(rng_next(rng), rng_next(rng)), at_eye);
 }
 
 #endif

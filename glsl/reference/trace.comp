@@ -242,7 +242,9 @@ void emit(uint l, inout uint rng, out vec3 origin, out vec3 dir, out vec3 flux) 
     }
 }
 
-void connect_surface(vec3 x, vec3 n, vec3 weight, vec3 albedo, uint tag, inout uint rng) {
+// The camera connections: `s` is the photon's state where it is (the
+// region its segment to the eye lies in when nothing blocks it).
+void connect_surface(SpecularState s, vec3 x, vec3 n, vec3 albedo, uint tag, inout uint rng) {
     ivec2 pixel;
     vec3 to_eye;
     float dist, measurement;
@@ -251,20 +253,20 @@ void connect_surface(vec3 x, vec3 n, vec3 weight, vec3 albedo, uint tag, inout u
     if (cos_x <= 0.0) return;
     vec3 o = offset_origin(x, n);
     if (trace_any(o, to_eye, 0.0, dist * (1.0 - 1e-4))) return;
-    vec3 tr = medium_transmittance(o, to_eye, dist, rng);
+    vec3 tr = region_transmittance(s, o, to_eye, dist, rng);
     photon_useful = true;
-    splat(pixel, tag, weight * (albedo / PI) * cos_x * measurement * tr);
+    splat(pixel, tag, s.weight * (albedo / PI) * cos_x * measurement * tr);
 }
 
-void connect_medium(vec3 x, vec3 d, vec3 weight_sigma_s, float g, uint tag, inout uint rng) {
+void connect_medium(SpecularState s, vec3 x, vec3 weight_sigma_s, float g, uint tag, inout uint rng) {
     ivec2 pixel;
     vec3 to_eye;
     float dist, measurement;
     if (!camera_connection(x, pixel, to_eye, dist, measurement)) return;
     if (trace_any(x, to_eye, 0.0, dist * (1.0 - 1e-4))) return;
-    vec3 tr = medium_transmittance(x, to_eye, dist, rng);
+    vec3 tr = region_transmittance(s, x, to_eye, dist, rng);
     photon_useful = true;
-    splat(pixel, tag, weight_sigma_s * hg_phase(dot(d, to_eye), g) * measurement * tr);
+    splat(pixel, tag, weight_sigma_s * hg_phase(dot(s.dir, to_eye), g) * measurement * tr);
 }
 
 // Progressive photon mapping, surface (Knaus & Zwicker 2011, Eq. 9 with the
@@ -340,14 +342,12 @@ void trace_photon() {
     else if (l < areas_end) emit_area(l - frame.counts.x, rng, s.origin, s.dir, s.weight);
     else emit_environment(l > areas_end, rng, s.origin, s.dir, s.weight);
     s.weight /= light_probability;
-    s.inside = false; // lights are outside objects
-    s.inside_absorption = vec3(0.0);
+    leave_dielectric(s); // lights are outside objects
 
     uint specular = 0u;
     bool scattered_or_bounced = false;
     uint diffuse_left = pc.diffuse_bounces;
     bool has_medium = medium_present();
-    float g = medium.sigma_s.w;
 
     for (uint depth = 0u; depth < pc.max_depth; ++depth) {
         // Direct light (L D, L V) is camera.comp's for these photons.
@@ -356,21 +356,27 @@ void trace_photon() {
         bool found = trace_closest(s.origin, s.dir, 0.0, 1e30, hit);
         float t_hit = found ? hit.t : 1e30;
 
-        if (has_medium && !s.inside) {
+        // The scene's medium outside dielectrics, or the homogeneous one
+        // inside a dielectric that holds one (turbid water: free-flight
+        // sampling after the photon entered it through the surface).
+        bool inside_medium = scatters_inside(s);
+        if ((has_medium && !s.inside) || inside_medium) {
             // Tentative collisions at rate `majorant` (delta tracking with
             // null collisions; weighted so that rgb coefficients may differ).
             float t0 = 0.0, t1 = t_hit;
-            float majorant = medium_majorant();
+            vec3 extinction = inside_medium ? s.inside_extinction : medium.sigma_s.rgb + medium.sigma_a.rgb;
+            float majorant = inside_medium ? max(extinction.r, max(extinction.g, extinction.b)) : medium_majorant();
+            float g = inside_medium ? s.inside_scattering.w : medium.sigma_s.w;
             bool event = false;
-            if (majorant > 0.0 && clip_to_medium(s.origin, s.dir, t0, t1)) {
+            if (majorant > 0.0 && (inside_medium || clip_to_medium(s.origin, s.dir, t0, t1))) {
                 float t = t0;
                 for (int i = 0; i < 100000; ++i) {
                     t -= log(1.0 - rng_next(rng)) / majorant;
                     if (t >= t1) break;
                     vec3 x = s.origin + t * s.dir;
-                    float density = medium_density(x);
-                    vec3 sigma_s = medium.sigma_s.rgb * density;
-                    vec3 sigma_n = vec3(majorant) - (medium.sigma_s.rgb + medium.sigma_a.rgb) * density;
+                    float density = inside_medium ? 1.0 : medium_density(x);
+                    vec3 sigma_s = (inside_medium ? s.inside_scattering.rgb : medium.sigma_s.rgb) * density;
+                    vec3 sigma_n = vec3(majorant) - extinction * density;
                     // Every tentative collision connects: E[sum] = integral of T sigma_s along the ray.
                     if (any(greaterThan(sigma_s, vec3(0.0)))) {
                         uint tag = tag_for(specular, scattered_or_bounced, true);
@@ -378,10 +384,15 @@ void trace_photon() {
                         // camera.comp samples along the camera rays.
                         // Multiple scattering (tag `other`) seen directly is
                         // the volume gather (volume_points.comp) when the volume photon
-                        // map is on (finite variance near the eye).
-                        bool gathered_on_first_segment = pc.volume_capacity != 0u && tag == COMPONENT_OTHER;
+                        // map is on (finite variance near the eye); so is
+                        // every collision inside a dielectric: an eye that
+                        // sees it directly is under the same surface, in
+                        // water lit all around it, where the connections'
+                        // 1/d^2 made the image fireflies.
+                        bool gathered_on_first_segment = pc.volume_capacity != 0u
+                            && (tag == COMPONENT_OTHER || inside_medium);
                         if (!straight_from_sampled_light && !gathered_on_first_segment) {
-                            connect_medium(x, s.dir, s.weight * sigma_s / majorant, g, tag, rng);
+                            connect_medium(s, x, s.weight * sigma_s / majorant, g, tag, rng);
                         }
                         if (pc.volume_capacity != 0u) store_volume_photon(x, s.dir, s.weight * sigma_s / majorant, tag);
                     }
@@ -409,7 +420,9 @@ void trace_photon() {
         vec3 x = s.origin + hit.t * s.dir;
         vec3 ng = hit_geometric_normal(hit);
         bool front = dot(s.dir, ng) < 0.0;
-        if (s.inside) s.weight *= exp(-s.inside_absorption * hit.t);
+        // Inside a dielectric without scattering: Beer-Lambert (with
+        // scattering, the free-flight sampling above attenuated the photon).
+        if (s.inside && !inside_medium) s.weight *= exp(-s.inside_extinction * hit.t);
 
         Material m = materials[hit_material(hit)];
         if (floatBitsToUint(m.color.w) == MATERIAL_DIFFUSE) {
@@ -421,7 +434,7 @@ void trace_photon() {
             // diffuse point, seen directly or through a specular chain: it
             // is neither connected nor gathered. Every other photon is both.
             if (!straight_from_sampled_light) {
-                connect_surface(x, ng_in, s.weight, albedo, tag, rng);
+                connect_surface(s, x, ng_in, albedo, tag, rng);
                 if (pc.gather != 0u) gather_surface(x, ng_in, s.weight, tag);
             }
             // The photon goes on by a `mixed` material's mirror part with

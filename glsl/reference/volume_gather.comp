@@ -28,7 +28,7 @@ void main() {
 
     vec3 dir = point.direction.xyz;
     uint tag_mask = floatBitsToUint(point.direction.w);
-    float g = medium.sigma_s.w;
+    float g = point.weight.w; // the phase of the medium the point lies in
     uint links = min(min(volume_photon_count, pc.volume_capacity), REFERENCE_GATHER_WALK_LIMIT);
     vec3 sums[COMPONENT_COUNT];
     for (uint k = 0u; k < COMPONENT_COUNT; ++k) sums[k] = vec3(0.0);

@@ -27,8 +27,9 @@
 // covers A_⊥ = (r.width s^c / W)(r.height s^c / H) perpendicular to the
 // light (Eq. 7 is the s^(2c)), so the beam through it carries Φ = E A_⊥; the
 // exact Fresnel reflectance F splits it into F Φ reflected and (1 − F) Φ
-// refracted, and the refracted part loses exp(−σ_a t') to the water's
-// absorption. Paper mode (WP_INTENSITY_PAPER): R = L I_att F (Eq. 12) with
+// refracted, and the refracted part loses exp(−σ_t t') to the water's
+// extinction (its absorption, and the scattering of a medium in it: the
+// light scattered out of the beam reaches the floor as no caustic). Paper mode (WP_INTENSITY_PAPER): R = L I_att F (Eq. 12) with
 // L = E A_⊥, I_att of Eq. 13 and the stylised Fresnel of Eqs. 14-15.
 #include "scene.glsl"
 #include "optics.glsl"
@@ -131,7 +132,7 @@ void main() {
 
     uint material = wp.water.x;
     float ior = materials[material].absorption_ior.w;
-    vec3 sigma_a = materials[material].absorption_ior.rgb;
+    vec3 sigma_t = materials[material].absorption_ior.rgb;
     float eta = 1.0 / max(ior, 1e-6);
     // The side of the surface the light arrives on (the water's normals
     // face +y; a sun above always sees that side).
@@ -180,7 +181,7 @@ void main() {
         } else {
             float f = type == WP_RAY_REFLECTED ? fresnel : 1.0 - fresnel;
             flux = beam * f;
-            if (type == WP_RAY_REFRACTED) flux *= exp(-sigma_a * h.t);
+            if (type == WP_RAY_REFRACTED) flux *= exp(-sigma_t * h.t);
         }
         if (all(equal(flux, vec3(0.0)))) continue;
 

@@ -205,15 +205,15 @@ void main() {
     if (inside) n1 = -n1;
     float ior = materials[m].absorption_ior.w;
     float eta = inside ? ior : 1.0 / ior;
-    vec3 sigma_a = materials[m].absorption_ior.rgb;
+    vec3 sigma_t = materials[m].absorption_ior.rgb;
     float f1 = fresnel_dielectric(-dot(v, n1), eta);
     float t;
     vec3 l = f1 * radiance_along(offset_along(p1, n1), reflect(v, n1), t);
-    if (inside) l *= exp(-sigma_a * t);
+    if (inside) l *= exp(-sigma_t * t);
     vec3 t1;
     if (refract_dir(v, n1, eta, t1)) {
         vec3 behind = radiance_along(offset_along(p1, -n1), t1, t);
-        l += (1.0 - f1) * eta * eta * (inside ? vec3(1.0) : exp(-sigma_a * t)) * behind;
+        l += (1.0 - f1) * eta * eta * (inside ? vec3(1.0) : exp(-sigma_t * t)) * behind;
     }
     imageStore(radiance, p, vec4(l, 1.0));
 }

@@ -185,7 +185,7 @@ impl Placer<'_> {
                 .normalize_or_zero();
             let point = origin + dir * hit.t;
             if inside_glass {
-                power *= (-material.absorption * hit.t).exp();
+                power *= (-material.extinction() * hit.t).exp();
             }
             travelled += hit.t;
             match material.kind {

@@ -181,7 +181,7 @@ impl ReferenceRenderer {
             &targets,
             settings,
             radius,
-            scene.medium.is_some(),
+            scene.has_scattering(),
             specular_sphere(&scene, time),
             scene.lights.len(),
         )?;

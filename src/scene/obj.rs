@@ -57,6 +57,7 @@ pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
             texture: None,
             emission: Vec3::ZERO,
             specular: Vec3::ZERO,
+            scattering: None,
         }
     } else if m.illumination_model == Some(3) {
         Material {
@@ -68,6 +69,7 @@ pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
             texture: None,
             emission: Vec3::ZERO,
             specular: Vec3::ZERO,
+            scattering: None,
         }
     } else {
         Material {
@@ -79,6 +81,7 @@ pub fn convert_material(prefix: &str, m: &tobj::Material) -> Material {
             texture: None,
             emission: Vec3::ZERO,
             specular: Vec3::ZERO,
+            scattering: None,
         }
     }
 }

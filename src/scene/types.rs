@@ -99,12 +99,37 @@ pub struct Material {
     /// Lambertian `color`; `color + specular` <= 1 per channel). 0 for a
     /// plain diffuse surface and for other kinds.
     pub specular: Vec3,
+    /// Dielectric only: the participating medium that fills its inside
+    /// (turbid water, milky glass) scatters with this; its absorption is
+    /// `absorption`. None: the inside only absorbs.
+    pub scattering: Option<Scattering>,
+}
+
+/// Scattering inside a dielectric (docs/SCENES.md, "A medium inside a
+/// dielectric"): homogeneous, with a Henyey-Greenstein phase.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scattering {
+    /// Scattering coefficient per channel, 1/m (> 0 in some channel).
+    pub sigma_s: Vec3,
+    /// Henyey-Greenstein asymmetry, in (-1, 1).
+    pub g: f32,
 }
 
 impl Material {
     /// A `mixed` material: diffuse with a mirror part (`specular` > 0).
     pub fn is_mixed(&self) -> bool {
         self.kind == MaterialKind::Diffuse && self.specular.max_element() > 0.0
+    }
+
+    /// What a ray loses per metre inside (1/m): the absorption plus the
+    /// scattering of a medium there (light scattered out of the ray).
+    pub fn extinction(&self) -> Vec3 {
+        self.absorption + self.scattering.map_or(Vec3::ZERO, |s| s.sigma_s)
+    }
+
+    /// A dielectric whose inside scatters (`scattering`).
+    pub fn holds_medium(&self) -> bool {
+        self.kind == MaterialKind::Dielectric && self.scattering.is_some()
     }
 }
 

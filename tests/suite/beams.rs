@@ -404,6 +404,7 @@ fn beams_match_their_in_scattering_integral_and_the_phase_function() {
         texture: None,
         emission: Vec3::ZERO,
         specular: Vec3::ZERO,
+        scattering: None,
     }];
     scene.objects = vec![object("mirror", floor_mesh(0.6, 1.5, 0))];
     scene.lights = vec![point_light(Vec3::new(0.0, 5.0, 0.8), 50.0)];

@@ -45,6 +45,7 @@ fn diffuse(name: &str) -> Material {
         texture: None,
         emission: glam::Vec3::ZERO,
         specular: glam::Vec3::ZERO,
+        scattering: None,
     }
 }
 

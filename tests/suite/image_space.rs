@@ -1025,6 +1025,7 @@ fn mirror_ring_cardioid_cusp() {
         texture: None,
         emission: glam::Vec3::ZERO,
         specular: glam::Vec3::ZERO,
+        scattering: None,
     };
     let mut ring = caustics::scene::shapes::cylinder(
         Vec3::ZERO,

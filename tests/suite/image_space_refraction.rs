@@ -782,6 +782,7 @@ fn mirror_reflects_the_floor() {
         texture: None,
         emission: glam::Vec3::ZERO,
         specular: glam::Vec3::ZERO,
+        scattering: None,
     };
     let s = scene(
         camera(Vec3::new(0.3, 2.5, 4.0), Vec3::new(0.0, 0.5, -1.0), 45.0),

@@ -49,5 +49,6 @@ mod sync_validation;
 mod textures;
 mod views;
 mod volume_lines;
+mod water_medium;
 mod water_photons;
 mod water_surface;

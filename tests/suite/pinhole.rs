@@ -102,6 +102,7 @@ fn mirror(name: &str, reflectance: f32) -> Material {
         texture: None,
         emission: Vec3::ZERO,
         specular: Vec3::ZERO,
+        scattering: None,
     }
 }
 
@@ -337,6 +338,7 @@ fn flat_mixed_plate_reflects_its_mirror_part() {
     let plate = Material {
         color: Vec3::splat(0.3),
         specular: Vec3::splat(0.6),
+        scattering: None,
         ..diffuse("plate", 0.3)
     };
     let (centre, _, _) = flat_reflector(&ctx, plate);

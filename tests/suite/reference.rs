@@ -550,6 +550,7 @@ fn glass_slab_transmits_one_minus_fresnel_squared() {
                 texture: None,
                 emission: glam::Vec3::ZERO,
                 specular: glam::Vec3::ZERO,
+                scattering: None,
                 ..dielectric("glass", n)
             },
         ],
@@ -822,6 +823,7 @@ fn mirror_shows_the_reflected_floor_times_its_reflectance() {
         texture: None,
         emission: glam::Vec3::ZERO,
         specular: glam::Vec3::ZERO,
+        scattering: None,
     };
     let s = scene(
         cam,

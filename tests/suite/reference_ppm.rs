@@ -24,6 +24,7 @@ fn mirror(name: &str, reflectance: f32) -> Material {
         texture: None,
         emission: glam::Vec3::ZERO,
         specular: glam::Vec3::ZERO,
+        scattering: None,
     }
 }
 

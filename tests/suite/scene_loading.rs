@@ -479,6 +479,54 @@ fn degenerate_boxes_and_cylinders_are_rejected() {
 
 #[test]
 fn material_values_are_checked() {
+    // A medium inside a dielectric (docs/SCENES.md).
+    let water = |medium: &str, extra: &str| {
+        base(&format!(
+            "[[material]]\nname = \"w\"\nkind = \"dielectric\"\nior = 1.33\n{extra}medium = {medium}\n"
+        ))
+    };
+    let scene = Scene::from_str(
+        &water(
+            "{ sigma_s = [0.1, 0.2, 0.3], sigma_a = 0.5, g = 0.8, density = 2.0 }",
+            "",
+        ),
+        Path::new("scenes/ok.toml"),
+    )
+    .unwrap();
+    let w = &scene.materials[1];
+    assert!(w.holds_medium());
+    assert_eq!(w.extinction(), glam::Vec3::new(1.2, 1.4, 1.6));
+    assert_eq!(w.scattering.unwrap().g, 0.8);
+    rejects(
+        &water("{ sigma_s = 0.1 }", "absorption = 0.2\n"),
+        "material[1].absorption",
+        "absorption = 0.2",
+        "medium.sigma_a",
+    );
+    rejects(
+        &water("{ sigma_s = 0.1, density = { noise = { scale = 1 } } }", ""),
+        "material[1].medium.density",
+        "medium =",
+        "constant density",
+    );
+    rejects(
+        &water("{ sigma_s = 0.1, g = 1.0 }", ""),
+        "material[1].medium.g",
+        "medium =",
+        "(-1, 1)",
+    );
+    rejects(
+        &water("{ g = 0.5 }", ""),
+        "material[1].medium.sigma_s",
+        "medium =",
+        "missing required field",
+    );
+    rejects(
+        &base("[[material]]\nname = \"d\"\nkind = \"diffuse\"\nmedium = { sigma_s = 0.1 }\n"),
+        "material[1].medium",
+        "medium =",
+        "unknown field",
+    );
     rejects(
         &base("[[material]]\nname = \"g\"\nkind = \"dielectric\"\nior = 0.9\n"),
         "material[1].ior",

@@ -885,6 +885,31 @@ fn unusable_scenes_and_parameters_are_refused() {
         err.to_string().contains("needs a directional light"),
         "{err}"
     );
+    // A second water body or a second sun: refused, naming it.
+    let check = caustics::techniques::find("water_photons")
+        .unwrap()
+        .check_scene;
+    let mut two_waters = Scene::load(&pool).unwrap();
+    let mut second = two_waters
+        .objects
+        .iter()
+        .find(|o| o.water.is_some())
+        .unwrap()
+        .clone();
+    second.name = "second pool".into();
+    two_waters.objects.push(second);
+    let err = check(&two_waters).unwrap_err().to_string();
+    assert!(
+        err.contains("object `second pool`: water_photons renders one water body (`water`)"),
+        "{err}"
+    );
+    let mut two_suns = Scene::load(&pool).unwrap();
+    two_suns.lights.push(two_suns.lights[0]);
+    let err = check(&two_suns).unwrap_err().to_string();
+    assert!(
+        err.contains("light[1]: water_photons traces the caustics of one sun"),
+        "{err}"
+    );
     assert_validation_clean(&ctx);
 }
 

@@ -211,6 +211,7 @@ pub(super) fn add_geometry(
                 texture: None,
                 emission: radiance,
                 specular: Vec3::ZERO,
+                scattering: None,
             });
             let (mut mesh, transform) = match shape {
                 EmitterShape::Rect {

@@ -72,6 +72,35 @@ pub(super) fn medium(t: &Tbl, within: &Confinement) -> R<Medium> {
     })
 }
 
+/// A dielectric material's `medium` table: what fills its inside, as
+/// (absorption, scattering), both already times the constant `density`.
+/// Homogeneous only: the inside has no bounds of its own for a grid, and
+/// the real-time techniques march it in closed form.
+pub(super) fn inside_dielectric(t: &Tbl) -> R<(Vec3, Option<Scattering>)> {
+    t.check_keys(&["sigma_s", "sigma_a", "g", "density"], "material.medium")?;
+    let sigma_s = non_negative_rgb(t, "sigma_s", None)?;
+    let sigma_a = non_negative_rgb(t, "sigma_a", Some(Vec3::ZERO))?;
+    let g = t.f32_or("g", 0.0)?;
+    if g.abs() >= 1.0 {
+        return Err(t.err("g", format!("must be within (-1, 1), got {g}")));
+    }
+    if t.get("density")
+        .is_some_and(|n| !matches!(n.node, Node::Int(_) | Node::Float(_)))
+    {
+        return Err(t.err(
+            "density",
+            "inside a dielectric takes a constant density (a number), not a noise or grid table",
+        ));
+    }
+    let density = t.f32_or("density", 1.0)?;
+    if density < 0.0 {
+        return Err(t.err("density", format!("must not be negative, got {density}")));
+    }
+    let sigma_s = sigma_s * density;
+    let scattering = (sigma_s.max_element() > 0.0).then_some(Scattering { sigma_s, g });
+    Ok((sigma_a * density, scattering))
+}
+
 fn density_table(t: &Tbl, within: &Confinement) -> R<Density> {
     if let Some(noise) = t.opt_table("noise")? {
         t.check_keys(&["noise"], "medium.density")?;

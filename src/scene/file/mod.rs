@@ -269,6 +269,7 @@ fn material(t: &Tbl, within: &Confinement, materials: &mut Materials) -> R<Mater
         texture: None,
         emission: Vec3::ZERO,
         specular: Vec3::ZERO,
+        scattering: None,
     };
     match kind {
         "diffuse" => {
@@ -310,7 +311,7 @@ fn material(t: &Tbl, within: &Confinement, materials: &mut Materials) -> R<Mater
         }
         "dielectric" => {
             t.check_keys(
-                &["name", "kind", "ior", "absorption"],
+                &["name", "kind", "ior", "absorption", "medium"],
                 "a dielectric material",
             )?;
             m.kind = MaterialKind::Dielectric;
@@ -319,6 +320,15 @@ fn material(t: &Tbl, within: &Confinement, materials: &mut Materials) -> R<Mater
                 return Err(t.err("ior", format!("must be at least 1, got {}", m.ior)));
             }
             m.absorption = non_negative_rgb(t, "absorption", Some(Vec3::ZERO))?;
+            if let Some(inside) = t.opt_table("medium")? {
+                if t.has("absorption") {
+                    return Err(t.err(
+                        "absorption",
+                        "give the inside's absorption once, as medium.sigma_a",
+                    ));
+                }
+                (m.absorption, m.scattering) = medium::inside_dielectric(&inside)?;
+            }
         }
         "thin_dielectric" => {
             t.check_keys(&["name", "kind", "ior"], "a thin dielectric material")?;

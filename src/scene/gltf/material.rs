@@ -68,6 +68,7 @@ pub(super) fn convert_material(
         texture: None,
         emission: Vec3::ZERO,
         specular: Vec3::ZERO,
+        scattering: None,
         name,
         kind: MaterialKind::Diffuse,
         color: base,

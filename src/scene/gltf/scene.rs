@@ -94,6 +94,7 @@ pub fn scene(path: &Path, options: &GltfSceneOptions) -> Result<Scene, GltfError
             texture: None,
             emission: Vec3::ZERO,
             specular: Vec3::ZERO,
+            scattering: None,
             name: "floor".into(),
             kind: MaterialKind::Diffuse,
             color: Vec3::splat(FLOOR_ALBEDO),

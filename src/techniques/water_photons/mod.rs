@@ -470,7 +470,32 @@ impl TechniqueBuild for WaterPhotons {
                 "{file}: light: water_photons needs a directional light (the paper's sun, kind = \"directional\") or an environment with a sun; the scene has neither"
             );
         }
-        Ok(())
+        // One water body under one sun: more would be drawn without their
+        // caustics, so they are refused rather than left out unseen.
+        let mut waters = scene.objects.iter().filter(|o| o.water.is_some());
+        let first = waters.next().map(|o| o.name.as_str()).unwrap_or_default();
+        if let Some(extra) = waters.next() {
+            anyhow::bail!(
+                "{file}: object `{}`: water_photons renders one water body (`{first}`); remove the other or choose another technique",
+                extra.name
+            );
+        }
+        let mut suns = scene
+            .lights
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| l.kind == LightKind::Directional);
+        let first_sun = suns.next().map(|(i, _)| i);
+        let extra_sun = suns.next().map(|(i, _)| i);
+        match (first_sun, extra_sun, environment_sun(scene).is_some()) {
+            (Some(a), Some(b), _) => anyhow::bail!(
+                "{file}: light[{b}]: water_photons traces the caustics of one sun (the directional light light[{a}]); remove the other or choose another technique"
+            ),
+            (Some(a), None, true) => anyhow::bail!(
+                "{file}: light[{a}]: water_photons traces the caustics of one sun, and the environment has one too; remove the directional light or the environment's sun, or choose another technique"
+            ),
+            _ => Ok(()),
+        }
     }
 
     fn update_live(&mut self, params: &WaterPhotonsParams) -> bool {

@@ -53,6 +53,7 @@ pub fn diffuse(name: &str, albedo: f32) -> Material {
         texture: None,
         emission: glam::Vec3::ZERO,
         specular: glam::Vec3::ZERO,
+        scattering: None,
     }
 }
 
@@ -66,6 +67,7 @@ pub fn dielectric(name: &str, ior: f32) -> Material {
         texture: None,
         emission: glam::Vec3::ZERO,
         specular: glam::Vec3::ZERO,
+        scattering: None,
     }
 }
 
