@@ -19,7 +19,7 @@ if [ -z "${CAUSTICS:-}" ]; then
   CAUSTICS=target/release/caustics
 fi
 # scene and the techniques shown (all: every technique that applies).
-for entry in "still_life all" "light_shaft direct,volume_lines,beams"; do
+for entry in "still_life all" "light_shaft direct,volume_lines,beams" "pool_shafts water_photons"; do
   set -- $entry
   scene=$1 techniques=$2
   out=out/gallery/$scene

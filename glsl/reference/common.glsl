@@ -276,21 +276,17 @@ bool emitter_sampled_by_camera(Emitter em) {
 }
 
 // The state of a camera path at the eye (weight 1, no direction yet):
-// inside the dielectric whose back face is the first surface straight up
-// from the eye (the eye under water, or in a closed glass object), else
-// outside. Lights are assumed outside every dielectric.
+// inside the dielectric around the eye (`dielectric_around`: under water,
+// in a closed glass object), else outside. Lights are assumed outside
+// every dielectric.
 SpecularState eye_state() {
     SpecularState s;
     s.origin = frame.eye.xyz;
     s.dir = vec3(0.0, 1.0, 0.0);
     s.weight = vec3(1.0);
     leave_dielectric(s);
-    Hit hit;
-    if (trace_closest(s.origin, s.dir, 0.0, 1e30, hit)) {
-        Material m = materials[hit_material(hit)];
-        bool from_back = dot(s.dir, hit_geometric_normal(hit)) > 0.0;
-        if (floatBitsToUint(m.color.w) == MATERIAL_DIELECTRIC && from_back) enter_dielectric(s, m);
-    }
+    uint around = dielectric_around(s.origin);
+    if (around != NO_DIELECTRIC) enter_dielectric(s, materials[around]);
     return s;
 }
 

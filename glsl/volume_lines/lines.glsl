@@ -43,6 +43,7 @@
 #include "random.glsl"
 #include "medium.glsl"
 #include "volume_lines.glsl"
+#include "beam_crossing.glsl"
 
 layout(set = 1, binding = VOLUME_LINES_BINDING_SEGMENTS, std430) readonly buffer SegmentBlock { Segment segments[]; };
 layout(set = 1, binding = VOLUME_LINES_BINDING_VISIBILITY, std430) readonly buffer VisibilityBlock { float surface_distance[]; };
@@ -62,23 +63,6 @@ layout(location = 0) out vec4 out_radiance;
 // (checked on the host).
 const int MAX_STEP_POINTS = 33;
 
-// Unnormalised direction of the viewing ray through `frag`: the far-plane
-// point minus the eye. For a perspective projection the unprojected
-// far-plane point's w does not depend on the pixel, so this is affine in
-// `frag` (the offsets below reuse one evaluation).
-vec3 view_vector(vec2 frag) {
-    vec2 ndc = frag / frame.viewport.xy * 2.0 - 1.0;
-    vec4 far = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
-    return far.xyz / far.w - frame.eye.xyz;
-}
-
-// Signed distance between the viewing ray along `v` (any length) and the
-// light ray (p1 = eye + r, direction u), along v x u.
-float ray_distance(vec3 v, vec3 r, vec3 u) {
-    vec3 n = cross(v, u);
-    return dot(r, n) * inversesqrt(max(dot(n, n), 1e-30));
-}
-
 // Jensen's normalised Gaussian filter (Realistic Image Synthesis Using
 // Photon Mapping, 2001), support r; the constant alpha cancels in the
 // normalisation.
@@ -91,9 +75,6 @@ void main() {
     Segment s = segments[g_segment];
     vec3 eye = frame.eye.xyz;
     vec3 v = view_vector(gl_FragCoord.xy);
-    // Half a pixel to the right and down (affine, see view_vector).
-    vec3 half_x = 0.5 * (view_vector(gl_FragCoord.xy + vec2(1.0, 0.0)) - v);
-    vec3 half_y = 0.5 * (view_vector(gl_FragCoord.xy + vec2(0.0, 1.0)) - v);
     vec3 w = normalize(v);
     vec3 seg = s.p2.xyz - s.p1.xyz;
     float len = length(seg);
@@ -109,9 +90,8 @@ void main() {
     if (t_l <= 0.0 || t_l >= t_surface) discard;
 
     // Kernel width in d (metres) of this line's rasterised footprint.
-    float ddx = ray_distance(v + half_x, r, u) - ray_distance(v - half_x, r, u);
-    float ddy = ray_distance(v + half_y, r, u) - ray_distance(v - half_y, r, u);
-    float width = pc.line_raster == LINE_RASTER_RECTANGULAR ? length(vec2(ddx, ddy)) : max(abs(ddx), abs(ddy));
+    vec2 dd = ray_distance_per_pixel(gl_FragCoord.xy, v, r, u);
+    float width = pc.line_raster == LINE_RASTER_RECTANGULAR ? length(dd) : max(abs(dd.x), abs(dd.y));
     if (!(width > 0.0)) discard;
 
     float cos_scatter = dot(u, -w); // before: along u; after: toward the camera

@@ -15,16 +15,20 @@ layout(set = 1, binding = WP_BINDING_PARAMS, std140) uniform WpParams {
     vec4 cascade;      // x: scale s; y: q_0 (Eq. 16); z: F_frac, w: F_exp (Eq. 14)
     vec4 paper;        // x: γ, y: t_max (Eq. 13); z: ε (Eq. 19); w: depth bias (relative)
     uvec4 water;       // x: the water's material index; y, z, w (f32 bits): rest height h, slope bound, Σ amplitude (view.comp)
+    uvec4 shafts;      // x: block stride k of the shaft tubes (shafts.glsl)
 } wp;
 
-// One photon (Algorithm 3 lines 36-41), 96 bytes.
+// One photon (Algorithm 3 lines 36-41, and the ray's start for the
+// shafts), 128 bytes.
 struct Photon {
-    vec4 position; // xyz: hit x'_{0:0}; w: cascade c
-    vec4 normal;   // xyz: receiver normal n'_{0:0} facing the ray; w: sqrt(A'/A) (Eq. 11 without s^c)
-    vec4 axis_u;   // xyz: ∂x'/∂u on the receiver's tangent plane; w: ray type WP_RAY_*
-    vec4 axis_v;   // xyz: ∂x'/∂v; w: hit distance t'
-    vec4 flux;     // rgb: flux Φ (W), or the paper's ray intensity R (Eq. 12); w: surface triangle area A (m^2)
-    vec4 dir;      // xyz: ray direction ω; w: 0
+    vec4 position;  // xyz: hit x'_{0:0}; w: cascade c
+    vec4 normal;    // xyz: receiver normal n'_{0:0} facing the ray; w: sqrt(A'/A) (Eq. 11 without s^c)
+    vec4 axis_u;    // xyz: ∂x'/∂u on the receiver's tangent plane; w: ray type WP_RAY_*
+    vec4 axis_v;    // xyz: ∂x'/∂v; w: hit distance t'
+    vec4 flux;      // rgb: flux Φ (W) at the hit, or the paper's ray intensity R (Eq. 12); w: surface triangle area A (m^2)
+    vec4 dir;       // xyz: ray direction ω; w: 0
+    vec4 surface_u; // xyz: ∂x/∂u on the water surface (Eq. 10 at the ray's start); w: k, its texel starts a k x k block of shafts (0: it does not)
+    vec4 surface_v; // xyz: ∂x/∂v there; w: 0
 };
 
 #endif

@@ -194,6 +194,10 @@ void main() {
         p.axis_v = vec4(axis_v, h.t);
         p.flux = vec4(flux, area_surface);
         p.dir = vec4(dir, 0.0);
+        // One shaft tube per k x k block of texels (shafts.glsl).
+        uint k = max(wp.shafts.x, 1u);
+        p.surface_u = vec4(dxu, all(equal(texel % k, uvec2(0u))) ? float(k) : 0.0);
+        p.surface_v = vec4(dxv, 0.0);
         photons[slot] = p;
         imageStore(photon_slots, ivec3(t, int(2u * c + type - WP_RAY_REFLECTED)), uvec4(slot));
         atomicAdd(draw.instance_count, 1u);

@@ -5,8 +5,8 @@
 // traced water. Runs after image_space's CameraRefraction, which keeps the
 // other specular surfaces and every other pixel; here the water's pixels
 // are recomputed:
-//   L = F1 L(x_R) + (1 − F1)/n² exp(−σ_a t) L(x_T)
-// (from under the water: F1 exp(−σ_a t) L(x_R) + (1 − F1) n² L(x_T), F1
+//   L = F1 L(x_R) + (1 − F1)/n² exp(−σ_t t) L(x_T)
+// (from under the water: F1 exp(−σ_t t) L(x_R) + (1 − F1) n² L(x_T), F1
 // and x_T for light entering the water, total reflection outside Snell's
 // window)
 // (GUIDE §2: radiance leaving the water keeps L/n², times the Fresnel
@@ -64,6 +64,7 @@ layout(set = 1, binding = WP_BINDING_FRONT_POSITION, rgba32f) uniform readonly i
 layout(set = 1, binding = WP_BINDING_FRONT_NORMAL, rgba32f) uniform readonly image2D front_normal;
 layout(set = 1, binding = WP_BINDING_BACK_POSITION, rgba32f) uniform readonly image2D back_position;
 layout(set = 1, binding = WP_BINDING_RADIANCE, rgba32f) uniform image2D radiance;
+layout(set = 1, binding = WP_BINDING_SHAFTS, rgba32f) uniform readonly image2D shafts;
 
 // N, the cascades (wp.size.z), a pipeline constant (WP_SPEC_CASCADES):
 // as a uniform this loop's bound makes lavapipe recompile this shader at
@@ -186,14 +187,51 @@ vec3 radiance_along(vec3 o, vec3 d, out float t_hit) {
            + component_weight(COMPONENT_SURFACE_CAUSTICS) * gather(x, n));
 }
 
+// An eye under the surface looks through the water at everything it sees:
+// a pixel's radiance loses exp(−σ_t d) over the distance d to its first
+// surface (the turbid water's extinction, as the reference's camera
+// connections and chains have it; 1 in clear water). The water's own
+// pixels take it on top of the formula above; every other pixel (the
+// floor, the walls, glass under the water) here, after the composite and
+// the refraction pass wrote it.
+void attenuate_under_water(ivec2 p, vec4 fp) {
+    vec4 opaque = imageLoad(opaque_position, p);
+    bool specular_first = fp.w >= 0.0;
+    if (!specular_first && opaque.w == 0.0) {
+        imageStore(radiance, p, vec4(0.0, 0.0, 0.0, 1.0)); // no surface: the water goes on
+        return;
+    }
+    float d = distance(specular_first ? fp.xyz : opaque.xyz, frame.eye.xyz);
+    vec3 sigma_t = materials[wp.water.x].absorption_ior.rgb;
+    vec4 l = imageLoad(radiance, p);
+    imageStore(radiance, p, vec4(l.rgb * exp(-sigma_t * d), l.a));
+}
+
+// The light the water's medium scatters toward the eye in front of the
+// pixel's surface (shafts.frag; black unless the host drew them).
+void add_shafts(ivec2 p) {
+    vec4 l = imageLoad(radiance, p);
+    imageStore(radiance, p, vec4(l.rgb + imageLoad(shafts, p).rgb, l.a));
+}
+
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(p, imageSize(radiance)))) return;
+    // One ray, the same for every invocation.
+    bool eye_under_water = dielectric_around(frame.eye.xyz) == wp.water.x;
     vec4 fp = imageLoad(front_position, p);
-    if (fp.w != 0.0) return; // no specular surface (-1), or one with thickness d_N
     vec4 fn = imageLoad(front_normal, p);
     uint m = uint(fn.w + 0.5);
-    if (m != wp.water.x || imageLoad(back_position, p).w >= 0.0) return;
+    // The water's pixels: its front specular surface, no thickness d_N
+    // (fp.w = 0; -1 is none), no back face.
+    bool water = fp.w == 0.0 && m == wp.water.x && imageLoad(back_position, p).w < 0.0;
+    if (!water) {
+        if (eye_under_water) {
+            attenuate_under_water(p, fp);
+            add_shafts(p);
+        }
+        return;
+    }
     vec3 p1 = fp.xyz;
     vec3 v = normalize(p1 - frame.eye.xyz);
     vec3 n1 = normalize(fn.xyz);
@@ -215,5 +253,7 @@ void main() {
         vec3 behind = radiance_along(offset_along(p1, -n1), t1, t);
         l += (1.0 - f1) * eta * eta * (inside ? vec3(1.0) : exp(-sigma_t * t)) * behind;
     }
+    if (inside) l *= exp(-sigma_t * distance(p1, frame.eye.xyz)); // the eye's own leg
     imageStore(radiance, p, vec4(l, 1.0));
+    if (eye_under_water) add_shafts(p);
 }

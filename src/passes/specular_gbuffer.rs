@@ -86,7 +86,10 @@ impl SpecularGBuffer {
                     width,
                     height,
                     SPECULAR_GBUFFER_FORMAT,
-                    vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::STORAGE,
+                    // Sampled: fragment shaders fetch it (water_photons' shafts).
+                    vk::ImageUsageFlags::COLOR_ATTACHMENT
+                        | vk::ImageUsageFlags::STORAGE
+                        | vk::ImageUsageFlags::SAMPLED,
                 ),
             )
         };

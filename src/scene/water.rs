@@ -81,6 +81,23 @@ impl Water {
         self.waves.iter().map(Wave::fold_share).sum()
     }
 
+    /// Whether `p` lies under the surface at `time`, within the water's
+    /// rectangle: the rest point whose displaced position lies over p is
+    /// found by fixed-point iteration (the horizontal displacement's
+    /// Jacobian is within `fold_measure` < 1 of the identity, so it
+    /// converges), then the heights are compared.
+    pub fn is_below_surface(&self, p: Vec3, time: f32) -> bool {
+        let target = Vec2::new(p.x, p.z);
+        let half = self.size * 0.5;
+        let mut rest = target;
+        for _ in 0..8 {
+            let (q, _) = self.surface_point(rest, time);
+            rest += target - Vec2::new(q.x, q.z);
+        }
+        let inside = (rest - self.center).abs().cmple(half).all();
+        inside && p.y < self.surface_point(rest, time).0.y
+    }
+
     /// Whether the surface changes with time (some wave has height and speed).
     pub fn is_moving(&self) -> bool {
         self.waves

@@ -141,3 +141,33 @@ fn gpu_surface_equals_the_cpu_gerstner_sum() {
     check(&ctx, "flat", &flat);
     assert_validation_clean(&ctx);
 }
+
+/// `Water::is_below_surface` (where `water_photons` draws its shafts): on
+/// `water_pool`'s waves at t = 1.3 s, a point 1 cm under the displaced
+/// surface above a rest point is below it and one 1 cm over it is not,
+/// for rest points across the pool (the surface's horizontal displacement
+/// is undone by the search); outside the rectangle nothing is.
+#[test]
+fn points_under_the_waves_are_below_the_surface() {
+    let water = scene_water("water_pool");
+    let time = 1.3;
+    let mut checked = 0;
+    for i in 1..20 {
+        for j in 1..20 {
+            let rest = Vec2::new(-3.0 + 0.3 * i as f32, -3.0 + 0.3 * j as f32);
+            let (p, _) = water.surface_point(rest, time);
+            assert!(
+                water.is_below_surface(p - Vec3::Y * 0.01, time),
+                "{p} - 1 cm"
+            );
+            assert!(
+                !water.is_below_surface(p + Vec3::Y * 0.01, time),
+                "{p} + 1 cm"
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 361);
+    assert!(!water.is_below_surface(Vec3::new(3.5, 0.5, 0.0), time));
+    assert!(!water.is_below_surface(Vec3::new(0.0, 0.5, -3.5), time));
+}

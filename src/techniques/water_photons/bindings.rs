@@ -38,6 +38,9 @@ pub const WP_BINDING_OPAQUE_RADIANCE: u32 = 11;
 pub const WP_BINDING_FRONT_POSITION: u32 = 12;
 pub const WP_BINDING_FRONT_NORMAL: u32 = 13;
 pub const WP_BINDING_BACK_POSITION: u32 = 14;
+// water_photons "shafts": the light scattered by a medium in the water,
+// seen from under the surface (shafts.rs), which the water view adds.
+pub const WP_BINDING_SHAFTS: u32 = 16;
 /// Most cascades of a cascaded caustic map (Kougianos & Moustakas 2021 use 1-4).
 pub const WP_MAX_CASCADES: u32 = 4;
 /// Trace threads per workgroup, and workgroups per dispatch row.

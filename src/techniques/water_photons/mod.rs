@@ -144,6 +144,7 @@ pub mod cascades;
 mod ccm;
 pub mod denoise;
 mod params;
+mod shafts;
 mod splat;
 mod trace;
 mod view;
@@ -153,7 +154,8 @@ pub use cascade_frame::{water_bounds, CascadeFrame};
 pub use ccm::Ccm;
 pub use denoise::{DenoiseParams, Denoiser};
 pub use params::{GpuWpParams, WaterPhotonsParams, WpParamsBuffer};
-pub use splat::{Composite, Splat};
+use shafts::Shafts;
+use splat::{Composite, Splat};
 pub use trace::{GpuWaterPhoton, PhotonCounts, Trace, GUARD_PHOTONS, GUARD_WORD};
 pub use view::WaterView;
 
@@ -187,6 +189,12 @@ pub struct WaterPhotons {
     /// The scene's bounding sphere, for `l_min` when lights change.
     scene_sphere: (Vec3, f32),
     composite: Composite,
+    shafts: Shafts,
+    /// The live `shafts` parameter: draw the shafts under a turbid water.
+    shafts_on: bool,
+    /// The water's material holds a medium (`Material::holds_medium`)
+    /// and the photons carry physical flux: the shafts have something to show.
+    shafts_possible: bool,
     view: WaterView,
     pub frame: CascadeFrame,
     params: WpParamsBuffer,
@@ -345,6 +353,19 @@ impl WaterPhotons {
         let scene_sphere = scene.bounding_sphere(0.0);
         // The composite reads the splat's caustic buffer (denoised in place).
         let composite = Composite::new(ctx, scene_gpu)?;
+        let shafts = Shafts::new(
+            ctx,
+            scene_gpu,
+            &params_buffer,
+            &trace.photons,
+            width,
+            height,
+        )?;
+        let shafts_possible = params.intensity_mode == bindings::WP_INTENSITY_PHYSICAL
+            && scene
+                .materials
+                .get(water.material as usize)
+                .is_some_and(|m| m.holds_medium());
         let view = WaterView::new(
             ctx,
             scene_gpu,
@@ -378,6 +399,7 @@ impl WaterPhotons {
                 params.depth_bias,
             ],
             water: water_uniform(&water),
+            shafts: [params.shaft_stride, 0, 0, 0],
         };
         let mut technique = Self {
             surface,
@@ -393,6 +415,9 @@ impl WaterPhotons {
             env_sun,
             scene_sphere,
             composite,
+            shafts,
+            shafts_on: params.shafts != 0,
+            shafts_possible,
             view,
             frame,
             params: params_buffer,
@@ -438,6 +463,8 @@ impl TechniqueBuild for WaterPhotons {
     const COMPONENTS: &'static [Component] = &[
         Component::Direct,
         Component::SurfaceCaustics,
+        // The shafts of a turbid water, seen from under its surface.
+        Component::VolumeCaustics,
         Component::Emitted,
     ];
     const CAUSTIC_SOURCES: CausticSources = CausticSources::Water;
@@ -499,6 +526,8 @@ impl TechniqueBuild for WaterPhotons {
     }
 
     fn update_live(&mut self, params: &WaterPhotonsParams) -> bool {
+        self.shafts_on = params.shafts != 0;
+        self.gpu_params.shafts[0] = params.shaft_stride;
         self.surface.set_live(&params.direct, params.search_steps);
         true
     }
@@ -560,6 +589,16 @@ impl Technique for WaterPhotons {
             self.surface.opaque(),
         );
         self.surface.record_refraction(rec, scene, targets);
+        let under_water = self.water.is_below_surface(eye, scene.geometry_time);
+        self.shafts.record(
+            rec,
+            scene,
+            &self.trace.photons,
+            &self.trace.draw,
+            self.surface.gbuffer(),
+            self.surface.specular(),
+            self.shafts_on && self.shafts_possible && under_water,
+        );
         self.view.record(
             rec,
             scene,
@@ -568,6 +607,7 @@ impl Technique for WaterPhotons {
             self.surface.opaque(),
             self.surface.gbuffer(),
             self.surface.specular(),
+            &self.shafts.image,
             targets,
         );
         Ok(())

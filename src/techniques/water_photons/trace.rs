@@ -38,8 +38,14 @@ pub struct GpuWaterPhoton {
     pub flux: [f32; 4],
     /// xyz ray direction; w: 0.
     pub dir: [f32; 4],
+    /// xyz the texel's neighbour offsets on the water surface, ∂x/∂u and
+    /// ∂x/∂v (Eq. 10 at the ray's start: with `axis_u`, `axis_v` at its
+    /// end, the beam's cross-section along the whole ray, shafts.glsl);
+    /// `surface_u` w: k where the texel starts a k x k block of shafts, else 0.
+    pub surface_u: [f32; 4],
+    pub surface_v: [f32; 4],
 }
-const _: () = assert!(size_of::<GpuWaterPhoton>() == 96);
+const _: () = assert!(size_of::<GpuWaterPhoton>() == 128);
 
 /// The draw buffer: `VkDrawIndirectCommand` + the requested counter.
 #[repr(C)]

@@ -66,6 +66,7 @@ impl WaterView {
         opaque: &Image,
         opaque_gbuffer: &GBuffer,
         specular: &SpecularGBuffer,
+        shafts: &Image,
         targets: &FrameTargets,
     ) {
         // The trace's photon and slot writes, the composite's radiance
@@ -109,6 +110,12 @@ impl WaterView {
                 set,
                 bindings::WP_BINDING_BACK_POSITION,
                 &specular.back_position,
+                Access::ComputeRead,
+            )
+            .storage_image(
+                set,
+                bindings::WP_BINDING_SHAFTS,
+                shafts,
                 Access::ComputeRead,
             )
             .storage_image(
