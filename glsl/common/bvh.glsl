@@ -188,19 +188,4 @@ vec3 hit_albedo(Hit h) {
     return material_albedo(hit_material(h), triangle_uv(h.triangle, h.barycentric));
 }
 
-const uint NO_DIELECTRIC = 0xffffffffu;
-
-// The material of the dielectric around p: the one whose back face is the
-// first surface straight up from p (the underside of water, the inside of
-// a closed glass object), else NO_DIELECTRIC. An eye there sees through
-// that dielectric's inside (turbid water: its extinction on every view).
-uint dielectric_around(vec3 p) {
-    Hit h;
-    vec3 up = vec3(0.0, 1.0, 0.0);
-    if (!trace_closest(p, up, 0.0, 1e30, h)) return NO_DIELECTRIC;
-    uint m = hit_material(h);
-    bool from_back = dot(up, hit_geometric_normal(h)) > 0.0;
-    return material_kind(m) == MATERIAL_DIELECTRIC && from_back ? m : NO_DIELECTRIC;
-}
-
 #endif

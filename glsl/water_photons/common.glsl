@@ -15,7 +15,7 @@ layout(set = 1, binding = WP_BINDING_PARAMS, std140) uniform WpParams {
     vec4 cascade;      // x: scale s; y: q_0 (Eq. 16); z: F_frac, w: F_exp (Eq. 14)
     vec4 paper;        // x: γ, y: t_max (Eq. 13); z: ε (Eq. 19); w: depth bias (relative)
     uvec4 water;       // x: the water's material index; y, z, w (f32 bits): rest height h, slope bound, Σ amplitude (view.comp)
-    uvec4 shafts;      // x: block stride k of the shaft tubes (shafts.glsl)
+    uvec4 shafts;      // x: block stride k of the shaft tubes (shafts.glsl); y: 1 while the eye is under the water
 } wp;
 
 // One photon (Algorithm 3 lines 36-41, and the ray's start for the

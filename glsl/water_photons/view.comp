@@ -217,8 +217,8 @@ void add_shafts(ivec2 p) {
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(p, imageSize(radiance)))) return;
-    // One ray, the same for every invocation.
-    bool eye_under_water = dielectric_around(frame.eye.xyz) == wp.water.x;
+    // The host's test, each frame (Water::is_below_surface).
+    bool eye_under_water = wp.shafts.y != 0u;
     vec4 fp = imageLoad(front_position, p);
     vec4 fn = imageLoad(front_normal, p);
     uint m = uint(fn.w + 0.5);

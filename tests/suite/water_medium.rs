@@ -374,8 +374,9 @@ fn pool_shafts_from_below_match_the_reference() {
 /// flat surface are parallel prisms that tile the water), with one, two
 /// and three cascades (s = 2): the outer cascades' texels are 2^c times
 /// wider and their tubes carry 4^c times the flux, so the shafts are the
-/// same across the seams; over the whole image and each quarter of its
-/// rows.
+/// same across the seams; and with two cascades drawn as tubes of 2 x 2
+/// texel blocks (`shaft_stride` 2, which tile flat water too); over the
+/// whole image and each quarter of its rows.
 #[test]
 fn flat_water_shafts_match_the_closed_form_across_cascades() {
     use caustics::params::{ParamSet, Params};
@@ -383,8 +384,11 @@ fn flat_water_shafts_match_the_closed_form_across_cascades() {
     let scene = flat_water([0.0, 2.5, 0.0], [0.0, 0.5, 3.0]);
     let want = expected(&scene);
     let mut worst: f64 = 0.0;
-    for cascades in [1, 2, 3] {
-        let overrides = [format!("cascades={cascades}")];
+    for (cascades, stride) in [(1, 1), (2, 1), (3, 1), (2, 2)] {
+        let overrides = [
+            format!("cascades={cascades}"),
+            format!("shaft_stride={stride}"),
+        ];
         let params = Params::resolve(
             "water_photons",
             caustics::techniques::water_photons::WaterPhotonsParams::specs(),
@@ -404,7 +408,7 @@ fn flat_water_shafts_match_the_closed_form_across_cascades() {
         r.scene_gpu.components = Component::VolumeCaustics.mask();
         r.render_frame(0.0).unwrap();
         let got = r.radiance().unwrap();
-        let label = format!("N = {cascades}");
+        let label = format!("N = {cascades}, shaft_stride {stride}");
         worst = worst.max(worst_band_error(
             &label,
             &got,

@@ -555,6 +555,10 @@ impl Technique for WaterPhotons {
             let light = self.light;
             self.set_light(&light);
         }
+        // The eye under the water: the water view attenuates the whole
+        // frame by the water between, and the shafts are drawn.
+        let under_water = self.water.is_below_surface(eye, scene.geometry_time);
+        self.gpu_params.shafts[1] = u32::from(under_water);
         // Through the frame's upload ring: earlier frames may still read the buffer.
         rec.upload(&self.params.0, bytemuck::bytes_of(&self.gpu_params));
         self.surface.record_opaque(rec, scene)?;
@@ -589,7 +593,6 @@ impl Technique for WaterPhotons {
             self.surface.opaque(),
         );
         self.surface.record_refraction(rec, scene, targets);
-        let under_water = self.water.is_below_surface(eye, scene.geometry_time);
         self.shafts.record(
             rec,
             scene,

@@ -43,8 +43,8 @@ crate::declare_params! {
             "splats move toward the camera by this fraction of their distance before the depth test (along the view ray: the image does not move); 0.001 lets ocean_large's far seabed reject its own splats";
         shafts: u32 [0, 1] = 1, live,
             "1: the light a medium in the water scatters, as shafts seen from under the surface (shafts.rs); 0: off";
-        shaft_stride: u32 [1, 16] = 2, live,
-            "k: one shaft tube for each k x k block of caustic-map texels, k times as wide, with k^2 times the flux (the shafts' cost goes as 1/k)";
+        shaft_stride: u32 [1, 16] = 1, live,
+            "k: one shaft tube for each k x k block of caustic-map texels, k times as wide, with k^2 times the flux (the shafts' cost goes as 1/k; over a faceted surface k > 1 draws lines where the bend changes within a block)";
         search_steps: u32 [4, 256] = 32, live,
             "linear steps of the camera refraction's image-space search (image_space)";
     }
@@ -63,7 +63,8 @@ pub struct GpuWpParams {
     pub cascade: [f32; 4],
     pub paper: [f32; 4],
     pub water: [u32; 4],
-    /// x: the shafts' block stride k (`shaft_stride`); y, z, w: unused.
+    /// x: the shafts' block stride k (`shaft_stride`); y: 1 while the eye
+    /// is under the water (`Water::is_below_surface`, each frame); z, w: unused.
     pub shafts: [u32; 4],
 }
 const _: () = assert!(size_of::<GpuWpParams>() == 208);
