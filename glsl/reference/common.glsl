@@ -277,17 +277,30 @@ bool emitter_sampled_by_camera(Emitter em) {
 
 const uint NO_DIELECTRIC = 0xffffffffu;
 
-// The material of the dielectric around p: the one whose back face is the
-// first surface straight up from p (the underside of water, the inside of
-// a closed glass object), else NO_DIELECTRIC. An eye there sees through
-// that dielectric's inside (turbid water: its extinction on every view).
+// The material of the dielectric around p: walking straight up from p
+// through every surface, the first dielectric met from its back face
+// whose front face the walk did not cross first (the underside of water
+// above a floating or submerged object, the inside of a closed glass
+// object), else NO_DIELECTRIC. One level: a dielectric entered on the way
+// is left again before another counts.
 uint dielectric_around(vec3 p) {
-    Hit h;
     vec3 up = vec3(0.0, 1.0, 0.0);
-    if (!trace_closest(p, up, 0.0, 1e30, h)) return NO_DIELECTRIC;
-    uint m = hit_material(h);
-    bool from_back = dot(up, hit_geometric_normal(h)) > 0.0;
-    return material_kind(m) == MATERIAL_DIELECTRIC && from_back ? m : NO_DIELECTRIC;
+    vec3 o = p;
+    uint entered = NO_DIELECTRIC;
+    for (uint step = 0u; step < 32u; ++step) {
+        Hit h;
+        if (!trace_closest(o, up, 0.0, 1e30, h)) return NO_DIELECTRIC;
+        uint m = hit_material(h);
+        vec3 ng = hit_geometric_normal(h);
+        bool from_back = dot(up, ng) > 0.0;
+        if (material_kind(m) == MATERIAL_DIELECTRIC) {
+            if (!from_back) entered = m;
+            else if (m == entered) entered = NO_DIELECTRIC;
+            else return m;
+        }
+        o = offset_origin(o + h.t * up, from_back ? ng : -ng);
+    }
+    return NO_DIELECTRIC;
 }
 
 // The state of a camera path at the eye (weight 1, no direction yet):

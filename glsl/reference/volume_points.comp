@@ -139,8 +139,8 @@ void main() {
             // no shorter than r_v); a step's weight is its length, so the
             // quadrature stays unbiased whatever the step.
             // Inside a dielectric's medium the first segment gathers every
-            // path type (trace.comp connects none there), as many points as
-            // a later segment: under water the shafts vary along the ray.
+            // path type (trace.comp connects none there), at the first
+            // segment's FIRST_SEGMENT_POINTS.
             bool gathers_all = depth > 0u || inside_medium;
             uint tag_mask = gathers_all ? 0xffffffffu : (1u << COMPONENT_OTHER);
             if (in_medium) {

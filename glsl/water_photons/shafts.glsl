@@ -9,7 +9,10 @@
 // water the blocks tile exactly, as the texels do (and the cascades' rings
 // start at multiples of k for s = 2 and power-of-two maps); over waves the
 // block takes its first texel's flux and bend, so k trades the shafts'
-// finest detail (k texels) for a cost that goes as 1/k.
+// finest detail (k texels) for a cost that goes as 1/k; at the water's
+// edge a block carries k² times its first texel's flux even where some of
+// its texels hold no water. k must divide the maps' side and their rings'
+// border (`check_shaft_stride`), where the cascades meet.
 #ifndef WATER_PHOTONS_SHAFTS_GLSL
 #define WATER_PHOTONS_SHAFTS_GLSL
 

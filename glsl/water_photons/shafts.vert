@@ -46,18 +46,23 @@ void main() {
     if (!shaft_tube(photons[gl_InstanceIndex], tube)) return;
     vec3 a = tube.start;
     vec3 b = tube.start + tube.dir * tube.len;
-    float za = -(frame.view * vec4(a, 1.0)).z;
-    float zb = -(frame.view * vec4(b, 1.0)).z;
+    vec3 va = (frame.view * vec4(a, 1.0)).xyz, vb = (frame.view * vec4(b, 1.0)).xyz;
+    float za = -va.z, zb = -vb.z;
     if (za < NEAR && zb < NEAR) return;
-    vec3 a_clipped = za < NEAR ? mix(a, b, (NEAR - za) / (zb - za)) : a;
-    vec3 b_clipped = zb < NEAR ? mix(a, b, (NEAR - za) / (zb - za)) : b;
+    float clip = (NEAR - za) / (zb - za);
+    vec3 a_clipped = za < NEAR ? mix(a, b, clip) : a;
+    vec3 b_clipped = zb < NEAR ? mix(a, b, clip) : b;
+    vec3 va_clipped = za < NEAR ? mix(va, vb, clip) : va;
+    vec3 vb_clipped = zb < NEAR ? mix(va, vb, clip) : vb;
     za = max(za, NEAR);
     zb = max(zb, NEAR);
     // The tube's half-width at each end, at most half the sum of its axes.
     float focal = 0.5 * frame.viewport.y / frame.eye.w; // pixels per metre at unit depth
     float wa = 0.5 * max(length(tube.surface_u) + length(tube.surface_v), length(tube.end_u) + length(tube.end_v));
-    float ha = max(wa * focal / za, MIN_HALF_WIDTH_PX);
-    float hb = max(wa * focal / zb, MIN_HALF_WIDTH_PX);
+    // A width across the viewing ray at angle α off the axis projects to
+    // wa f / (z cos α) = wa f d / z² pixels along the radial direction.
+    float ha = max(wa * focal * length(va_clipped) / (za * za), MIN_HALF_WIDTH_PX);
+    float hb = max(wa * focal * length(vb_clipped) / (zb * zb), MIN_HALF_WIDTH_PX);
     vec2 pa = to_pixels(a_clipped), pb = to_pixels(b_clipped);
     vec2 along = pb - pa;
     along = dot(along, along) > 1e-8 ? normalize(along) : vec2(1.0, 0.0);

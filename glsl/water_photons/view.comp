@@ -190,35 +190,32 @@ vec3 radiance_along(vec3 o, vec3 d, out float t_hit) {
 // An eye under the surface looks through the water at everything it sees:
 // a pixel's radiance loses exp(−σ_t d) over the distance d to its first
 // surface (the turbid water's extinction, as the reference's camera
-// connections and chains have it; 1 in clear water). The water's own
-// pixels take it on top of the formula above; every other pixel (the
+// connections and chains have it; 1 in clear water), and gains the light
+// the water's medium scatters toward the eye in front of that surface
+// (the shafts image; black unless the host drew them). The water's own
+// pixels take both on top of the formula above; every other pixel (the
 // floor, the walls, glass under the water) here, after the composite and
-// the refraction pass wrote it.
-void attenuate_under_water(ivec2 p, vec4 fp) {
+// the refraction pass wrote it. `under`: 1 while the eye is under the
+// water (the host's test each frame), else 0; a factor, never a branch:
+// lavapipe recompiles a shader at every bind while a uniform decides one
+// of its branches (bindings.rs; water_photons' host-memory test).
+void under_water_view(ivec2 p, vec4 fp, float under) {
     vec4 opaque = imageLoad(opaque_position, p);
     bool specular_first = fp.w >= 0.0;
-    if (!specular_first && opaque.w == 0.0) {
-        imageStore(radiance, p, vec4(0.0, 0.0, 0.0, 1.0)); // no surface: the water goes on
-        return;
-    }
-    float d = distance(specular_first ? fp.xyz : opaque.xyz, frame.eye.xyz);
+    bool surface = specular_first || opaque.w != 0.0;
+    float d = surface ? distance(specular_first ? fp.xyz : opaque.xyz, frame.eye.xyz) : 0.0;
     vec3 sigma_t = materials[wp.water.x].absorption_ior.rgb;
+    // No surface at all under the water: the water goes on, black.
+    vec3 kept = surface ? exp(-sigma_t * (d * under)) : vec3(1.0 - under);
     vec4 l = imageLoad(radiance, p);
-    imageStore(radiance, p, vec4(l.rgb * exp(-sigma_t * d), l.a));
-}
-
-// The light the water's medium scatters toward the eye in front of the
-// pixel's surface (shafts.frag; black unless the host drew them).
-void add_shafts(ivec2 p) {
-    vec4 l = imageLoad(radiance, p);
-    imageStore(radiance, p, vec4(l.rgb + imageLoad(shafts, p).rgb, l.a));
+    imageStore(radiance, p, vec4(l.rgb * kept + under * imageLoad(shafts, p).rgb, l.a));
 }
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(p, imageSize(radiance)))) return;
     // The host's test, each frame (Water::is_below_surface).
-    bool eye_under_water = wp.shafts.y != 0u;
+    float under = float(wp.shafts.y);
     vec4 fp = imageLoad(front_position, p);
     vec4 fn = imageLoad(front_normal, p);
     uint m = uint(fn.w + 0.5);
@@ -226,10 +223,7 @@ void main() {
     // (fp.w = 0; -1 is none), no back face.
     bool water = fp.w == 0.0 && m == wp.water.x && imageLoad(back_position, p).w < 0.0;
     if (!water) {
-        if (eye_under_water) {
-            attenuate_under_water(p, fp);
-            add_shafts(p);
-        }
+        under_water_view(p, fp, under);
         return;
     }
     vec3 p1 = fp.xyz;
@@ -254,6 +248,6 @@ void main() {
         l += (1.0 - f1) * eta * eta * (inside ? vec3(1.0) : exp(-sigma_t * t)) * behind;
     }
     if (inside) l *= exp(-sigma_t * distance(p1, frame.eye.xyz)); // the eye's own leg
+    l += under * imageLoad(shafts, p).rgb;
     imageStore(radiance, p, vec4(l, 1.0));
-    if (eye_under_water) add_shafts(p);
 }

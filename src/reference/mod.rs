@@ -181,7 +181,7 @@ impl ReferenceRenderer {
             &targets,
             settings,
             radius,
-            scene.has_scattering(),
+            tracer::Media::of(&scene),
             specular_sphere(&scene, time),
             scene.lights.len(),
         )?;

@@ -130,10 +130,31 @@ fn aim_share_for(settings: &ReferenceSettings, has_medium: bool) -> f32 {
     }
 }
 
+/// Where light scatters in a scene: its `[medium]`, and media inside
+/// dielectrics (`Material::holds_medium`).
+#[derive(Clone, Copy, Debug)]
+pub struct Media {
+    pub scene: bool,
+    pub inside_dielectrics: bool,
+}
+
+impl Media {
+    pub fn of(scene: &crate::scene::Scene) -> Self {
+        Self {
+            scene: scene.medium.is_some(),
+            inside_dielectrics: scene
+                .materials
+                .iter()
+                .any(crate::scene::Material::holds_medium),
+        }
+    }
+}
+
 impl Reference {
     /// `radius`: the first pass's surface gather radius (m); `aim`: the
     /// bounding sphere photons are aimed at (`specular_sphere`); `lights`:
-    /// the scene's point, spot and directional lights.
+    /// the scene's point, spot and directional lights; `media`: where
+    /// light scatters.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: &Arc<Context>,
@@ -141,11 +162,13 @@ impl Reference {
         targets: &FrameTargets,
         settings: ReferenceSettings,
         radius: f32,
-        has_medium: bool,
+        media: Media,
         aim: Option<(glam::Vec3, f32)>,
         lights: usize,
     ) -> anyhow::Result<Self> {
         let accum_bytes = check_image_size(ctx, targets.width, targets.height)?;
+        let has_medium = media.scene || media.inside_dielectrics;
+        let inside_media = media.inside_dielectrics;
         if !(radius.is_finite() && radius > 0.0) {
             anyhow::bail!("the photon-mapping radius must be positive and finite, got {radius}");
         }
@@ -209,9 +232,17 @@ impl Reference {
         // Gather points: FIRST_SEGMENT_POINTS (8) a pixel on the first
         // segment plus up to 32 on each later one (volume_points.comp); 24 a
         // pixel on average leaves room for a quarter of the image seen
-        // through glass or in a mirror, up to 2^22 points (192 MiB).
+        // through glass or in a mirror, up to 2^22 points (192 MiB). With a
+        // medium inside a dielectric, 48 and 2^23: an eye under turbid
+        // water has points on its first segment and on every segment the
+        // surface reflects back into the water.
+        let (per_pixel, most) = if inside_media {
+            (48, 1 << 23)
+        } else {
+            (24, 1 << 22)
+        };
         let gather_capacity = if volume_capacity > 0 {
-            (pixels * 24).min(1 << 22) as u32
+            (pixels * per_pixel).min(most) as u32
         } else {
             0
         };

@@ -124,12 +124,6 @@ impl Scene {
             .map(|i| i as u32)
     }
 
-    /// Whether light scatters anywhere: the scene's `[medium]` or a
-    /// dielectric whose inside holds one (`Material::holds_medium`).
-    pub fn has_scattering(&self) -> bool {
-        self.medium.is_some() || self.materials.iter().any(Material::holds_medium)
-    }
-
     /// Total triangle count over all objects.
     pub fn triangle_count(&self) -> usize {
         self.objects.iter().map(|o| o.mesh.indices.len()).sum()

@@ -907,7 +907,7 @@ fn unusable_scenes_and_parameters_are_refused() {
     two_suns.lights.push(two_suns.lights[0]);
     let err = check(&two_suns).unwrap_err().to_string();
     assert!(
-        err.contains("light[1]: water_photons traces the caustics of one sun"),
+        err.contains("light: water_photons traces the caustics of one sun, and the scene has 2 directional lights"),
         "{err}"
     );
     assert_validation_clean(&ctx);

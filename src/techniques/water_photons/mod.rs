@@ -232,6 +232,22 @@ fn environment_sun(scene: &Scene) -> Option<Light> {
     })
 }
 
+/// The shafts' blocks of k x k texels (shafts.glsl) tile a cascade only
+/// where k divides its side and its ring's border (Eq. 6): a block
+/// across the border would count the inner cascade's light twice and
+/// leave texels past it in no block.
+fn check_shaft_stride(k: u32, layout: &CascadeLayout) -> anyhow::Result<()> {
+    let [w, h] = layout.size;
+    let [bx, by] = layout.border;
+    let divides = |n: u32| n % k == 0;
+    if !(divides(w) && divides(h) && (layout.levels == 1 || (divides(bx) && divides(by)))) {
+        anyhow::bail!(
+            "--param shaft_stride={k}: must divide the caustic maps' side ({w} x {h}) and their rings' border ({bx} x {by} texels)"
+        );
+    }
+    Ok(())
+}
+
 /// `lights` and the environment's sun.
 fn with_sun(lights: &[Light], sun: Option<Light>) -> Vec<Light> {
     lights.iter().copied().chain(sun).collect()
@@ -277,6 +293,7 @@ impl WaterPhotons {
             params.ccm_size
         };
         let layout = CascadeLayout::new([size, size], levels, scale)?;
+        check_shaft_stride(params.shaft_stride, &layout)?;
         let frame = CascadeFrame::new(
             &water,
             scene.camera.eye,
@@ -507,19 +524,17 @@ impl TechniqueBuild for WaterPhotons {
                 extra.name
             );
         }
-        let mut suns = scene
+        let suns = scene
             .lights
             .iter()
-            .enumerate()
-            .filter(|(_, l)| l.kind == LightKind::Directional);
-        let first_sun = suns.next().map(|(i, _)| i);
-        let extra_sun = suns.next().map(|(i, _)| i);
-        match (first_sun, extra_sun, environment_sun(scene).is_some()) {
-            (Some(a), Some(b), _) => anyhow::bail!(
-                "{file}: light[{b}]: water_photons traces the caustics of one sun (the directional light light[{a}]); remove the other or choose another technique"
+            .filter(|l| l.kind == LightKind::Directional)
+            .count();
+        match (suns, environment_sun(scene).is_some()) {
+            (2.., _) => anyhow::bail!(
+                "{file}: light: water_photons traces the caustics of one sun, and the scene has {suns} directional lights; remove all but one or choose another technique"
             ),
-            (Some(a), None, true) => anyhow::bail!(
-                "{file}: light[{a}]: water_photons traces the caustics of one sun, and the environment has one too; remove the directional light or the environment's sun, or choose another technique"
+            (1, true) => anyhow::bail!(
+                "{file}: light: water_photons traces the caustics of one sun, and the scene has a directional light and an environment with a sun; remove one or choose another technique"
             ),
             _ => Ok(()),
         }
@@ -527,6 +542,11 @@ impl TechniqueBuild for WaterPhotons {
 
     fn update_live(&mut self, params: &WaterPhotonsParams) -> bool {
         self.shafts_on = params.shafts != 0;
+        // A stride that does not tile these cascades: rebuilt, whose check
+        // says why.
+        if check_shaft_stride(params.shaft_stride, &self.frame.layout).is_err() {
+            return false;
+        }
         self.gpu_params.shafts[0] = params.shaft_stride;
         self.surface.set_live(&params.direct, params.search_steps);
         true
