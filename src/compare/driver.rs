@@ -370,13 +370,27 @@ pub fn judge_technique(
     let (full, map) = metrics::compare(&image, &reference.all, width, height, exposure);
     // Both frames without the components not scored: what the technique
     // claims to render, against the reference's matching components.
+    // The truth is the sum of the reference's scored components, not `all`
+    // less the others: where those are black (`direct` under the water of
+    // `pool_shafts`) the subtraction's rounding residue read "energy -100%".
     let modelled = (!not_applicable.is_empty()).then(|| {
-        let unscored_truth = not_applicable.iter().filter_map(|n| {
-            let c = Component::parse(&n.component).ok()?;
-            reference.component(c)
-        });
+        let unscored = |c: Component| not_applicable.iter().any(|n| n.component == c.name());
+        // rgb summed, alpha as `all`'s.
+        let mut truth: Vec<f32> = reference
+            .all
+            .iter()
+            .enumerate()
+            .map(|(i, &a)| if i % 4 == 3 { a } else { 0.0 })
+            .collect();
+        for (c, img) in reference.components.iter().filter(|(c, _)| !unscored(*c)) {
+            debug_assert_ne!(*c, Component::All);
+            for (i, (t, v)) in truth.iter_mut().zip(img).enumerate() {
+                if i % 4 != 3 {
+                    *t += v;
+                }
+            }
+        }
         let ours = without(&image, unscored_images.iter().map(Vec::as_slice));
-        let truth = without(&reference.all, unscored_truth);
         metrics::compare(&ours, &truth, width, height, exposure).0
     });
     sink.radiance(name, &image)?;
