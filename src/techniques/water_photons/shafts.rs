@@ -8,18 +8,20 @@
 //! while the eye is under a water that holds a medium and `shafts` is on.
 
 use super::bindings;
+use super::splat::photon_quads;
 use super::WpParamsBuffer;
 use crate::frame::SceneGpu;
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::specular_gbuffer::SpecularGBuffer;
 use crate::vk::{
     Access, Buffer, Context, DescriptorSet, DescriptorSetLayout, FrameRecorder, GraphicsPipeline,
-    GraphicsPipelineDesc, Image, ImageDesc, Sampler, VkResult,
+    Image, ImageDesc, Sampler, VkResult,
 };
 use ash::vk;
 use std::sync::Arc;
 
 const SHAFTS_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+const SHAFTS_SHADERS: [&str; 2] = ["water_photons/shafts.vert", "water_photons/shafts.frag"];
 
 pub struct Shafts {
     /// Radiance scattered toward the eye in front of each pixel's surface (rgb).
@@ -50,21 +52,16 @@ impl Shafts {
                 vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::STORAGE,
             ),
         )?;
-        let layout = DescriptorSetLayout::of_shaders(
-            ctx,
-            1,
-            &["water_photons/shafts.vert", "water_photons/shafts.frag"],
-        )?;
         let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
-        let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_buffer(bindings::WP_BINDING_PARAMS, &params.0)
-            .write_buffer(bindings::WP_BINDING_PHOTONS, photons);
-        let mut desc =
-            GraphicsPipelineDesc::new("water_photons/shafts.vert", "water_photons/shafts.frag");
-        desc.color_formats = vec![SHAFTS_FORMAT];
-        desc.additive = true;
-        desc.topology = vk::PrimitiveTopology::TRIANGLE_STRIP;
-        let pipeline = GraphicsPipeline::new(ctx, &desc, &[&scene_gpu.layout, &layout])?;
+        let (layout, set, pipeline) = photon_quads(
+            ctx,
+            scene_gpu,
+            params,
+            photons,
+            SHAFTS_SHADERS,
+            SHAFTS_FORMAT,
+            |_| {},
+        )?;
         Ok(Self {
             image,
             pipeline,

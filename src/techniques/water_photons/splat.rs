@@ -25,6 +25,7 @@ use ash::vk;
 use std::sync::Arc;
 
 pub const CAUSTIC_BUFFER_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+const SPLAT_SHADERS: [&str; 2] = ["water_photons/splat.vert", "water_photons/splat.frag"];
 
 pub struct Splat {
     /// Screen-space caustic irradiance (rgb, W/m²) and kernel weight sum (a).
@@ -57,26 +58,22 @@ impl Splat {
                     | vk::ImageUsageFlags::SAMPLED,
             ),
         )?;
-        let layout = DescriptorSetLayout::of_shaders(
-            ctx,
-            1,
-            &["water_photons/splat.vert", "water_photons/splat.frag"],
-        )?;
         // Nearest: splat.frag fetches the G-buffer texel under the fragment.
         let sampler = Sampler::new(ctx, vk::Filter::NEAREST)?;
-        let set = DescriptorSet::new(ctx, &layout)?;
-        set.write_buffer(bindings::WP_BINDING_PARAMS, &params.0)
-            .write_buffer(bindings::WP_BINDING_PHOTONS, photons);
-        let mut desc =
-            GraphicsPipelineDesc::new("water_photons/splat.vert", "water_photons/splat.frag");
-        desc.color_formats = vec![CAUSTIC_BUFFER_FORMAT];
-        desc.depth_format = Some(DEPTH_FORMAT);
-        desc.depth_test = true;
-        desc.depth_write = false;
-        desc.additive = true;
-        desc.topology = vk::PrimitiveTopology::TRIANGLE_STRIP;
-        desc.specialization = specialization.clone();
-        let pipeline = GraphicsPipeline::new(ctx, &desc, &[&scene_gpu.layout, &layout])?;
+        let (layout, set, pipeline) = photon_quads(
+            ctx,
+            scene_gpu,
+            params,
+            photons,
+            SPLAT_SHADERS,
+            CAUSTIC_BUFFER_FORMAT,
+            |desc| {
+                desc.depth_format = Some(DEPTH_FORMAT);
+                desc.depth_test = true;
+                desc.depth_write = false;
+                desc.specialization = specialization.clone();
+            },
+        )?;
         Ok(Self {
             caustics,
             pipeline,
@@ -122,6 +119,33 @@ impl Splat {
                 });
             });
     }
+}
+
+/// The pipeline of an instanced draw of one 4-vertex strip per photon
+/// (the trace's indirect draw), its vertex and fragment shaders `shaders`,
+/// added into one `format` attachment, with its set 1 holding
+/// the parameters and the photons; `configure` adds the rest (depth,
+/// specialisation). Shared by the splat and the shafts.
+pub(super) fn photon_quads(
+    ctx: &Arc<Context>,
+    scene_gpu: &SceneGpu,
+    params: &WpParamsBuffer,
+    photons: &Buffer,
+    shaders: [&'static str; 2],
+    format: vk::Format,
+    configure: impl FnOnce(&mut GraphicsPipelineDesc),
+) -> VkResult<(DescriptorSetLayout, DescriptorSet, GraphicsPipeline)> {
+    let layout = DescriptorSetLayout::of_shaders(ctx, 1, &shaders)?;
+    let set = DescriptorSet::new(ctx, &layout)?;
+    set.write_buffer(bindings::WP_BINDING_PARAMS, &params.0)
+        .write_buffer(bindings::WP_BINDING_PHOTONS, photons);
+    let mut desc = GraphicsPipelineDesc::new(shaders[0], shaders[1]);
+    desc.color_formats = vec![format];
+    desc.additive = true;
+    desc.topology = vk::PrimitiveTopology::TRIANGLE_STRIP;
+    configure(&mut desc);
+    let pipeline = GraphicsPipeline::new(ctx, &desc, &[&scene_gpu.layout, &layout])?;
+    Ok((layout, set, pipeline))
 }
 
 /// L += albedo/π · E_caustic on the diffuse receivers of a G-buffer.
